@@ -1,0 +1,46 @@
+// Kanayama kinematic tracking controller (eqs 4.1-4.2) with analytic desired accelerations.
+#pragma once
+
+#include <string>
+
+#include "sowing_robot/core/types.h"
+
+namespace sowing_robot {
+namespace core {
+
+struct KanayamaGains {
+  double kx = 1.0;      ///< [1/s]
+  double ky = 1.5;      ///< [1/m^2]
+  double ktheta = 2.2;  ///< [1/m]
+  std::string validate() const;
+};
+
+/// Posture error in the robot frame (eq 4.1).
+struct PostureError {
+  double xe = 0.0, ye = 0.0, thetae = 0.0;
+};
+
+class Kanayama {
+ public:
+  explicit Kanayama(const KanayamaGains& gains = {}) : gains_(gains) {}
+
+  /// eq 4.1: e_p = T(theta)^T (P_r - P_A), with theta_e wrapped to (-pi, pi].
+  static PostureError postureError(const Pose2D& reference, const Pose2D& actual);
+
+  /// eq 4.2 for the velocities. The accelerations are the exact time derivatives of eq 4.2 along the
+  /// error dynamics (eq 4.15) evaluated with the measured velocities v, omega, so no numerical
+  /// differentiation (and no filter lag) enters the inner loop.
+  VelocityCommand compute(const Reference& ref, const Pose2D& actual, double v, double omega) const;
+
+  /// eq 4.14: L0 = (xe^2 + ye^2)/2 + (1 - cos thetae)/ky.
+  double lyapunov(const PostureError& e) const;
+
+  const KanayamaGains& gains() const { return gains_; }
+  void setGains(const KanayamaGains& g) { gains_ = g; }
+
+ private:
+  KanayamaGains gains_;
+};
+
+}  // namespace core
+}  // namespace sowing_robot

@@ -1,0 +1,70 @@
+// The DDMR plant: Lagrangian dynamics in (v, w) with centre-of-mass offset d (eq 3.54), nonholonomic
+// kinematics of the axle midpoint (eq 3.13) and the wheel angles, integrated with fixed-step RK4.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <random>
+#include <string>
+
+#include "sowing_robot/core/robot_params.h"
+
+namespace sowing_robot {
+namespace core {
+
+/// Named indices into the plant state (no magic offsets).
+enum StateIndex { X = 0, Y, THETA, V, OMEGA, PHI_R, PHI_L, STATE_SIZE };
+using State = Eigen::Matrix<double, STATE_SIZE, 1>;
+
+/// Everything the plant does to the ideal model: disturbance, noise and parameter mismatch.
+struct PlantDisturbance {
+  bool sinusoidal = false;     ///< add td_R = A sin(w t), td_L = A cos(w t) to the wheel torques (Fig 5.9)
+  double amplitude = 2.75;     ///< A [N·m]
+  double frequency = 3.0;      ///< w [rad/s]
+  double noise_std = 0.0;      ///< std of Gaussian wheel-torque noise, held over one step [N·m]; 0 = off
+  std::uint64_t seed = 1;      ///< seed of the noise generator
+  double mass_scale = 1.0;     ///< true m0 and mc·d are this times the nominal (1 = no mismatch)
+  double inertia_scale = 1.0;  ///< true I0 is this times the nominal (1 = no mismatch)
+
+  std::string validate() const;
+};
+
+/// Fixed-step RK4 simulation of the DDMR. The pose (x, y, theta) is that of the axle midpoint
+/// (REP-105 base_link); the centre of mass sits d ahead of it.
+class Plant {
+ public:
+  Plant(const RobotParams& nominal, const PlantDisturbance& disturbance);
+
+  /// Start again at time t with the given state (noise generator re-seeded).
+  void reset(const State& initial, double t = 0.0);
+
+  /// Advance by dt [s] with the commanded wheel torques [N·m], held constant over the step.
+  void step(double tau_right, double tau_left, double dt);
+
+  /// Time derivative of the state for the *applied* torques (commands + disturbance already added).
+  State derivative(const State& s, double applied_right, double applied_left) const;
+
+  /// Sinusoidal wheel-torque disturbance at time t [N·m] (zero when switched off).
+  void sinusoidalDisturbance(double t, double& right, double& left) const;
+
+  const State& state() const { return state_; }
+  double time() const { return time_; }
+  /// Physical parameters the plant really has (nominal scaled by the mismatch).
+  double trueM0() const { return m0_; }
+  double trueI0() const { return i0_; }
+
+  /// Position of the centre of mass (eq 3.26: x_c = x + d cos theta, y_c = y + d sin theta).
+  Eigen::Vector2d centreOfMass() const;
+
+ private:
+  RobotParams nominal_;
+  PlantDisturbance disturbance_;
+  double m0_, i0_, mcd_;  // true effective inertias and the coupling mc·d
+  State state_ = State::Zero();
+  double time_ = 0.0;
+  std::mt19937_64 rng_;
+  std::normal_distribution<double> noise_{0.0, 1.0};
+};
+
+}  // namespace core
+}  // namespace sowing_robot

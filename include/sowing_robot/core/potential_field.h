@@ -1,0 +1,169 @@
+// Potential-field reference generator (thesis section 4.3, eqs 4.32-4.37, corrected; see
+// docs/potential_field.md): a reference point with double-integrator dynamics is pulled onto a moving
+// target (the sowing row) and pushed around obstacles.
+//
+//   p'' = p_d'' - alpha (p - p_d) - beta (p' - p_d') + mu(p),   mu = -k grad V_a + tangential term
+//
+// The integration runs on the error e = p - p_d, so with no obstacle in range e stays exactly zero and
+// the reference IS the target.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "sowing_robot/core/reference.h"
+#include "sowing_robot/core/types.h"
+
+namespace sowing_robot {
+namespace core {
+
+/// Circular obstacle.
+struct Obstacle {
+  double x = 0.0, y = 0.0;  ///< centre [m]
+  double radius = 0.3;      ///< [m], > 0
+  std::string validate() const;
+};
+
+/// Straight sowing row travelled at constant speed: p_d(t) = start + speed t (cos heading, sin heading).
+struct RowLine {
+  double x0 = 0.0, y0 = 3.0;  ///< position of the target at t = 0 [m] (thesis: x = t, y = 3)
+  double heading = 0.0;       ///< direction of travel [rad]
+  double speed = 1.0;         ///< v_r [m/s], > 0
+  std::string validate() const;
+};
+
+/// Which way the reference goes around an obstacle (seen along the target's direction of travel).
+enum class AvoidSide {
+  kLeft,     ///< always pass with the obstacle on the right
+  kRight,    ///< always pass with the obstacle on the left
+  kShorter,  ///< pass on the side away from the obstacle centre; a centre on the line (|offset| <= 1 nm) -> left
+};
+
+struct PotentialFieldParams {
+  double alpha = 4.0;                ///< position gain alpha [1/s^2] (thesis: 4)
+  double beta = 16.0;                ///< damping of the velocity relative to the target, beta [1/s] (thesis: 16)
+  double influence_distance = 0.5;   ///< d: no repulsion beyond this clearance from the obstacle SURFACE [m]
+  double gain = 2.5;                 ///< k: mu_radial = -k grad V_a [m^2/s^2], >= 0 (0 disables avoidance)
+  double tangential_ratio = 1.0;     ///< |tangential| / |radial| repulsion [-], >= 0
+  AvoidSide avoid_side = AvoidSide::kShorter;
+  /// Below this fraction of d the clearance potential continues linearly (finite force, so a reference
+  /// that starts inside an obstacle is pushed out instead of blowing up the integrator) [-], (0, 1).
+  double core_fraction = 0.1;
+  double step = 1e-3;                ///< internal RK4 step h [s], (0, 1e-3]
+  std::string validate() const;
+};
+
+/// Kinematic state of a target at one time; a, j are exact time derivatives of v, a.
+struct TargetState {
+  Eigen::Vector2d p = Eigen::Vector2d::Zero();  ///< [m]
+  Eigen::Vector2d v = Eigen::Vector2d::Zero();  ///< [m/s]
+  Eigen::Vector2d a = Eigen::Vector2d::Zero();  ///< [m/s^2]
+  Eigen::Vector2d j = Eigen::Vector2d::Zero();  ///< jerk [m/s^3]
+  double heading = 0.0;  ///< direction of travel [rad], defined also when the target is at rest
+  bool tool_down = true;
+};
+
+/// A time-parameterised target; at(t) must be a pure function of t (t < 0 is treated as 0).
+class TargetTrajectory {
+ public:
+  virtual ~TargetTrajectory() = default;
+  virtual TargetState at(double t) const = 0;
+  virtual std::unique_ptr<TargetTrajectory> clone() const = 0;
+};
+
+/// The target moving along a RowLine forever.
+class LineTarget : public TargetTrajectory {
+ public:
+  explicit LineTarget(const RowLine& row);
+  TargetState at(double t) const override;
+  std::unique_ptr<TargetTrajectory> clone() const override { return std::make_unique<LineTarget>(*this); }
+  const RowLine& row() const { return row_; }
+
+ private:
+  RowLine row_;
+  Eigen::Vector2d u_;
+};
+
+/// Corrected thesis potential field (section 4.3) as a ReferenceSource.
+///
+/// * Clearance rho_i = |p - c_i| - r_i (distance to the obstacle surface); V_a = (1/2 (d/rho - 1))^2 for
+///   rho <= d, 0 beyond (V_a and grad V_a are both zero at rho = d). Below core_fraction*d, V_a continues
+///   linearly in rho.
+/// * mu = sum_i f_i (n_i + s_i tangential_ratio R n_i), f_i = -k dV_a/drho >= 0, n_i = (p - c_i)/|p - c_i|,
+///   R n = (n_y, -n_x) (n turned 90 deg clockwise) and s_i = +1 to pass obstacle i on the left of the
+///   direction of travel, -1 on the right. The tangential part breaks the symmetric stall in front of
+///   an obstacle on the line and always turns to the same, deterministic side.
+/// * RK4 with a fixed step h on the grid t = n h; next(t) integrates to the last grid point <= t and
+///   evaluates t by a partial RK4 step that is not kept, so the output depends only on t (and on when
+///   setObstacles() was called).
+/// * Output: theta = atan2(y', x'), v = |p'|, omega = (x'y'' - y'x'')/v^2, v_dot = p'.p''/v and an
+///   analytic omega_dot from the jerk p''' = p_d''' + e''' with e''' = -alpha e' - beta e'' + J_mu p'
+///   (J_mu the Jacobian of mu). Below 1e-4 m/s the last theta is held and omega = omega_dot = 0.
+class PotentialField : public ReferenceSource {
+ public:
+  /// Straight row. Throws std::invalid_argument on invalid parameters or obstacles.
+  PotentialField(const PotentialFieldParams& params, const RowLine& row = {}, std::vector<Obstacle> obstacles = {});
+  /// Any target (e.g. a whole field with headland turns). Throws std::invalid_argument as above.
+  PotentialField(const PotentialFieldParams& params, std::unique_ptr<TargetTrajectory> target,
+                 std::vector<Obstacle> obstacles = {});
+  PotentialField(const PotentialField& other);
+  PotentialField& operator=(const PotentialField& other);
+  PotentialField(PotentialField&&) = default;
+  PotentialField& operator=(PotentialField&&) = default;
+
+  /// Reference back on the target at t = 0 (position p_d(0), velocity p_d'(0)).
+  void reset() override;
+  /// Reference at t [s], t non-decreasing after reset(). tool_down is the target's.
+  Reference next(double t) override;
+  /// Same params, target and current obstacle list, in the reset state.
+  std::unique_ptr<ReferenceSource> clone() const override;
+
+  /// Replace the obstacles (validated; throws std::invalid_argument). Takes effect from the current
+  /// internal grid time on; the state is kept.
+  void setObstacles(std::vector<Obstacle> obstacles);
+  const std::vector<Obstacle>& obstacles() const { return obstacles_; }
+
+  /// Sum over the obstacles of V_a(p) [-] (without the gain k).
+  double repulsivePotential(const Eigen::Vector2d& p) const;
+  /// Gradient of repulsivePotential() [1/m]; the radial repulsion is -k times this.
+  Eigen::Vector2d repulsiveGradient(const Eigen::Vector2d& p) const;
+  /// Full repulsive acceleration mu [m/s^2] (radial + tangential) for a target with the given state.
+  Eigen::Vector2d repulsiveAcceleration(const Eigen::Vector2d& p, const TargetState& target) const;
+  /// Smallest |p - c_i| - r_i over the obstacles [m]; +infinity without obstacles.
+  double minObstacleClearance(const Eigen::Vector2d& p) const;
+
+  const PotentialFieldParams& params() const { return params_; }
+  const TargetTrajectory& target() const { return *target_; }
+  /// Reference position [m], velocity [m/s] and acceleration [m/s^2] of the last next() call.
+  const Eigen::Vector2d& position() const { return out_p_; }
+  const Eigen::Vector2d& velocity() const { return out_v_; }
+  const Eigen::Vector2d& acceleration() const { return out_a_; }
+
+ private:
+  struct ErrorState {
+    Eigen::Vector2d e = Eigen::Vector2d::Zero(), ed = Eigen::Vector2d::Zero();
+  };
+  /// V_a'(rho) and V_a''(rho) for one clearance (zero beyond d).
+  void clearanceDerivatives(double rho, double& dv, double& ddv) const;
+  /// mu at p; adds d mu/d p into *jacobian when given.
+  Eigen::Vector2d mu(const Eigen::Vector2d& p, const TargetState& target, Eigen::Matrix2d* jacobian) const;
+  /// e'' for an error state at time t with the target state tgt.
+  Eigen::Vector2d errorAccel(const ErrorState& s, const TargetState& tgt) const;
+  ErrorState rk4(const ErrorState& s, double t, double h) const;
+
+  PotentialFieldParams params_;
+  std::unique_ptr<TargetTrajectory> target_;
+  std::vector<Obstacle> obstacles_;
+
+  ErrorState state_;  ///< error state at the grid time steps_ * h
+  long long steps_ = 0;
+  double last_theta_ = 0.0;
+  Eigen::Vector2d out_p_ = Eigen::Vector2d::Zero(), out_v_ = Eigen::Vector2d::Zero(),
+                  out_a_ = Eigen::Vector2d::Zero();
+};
+
+}  // namespace core
+}  // namespace sowing_robot

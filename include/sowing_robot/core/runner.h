@@ -1,0 +1,65 @@
+// In-process closed loop: plant + Kanayama + sliding-mode controller + reference, stepped exactly as
+// the node pipeline steps them in lockstep (same order, same times, same yaw round trip), so the two
+// give the same numbers. Used by tests, the metrics tool and the PSO tuner.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <string>
+
+#include "sowing_robot/core/kanayama.h"
+#include "sowing_robot/core/metrics.h"
+#include "sowing_robot/core/plant.h"
+#include "sowing_robot/core/reference.h"
+#include "sowing_robot/core/sliding_mode.h"
+
+namespace sowing_robot {
+namespace core {
+
+struct Scenario {
+  double duration = 25.0;                 ///< simulated time [s]
+  std::int64_t control_period_ns = 1000000;  ///< plant step and control period [ns] (1 kHz)
+  Pose2D start{-1.0, 0.0, 0.0};           ///< initial posture of the axle midpoint
+  RobotParams robot;                      ///< nominal parameters (the controllers' model)
+  PlantDisturbance disturbance;           ///< what the plant adds (disturbance, noise, mismatch)
+  KanayamaGains kanayama;
+  SlidingModeParams sliding;
+
+  std::string validate() const;
+  /// Number of control periods; states are evaluated at k = 0..steps() inclusive.
+  std::int64_t steps() const;
+};
+
+/// One control period of the loop, as seen by a trace callback.
+struct LoopSample {
+  double t;
+  const State* state;
+  const Reference* reference;
+  const VelocityCommand* desired;
+  const SlidingModeOutput* control;
+  double m0_hat, i0_hat;
+  double ex, ey, etheta;  ///< world-frame errors
+};
+
+struct RunResult {
+  std::array<AxisMetrics, AXIS_COUNT> metrics{};
+  State final_state = State::Zero();
+  bool diverged = false;  ///< state became non-finite; metrics are then +inf
+  std::int64_t saturated_steps = 0;
+};
+
+/// Run the scenario with the given reference. trace (optional) sees every period; keep_samples turns
+/// on the time-domain figures (rise/settling/overshoot).
+RunResult runClosedLoop(const Scenario& scenario, ReferenceSource& reference, bool keep_samples = true,
+                        const std::function<void(const LoopSample&)>& trace = {});
+
+/// World-frame errors (reference minus actual, theta wrapped).
+inline void worldErrors(const Reference& r, const Pose2D& a, double& ex, double& ey, double& eth) {
+  ex = r.pose.x - a.x;
+  ey = r.pose.y - a.y;
+  eth = wrapAngle(r.pose.theta - a.theta);
+}
+
+}  // namespace core
+}  // namespace sowing_robot

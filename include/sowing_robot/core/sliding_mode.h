@@ -1,0 +1,74 @@
+// Integral terminal sliding-mode wheel-torque controller (eqs 4.7-4.22): adaptive (ATSMC) or with
+// fixed nominal parameters (TSMC, the thesis's baseline).
+#pragma once
+
+#include <string>
+
+#include "sowing_robot/core/robot_params.h"
+#include "sowing_robot/core/switching.h"
+#include "sowing_robot/core/types.h"
+
+namespace sowing_robot {
+namespace core {
+
+/// Real power x^(num/den) for an odd den, i.e. the real root: sign(x)^num |x|^(num/den).
+double realPower(double x, int num, int den);
+
+struct SlidingModeParams {
+  bool adaptive = true;  ///< true: ATSMC (eq 4.22 with projection); false: TSMC (fixed nominal)
+  int p = 5, q = 3;      ///< terminal exponent p/q, both odd, 1 < p/q < 2
+  double beta_v = 1.0, beta_omega = 1.0;  ///< surface gains beta per channel (not given in the thesis)
+  double k1 = 1.0, k2 = 150.0;            ///< feedback gains K1 [N·m·s/m], K2 [N·m·s/rad]
+  double eta1 = 2.0, eta2 = 2.0;          ///< switching gains [N·m]
+  double rate_m = 0.1, rate_i = 0.1;      ///< adaptation rates of m0_hat and I0_hat (Table 5.3 gamma1/2)
+  double m0_min = 17.51, m0_max = 37.51;  ///< projection bounds on m0_hat [kg]
+  double i0_min = 0.57, i0_max = 4.57;    ///< projection bounds on I0_hat [kg·m^2]
+  double m0_initial = 0.0, i0_initial = 0.0;  ///< initial/nominal estimates; <= 0 means "from the URDF"
+  double max_torque = 100.0;              ///< per-wheel motor limit [N·m]
+  SwitchFunction switching;
+
+  std::string validate() const;
+};
+
+/// What one control update produced, for logging and plots.
+struct SlidingModeOutput {
+  WheelTorques torques;
+  double e_v = 0.0, e_omega = 0.0;  ///< desired minus measured
+  double s_v = 0.0, s_omega = 0.0;  ///< sliding variables S1, S2
+  double u1 = 0.0, u2 = 0.0;        ///< before saturation
+  bool saturated = false;
+};
+
+class SlidingModeController {
+ public:
+  /// `nominal` gives R, L and (where the params leave them <= 0) the initial m0, I0 estimates.
+  SlidingModeController(const SlidingModeParams& params, const RobotParams& nominal);
+
+  /// Zero the integrals and return the estimates to their initial values.
+  void reset();
+
+  /// One control period of length dt [s]. Non-finite inputs must be rejected by the caller.
+  SlidingModeOutput update(const VelocityCommand& desired, double v, double omega, double dt);
+
+  double m0Hat() const { return m0_hat_; }
+  double i0Hat() const { return i0_hat_; }
+  const SlidingModeParams& params() const { return params_; }
+  /// Change gains live (integrals and estimates are kept; estimates clamped into new bounds).
+  void setParams(const SlidingModeParams& params);
+
+ private:
+  struct Channel {
+    double integral = 0.0;
+  };
+  /// S and phi = x_dot_d + beta (p/q) e (int e)^(p/q-1) for one channel; updates its integral.
+  void surface(Channel& c, double e, double xd_dot, double beta, double dt, double& s, double& phi) const;
+
+  SlidingModeParams params_;
+  double R_, L_;
+  double m0_initial_, i0_initial_;
+  double m0_hat_, i0_hat_;
+  Channel linear_, angular_;
+};
+
+}  // namespace core
+}  // namespace sowing_robot

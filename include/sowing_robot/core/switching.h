@@ -1,0 +1,27 @@
+// The robustness term's switching function: sign and its chattering remedies (eqs 4.46-4.48).
+#pragma once
+
+#include <string>
+
+namespace sowing_robot {
+namespace core {
+
+enum class SwitchType { Sign, Saturation, Relay, Atan, Tanh };
+
+struct SwitchFunction {
+  SwitchType type = SwitchType::Sign;
+  /// Width of the smoothing: boundary layer phi of sat(S/phi) and tanh(S/phi), delta of the relay
+  /// S/(|S|+delta), and 1/Delta of the normalised arctangent (2/pi) atan(S/width).
+  double width = 0.01;
+
+  /// Value in [-1, 1]; odd in s; tends to sign(s) as |s| grows.
+  double operator()(double s) const;
+
+  std::string validate() const;
+  /// "sign", "sat", "relay", "atan", "tanh" -> type; false on an unknown name.
+  static bool parse(const std::string& name, SwitchType& type);
+  static const char* name(SwitchType type);
+};
+
+}  // namespace core
+}  // namespace sowing_robot

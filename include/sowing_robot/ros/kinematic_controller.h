@@ -1,0 +1,34 @@
+// kinematic_controller: reference + odom -> desired body velocities (Kanayama, eqs 4.1-4.2) and the
+// tracking error for plotting and metrics.
+#pragma once
+
+#include <nav_msgs/Odometry.h>
+#include <ros/ros.h>
+
+#include "sowing_robot/DesiredVelocity.h"
+#include "sowing_robot/ReferenceState.h"
+#include "sowing_robot/TrackingError.h"
+#include "sowing_robot/core/kanayama.h"
+#include "sowing_robot/ros/stamp_pair.h"
+
+namespace sowing_robot {
+
+class KinematicController {
+ public:
+  KinematicController(ros::NodeHandle nh, ros::NodeHandle pnh);
+
+ private:
+  void odomCallback(const nav_msgs::Odometry::ConstPtr& msg);
+  void referenceCallback(const ReferenceState::ConstPtr& msg);
+  void compute();
+
+  core::Kanayama kanayama_;
+  ros::Subscriber odom_sub_, ref_sub_;
+  ros::Publisher desired_pub_, error_pub_;
+  StampPair<nav_msgs::Odometry, ReferenceState> inputs_;
+  DesiredVelocity desired_;
+  TrackingError error_;
+  long rejected_ = 0;
+};
+
+}  // namespace sowing_robot

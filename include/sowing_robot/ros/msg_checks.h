@@ -1,0 +1,24 @@
+// Conversions and finiteness checks shared by the nodes.
+#pragma once
+
+#include <nav_msgs/Odometry.h>
+
+#include "sowing_robot/core/types.h"
+
+namespace sowing_robot {
+
+/// Planar pose from odometry. The yaw comes from the quaternion exactly as core::yawThroughQuaternion
+/// reconstructs it, so nodes and the in-process runner agree bit for bit.
+inline core::Pose2D poseOf(const nav_msgs::Odometry& o) {
+  const auto& q = o.pose.pose.orientation;
+  return {o.pose.pose.position.x, o.pose.pose.position.y, std::atan2(2.0 * q.w * q.z, 1.0 - 2.0 * q.z * q.z)};
+}
+
+/// True when every field the controllers use is finite.
+inline bool odomIsFinite(const nav_msgs::Odometry& o) {
+  const auto& q = o.pose.pose.orientation;
+  return core::allFinite(o.pose.pose.position.x, o.pose.pose.position.y, q.z, q.w, o.twist.twist.linear.x,
+                         o.twist.twist.angular.z);
+}
+
+}  // namespace sowing_robot

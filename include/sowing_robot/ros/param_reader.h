@@ -1,0 +1,45 @@
+// Reads a node's private parameters once at start-up, remembers which keys were read, and reports the
+// first problem (wrong type, unknown key) as one line. Range checks live in the core params' validate().
+#pragma once
+
+#include <ros/node_handle.h>
+
+#include <set>
+#include <string>
+
+namespace sowing_robot {
+
+class ParamReader {
+ public:
+  explicit ParamReader(const ros::NodeHandle& nh) : nh_(nh) {}
+
+  /// Value of `key` (relative to the handle) or `def` when absent; a value of the wrong type is an error.
+  double get(const std::string& key, double def);
+  int get(const std::string& key, int def);
+  bool get(const std::string& key, bool def);
+  std::string get(const std::string& key, const std::string& def);
+  std::string get(const std::string& key, const char* def) { return get(key, std::string(def)); }
+
+  /// Mark a key (or a whole sub-namespace ending in '/') as known without reading it.
+  void allow(const std::string& key) { read_.insert(nh_.getNamespace() + "/" + key); }
+
+  /// First type error, or "" when every read succeeded.
+  const std::string& error() const { return error_; }
+  /// "" when every parameter under the handle's namespace was read, else one line listing the others
+  /// (catches the typo that would silently leave a default in force).
+  std::string unknownKeys() const;
+  const ros::NodeHandle& handle() const { return nh_; }
+
+ private:
+  template <typename T>
+  T read(const std::string& key, const T& def, const char* type_name);
+
+  ros::NodeHandle nh_;
+  std::set<std::string> read_;
+  std::string error_;
+};
+
+/// Log `message` as FATAL with the node name and exit(1): the refusal to start that STYLE.md asks for.
+[[noreturn]] void refuseToStart(const std::string& message);
+
+}  // namespace sowing_robot

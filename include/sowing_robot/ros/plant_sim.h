@@ -1,0 +1,76 @@
+// plant_sim: the DDMR plant as a node. Owns simulated time (/clock) and publishes odom, tf,
+// joint_states and the travelled path; consumes wheel torques.
+//
+// Modes: realtime (paced to the wall clock, zero-order hold of the latest torque, torque timeout ->
+// zero torque) and lockstep (publish the state at t_k, advance only when the torque stamped t_k has
+// arrived; a late or missing torque is reported, never skipped).
+#pragma once
+
+#include <nav_msgs/Odometry.h>
+#include <nav_msgs/Path.h>
+#include <ros/ros.h>
+#include <sensor_msgs/JointState.h>
+#include <tf2_ros/transform_broadcaster.h>
+
+#include <atomic>
+#include <memory>
+#include <mutex>
+
+#include "sowing_robot/WheelTorque.h"
+#include "sowing_robot/core/plant.h"
+#include "sowing_robot/core/types.h"
+
+namespace sowing_robot {
+
+class PlantSim {
+ public:
+  /// Loads and validates all parameters; refuses to start (exit 1) on a bad one.
+  PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh);
+  /// Runs the simulation until shutdown (or the end of a lockstep scenario, then keeps serving).
+  void run();
+
+ private:
+  struct Config {
+    bool lockstep = false;
+    std::int64_t period_ns = 1000000;
+    double duration = 25.0;          // [s] sim; <= 0 runs forever
+    double realtime_factor = 1.0;    // sim seconds per wall second in realtime mode
+    double torque_timeout = 0.1;     // [s] sim, realtime mode: older torques are replaced by zero
+    double publish_rate = 50.0;      // [Hz] sim, tf / joint_states / path
+    double lockstep_retry = 0.5;     // [s] wall: republish the state if no torque came
+    double lockstep_timeout = 5.0;   // [s] wall: report the missing input
+    int min_subscribers = 3;         // odom subscribers to wait for before step 0 (lockstep)
+    double startup_delay = 0.5;      // [s] wall, lockstep: let every connection settle before step 0
+    double max_speed = 20.0;         // [m/s]; beyond it (or NaN) the run is stopped as diverged
+    bool exit_at_end = false;        // lockstep: exit when the scenario ends
+  };
+
+  void torqueCallback(const WheelTorque::ConstPtr& msg);
+  void publishState(const ros::Time& stamp, bool visuals);
+  bool healthy();
+  void runLockstep();
+  void runRealtime();
+
+  ros::NodeHandle nh_;
+  Config cfg_;
+  std::unique_ptr<core::Plant> plant_;
+  core::Pose2D start_;
+
+  ros::Publisher clock_pub_, odom_pub_, joint_pub_, path_pub_;
+  ros::Subscriber torque_sub_;
+  tf2_ros::TransformBroadcaster tf_;
+  nav_msgs::Odometry odom_msg_;
+  sensor_msgs::JointState joint_msg_;
+  nav_msgs::Path path_msg_;
+  std::int64_t visual_every_ = 20;  // publish visuals every n steps
+
+  std::mutex torque_mutex_;
+  core::WheelTorques torque_;       // last accepted torque
+  ros::Time torque_stamp_;          // its stamp
+  bool torque_valid_ = false;
+  ros::Time waiting_for_;           // lockstep: the stamp we need a torque for
+  std::atomic<bool> got_torque_{false};
+  std::int64_t rejected_ = 0, late_ = 0;
+};
+
+}  // namespace sowing_robot

@@ -1,0 +1,37 @@
+// torque_controller: desired + measured velocities -> wheel torques (ATSMC or TSMC, eqs 4.7-4.22).
+// Publishes its sliding variables and adaptive estimates on ~state.
+#pragma once
+
+#include <nav_msgs/Odometry.h>
+#include <ros/ros.h>
+
+#include <memory>
+
+#include "sowing_robot/DesiredVelocity.h"
+#include "sowing_robot/TorqueControllerState.h"
+#include "sowing_robot/WheelTorque.h"
+#include "sowing_robot/core/sliding_mode.h"
+#include "sowing_robot/ros/stamp_pair.h"
+
+namespace sowing_robot {
+
+class TorqueController {
+ public:
+  TorqueController(ros::NodeHandle nh, ros::NodeHandle pnh);
+
+ private:
+  void odomCallback(const nav_msgs::Odometry::ConstPtr& msg);
+  void desiredCallback(const DesiredVelocity::ConstPtr& msg);
+  void compute();
+
+  std::unique_ptr<core::SlidingModeController> smc_;
+  double dt_ = 0.001;
+  ros::Subscriber odom_sub_, desired_sub_;
+  ros::Publisher torque_pub_, state_pub_;
+  StampPair<nav_msgs::Odometry, DesiredVelocity> inputs_;
+  WheelTorque torque_;
+  TorqueControllerState state_;
+  long rejected_ = 0, saturated_ = 0;
+};
+
+}  // namespace sowing_robot

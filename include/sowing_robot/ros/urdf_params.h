@@ -1,0 +1,24 @@
+// Reads the thesis Table 5.1 parameters (core::RobotParams) from the robot's URDF, so the URDF is the
+// single source of geometry and inertia. ROS-free: urdfdom only (link urdfdom_model), no roscpp.
+#pragma once
+
+#include <string>
+
+#include "sowing_robot/core/robot_params.h"
+
+namespace sowing_robot {
+
+/// Reads Table 5.1 parameters from a URDF string. Returns "" on success or one line naming what is
+/// missing/wrong; `out` is written only on success.
+///
+/// Mapping (all in base_link, wheel joints at zero angle; see the comment at the top of
+/// urdf/sowing_robot.urdf):
+///   mc = mass of link `chassis`; d = x of its centre of mass; Ic = its yaw inertia about the axle
+///   midpoint (izz about the COM + mc (x^2 + y^2)); mw, Iw, Im = mass, inertia about the joint axis and
+///   inertia about the vertical of link `right_wheel` (left must match); L = |y| of
+///   `right_wheel_joint` (left must mirror it); R = radius of the wheel's collision cylinder, which must
+///   equal the joint height.
+/// Besides chassis and the two wheels no link may carry mass: Table 5.1 lumps everything else into mc.
+std::string robotParamsFromUrdf(const std::string& urdf_xml, core::RobotParams& out);
+
+}  // namespace sowing_robot

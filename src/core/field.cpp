@@ -1,0 +1,356 @@
+#include "sowing_robot/core/field.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+#include "sowing_robot/core/validation.h"
+
+namespace sowing_robot {
+namespace core {
+
+namespace {
+
+/// Distance covered by a half-cosine speed ramp from v0 to v1 with peak |v_dot| = a [m].
+double rampDistance(double v0, double v1, double a) { return M_PI * std::fabs(v1 * v1 - v0 * v0) / (4.0 * a); }
+
+/// Length of a cosine curvature ramp of height dk with peak |dkappa/ds| = rate [m].
+double rampLength(double dk, double rate) { return 0.5 * M_PI * std::fabs(dk) / rate; }
+
+/// Speed entering and leaving row i.
+void rowSpeeds(const FieldParams& p, int i, double& v_in, double& v_out) {
+  v_in = i == 0 ? (p.start_from_rest ? 0.0 : p.row_speed) : p.turn_speed;
+  v_out = i == p.rows - 1 ? 0.0 : p.turn_speed;
+}
+
+std::string formatNumber(double v) {
+  char b[32];
+  std::snprintf(b, sizeof(b), "%.6g", v);
+  return b;
+}
+
+}  // namespace
+
+std::string FieldParams::validate() const {
+  if (rows < 1) return "rows = " + std::to_string(rows) + " must be >= 1";
+  if (!allFinite(start_x, start_y, heading))
+    return "start (" + formatNumber(start_x) + ", " + formatNumber(start_y) + ") and heading = " +
+           formatNumber(heading) + " must be finite";
+  std::string e = firstError(
+      {checkPositive("row_length", row_length, "m"), checkPositive("row_spacing", row_spacing, "m"),
+       checkPositive("row_speed", row_speed, "m/s"), checkPositive("turn_speed", turn_speed, "m/s"),
+       checkRange("turn_speed", turn_speed, 0.0, row_speed, "m/s (up to row_speed)"),
+       checkPositive("min_turn_radius", min_turn_radius, "m"), checkPositive("max_accel", max_accel, "m/s^2"),
+       checkPositive("max_curvature_rate", max_curvature_rate, "1/m^2"), potential.validate()});
+  if (!e.empty()) return e;
+  const double rate_min = 0.5 / (min_turn_radius * min_turn_radius);
+  if (max_curvature_rate < rate_min)
+    return "max_curvature_rate = " + formatNumber(max_curvature_rate) + " 1/m^2 must be >= 1/(2 min_turn_radius^2) = " +
+           formatNumber(rate_min) + " 1/m^2";
+  double v_in, v_out;
+  rowSpeeds(*this, 0, v_in, v_out);
+  const double need = rampDistance(v_in, v_out, max_accel);
+  if (v_in > v_out && row_length < need * (1.0 - 1e-12))
+    return "row_length = " + formatNumber(row_length) + " m is too short to change speed from " + formatNumber(v_in) +
+           " to " + formatNumber(v_out) + " m/s at max_accel (needs >= " + formatNumber(need) + " m)";
+  return "";
+}
+
+// ---------------------------------------------------------------------------------------------------
+// HeadlandTurn
+
+namespace {
+// 5-point Gauss-Legendre on [0, 1].
+constexpr double kGaussX[5] = {0.04691007703066800, 0.23076534494715845, 0.5, 0.76923465505284155,
+                               0.95308992296933200};
+constexpr double kGaussW[5] = {0.11846344252809454, 0.23931433524968324, 0.28444444444444444,
+                               0.23931433524968324, 0.11846344252809454};
+}  // namespace
+
+void HeadlandTurn::segmentState(const Segment& g, double tau, double& theta, double& kappa, double& dkappa) {
+  if (g.k0 == g.k1 || g.length <= 0.0) {
+    kappa = g.k0;
+    theta = g.theta0 + g.k0 * tau;
+    dkappa = 0.0;
+    return;
+  }
+  const double dk = g.k1 - g.k0, w = M_PI / g.length;
+  kappa = g.k0 + 0.5 * dk * (1.0 - std::cos(w * tau));
+  theta = g.theta0 + g.k0 * tau + 0.5 * dk * (tau - std::sin(w * tau) / w);
+  dkappa = 0.5 * dk * w * std::sin(w * tau);
+}
+
+Eigen::Vector2d HeadlandTurn::integrate(const Segment& g, double a, double b) {
+  Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+  const double h = b - a;
+  if (h == 0.0) return sum;
+  for (int i = 0; i < 5; ++i) {
+    double th, k, dk;
+    segmentState(g, a + kGaussX[i] * h, th, k, dk);
+    sum += kGaussW[i] * Eigen::Vector2d(std::cos(th), std::sin(th));
+  }
+  return h * sum;
+}
+
+bool HeadlandTurn::build(double k, double lambda, double away, double rate) {
+  segments_.clear();
+  nodes_.clear();
+  const double ka = -lambda * k;
+  // Curvature levels and holds; the hold at k is found from the total heading change pi.
+  struct Piece {
+    double k0, k1, length;
+  };
+  Piece pieces[7] = {{0.0, ka, rampLength(ka, rate)}, {ka, ka, away}, {ka, k, rampLength(k - ka, rate)},
+                     {k, k, 0.0}, {k, ka, rampLength(k - ka, rate)}, {ka, ka, away}, {ka, 0.0, rampLength(ka, rate)}};
+  double heading = 0.0;
+  for (int i = 0; i < 7; ++i)
+    if (i != 3) heading += 0.5 * (pieces[i].k0 + pieces[i].k1) * pieces[i].length;
+  const double hold = (M_PI - heading) / k;
+  if (hold < -1e-12 * std::max(1.0, 1.0 / k)) return false;
+  pieces[3].length = std::max(0.0, hold);
+
+  double s = 0.0, theta = 0.0;
+  Eigen::Vector2d p = Eigen::Vector2d::Zero();
+  peak_curvature_ = 0.0;
+  for (const Piece& pc : pieces) {
+    if (pc.length <= 0.0) continue;
+    Segment g;
+    g.s0 = s;
+    g.length = pc.length;
+    g.k0 = pc.k0;
+    g.k1 = pc.k1;
+    g.theta0 = theta;
+    g.nodes = static_cast<int>(std::clamp(std::ceil(pc.length / 0.01), 16.0, 2000.0));
+    g.node_step = pc.length / g.nodes;
+    g.first_node = nodes_.size();
+    for (int i = 0; i < g.nodes; ++i) {
+      nodes_.push_back(p);
+      p += integrate(g, i * g.node_step, i + 1 == g.nodes ? g.length : (i + 1) * g.node_step);
+    }
+    double kappa, dk;
+    segmentState(g, g.length, theta, kappa, dk);
+    peak_curvature_ = std::max({peak_curvature_, std::fabs(g.k0), std::fabs(g.k1)});
+    segments_.push_back(g);
+    s += pc.length;
+  }
+  length_ = s;
+  end_ = p;
+  bulb_ = lambda > 0.0;
+  return true;
+}
+
+HeadlandTurn::HeadlandTurn(double width, double max_curvature, double rate) {
+  if (!(width > 0.0 && max_curvature > 0.0 && rate > 0.0 && std::isfinite(width) && std::isfinite(max_curvature) &&
+        std::isfinite(rate)))
+    throw std::invalid_argument("HeadlandTurn: width, max_curvature and rate must be finite and > 0");
+  const double k_hi = std::min(max_curvature, std::sqrt(2.0 * rate));
+  auto widthAt = [&](double k, double lambda, double away) {
+    if (!build(k, lambda, away, rate)) throw std::invalid_argument("HeadlandTurn: curvature ramps do not fit");
+    return end_.y();
+  };
+  if (widthAt(k_hi, 0.0, 0.0) <= width) {
+    // Rounded semicircle: the lateral offset falls as the curvature rises; bisect on kappa.
+    double lo = std::min(k_hi, 1.0 / width), hi = k_hi;
+    while (widthAt(lo, 0.0, 0.0) < width) lo *= 0.5;
+    for (int i = 0; i < 200 && hi - lo > 1e-15 * hi; ++i) {
+      const double mid = 0.5 * (lo + hi);
+      (widthAt(mid, 0.0, 0.0) > width ? lo : hi) = mid;
+    }
+    widthAt(0.5 * (lo + hi), 0.0, 0.0);
+  } else {
+    // Bulb turn at the largest curvature: b in [0, 1] grows the away lobe, b > 1 adds away arcs of
+    // (b - 1) rad each. The lateral offset falls as b grows.
+    auto widthB = [&](double b) { return b <= 1.0 ? widthAt(k_hi, b, 0.0) : widthAt(k_hi, 1.0, (b - 1.0) / k_hi); };
+    double lo = 0.0, hi = 1.0;
+    while (widthB(hi) > width) {
+      lo = hi;
+      hi += 0.25;
+      if (hi > 1.0 + M_PI) throw std::invalid_argument("HeadlandTurn: no bulb turn found");
+    }
+    for (int i = 0; i < 200 && hi - lo > 1e-15 * hi; ++i) {
+      const double mid = 0.5 * (lo + hi);
+      (widthB(mid) > width ? lo : hi) = mid;
+    }
+    widthB(0.5 * (lo + hi));
+  }
+  if (std::fabs(end_.y() - width) > 1e-9 * std::max(1.0, width) || std::fabs(end_.x()) > 1e-9 * std::max(1.0, width))
+    throw std::invalid_argument("HeadlandTurn: turn construction did not converge");
+}
+
+void HeadlandTurn::evaluate(double s, Eigen::Vector2d& p, double& theta, double& kappa, double& dkappa) const {
+  if (segments_.empty()) {
+    p.setZero();
+    theta = kappa = dkappa = 0.0;
+    return;
+  }
+  s = std::clamp(s, 0.0, length_);
+  std::size_t i = 0;
+  while (i + 1 < segments_.size() && segments_[i + 1].s0 <= s) ++i;
+  const Segment& g = segments_[i];
+  const double tau = std::clamp(s - g.s0, 0.0, g.length);
+  const int n = std::min(g.nodes - 1, static_cast<int>(tau / g.node_step));
+  p = nodes_[g.first_node + n] + integrate(g, n * g.node_step, tau);
+  segmentState(g, tau, theta, kappa, dkappa);
+}
+
+// ---------------------------------------------------------------------------------------------------
+// FieldPath
+
+Eigen::Vector2d FieldPath::rowStart(int i) const {
+  const double h = params_.heading;
+  const Eigen::Vector2d u(std::cos(h), std::sin(h));
+  const Eigen::Vector2d side = (params_.rows_to_left ? 1.0 : -1.0) * Eigen::Vector2d(-u.y(), u.x());
+  Eigen::Vector2d p = Eigen::Vector2d(params_.start_x, params_.start_y) + (i * params_.row_spacing) * side;
+  if (i % 2 == 1) p += params_.row_length * u;
+  return p;
+}
+
+void FieldPath::addPhase(double distance, double v0, double v1) {
+  Phase ph;
+  ph.t0 = duration_;
+  if (!phases_.empty()) {
+    const Phase& b = phases_.back();
+    ph.s0 = b.s0 + 0.5 * (b.v0 + b.v1) * b.duration;  // exact for cruises and half-cosine ramps
+  }
+  ph.v0 = v0;
+  ph.v1 = v1;
+  ph.duration = v0 == v1 ? distance / v0 : M_PI * std::fabs(v1 - v0) / (2.0 * params_.max_accel);
+  phases_.push_back(ph);
+  duration_ += ph.duration;
+}
+
+FieldPath::FieldPath(const FieldParams& params) : params_(params) {
+  const std::string e = params_.validate();
+  if (!e.empty()) throw std::invalid_argument("FieldParams: " + e);
+  const int n = params_.rows;
+  if (n > 1) turn_ = HeadlandTurn(params_.row_spacing, 1.0 / params_.min_turn_radius, params_.max_curvature_rate);
+
+  // Geometry.
+  double s = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const double h = params_.heading + (i % 2 == 1 ? M_PI : 0.0);
+    Element row;
+    row.s0 = s;
+    row.length = params_.row_length;
+    row.p0 = rowStart(i);
+    row.heading = h;
+    elements_.push_back(row);
+    s += row.length;
+    if (i + 1 < n) {
+      Element t;
+      t.s0 = s;
+      t.length = turn_.length();
+      t.turn = true;
+      t.p0 = row.p0 + params_.row_length * Eigen::Vector2d(std::cos(h), std::sin(h));
+      t.heading = h;
+      t.side = (params_.rows_to_left ? 1.0 : -1.0) * (i % 2 == 0 ? 1.0 : -1.0);
+      elements_.push_back(t);
+      s += t.length;
+    }
+  }
+  total_length_ = s;
+
+  // Speed profile along the same sequence.
+  const double a = params_.max_accel, vr = params_.row_speed, vt = params_.turn_speed;
+  for (int i = 0; i < n; ++i) {
+    double v_in, v_out;
+    rowSpeeds(params_, i, v_in, v_out);
+    const double L = params_.row_length;
+    const double vp = std::max(
+        {std::min(vr, std::sqrt(0.5 * (4.0 * a * L / M_PI + v_in * v_in + v_out * v_out))), v_in, v_out});
+    const double d1 = vp > v_in ? rampDistance(v_in, vp, a) : 0.0;
+    const double d2 = vp > v_out ? rampDistance(vp, v_out, a) : 0.0;
+    if (d1 > 0.0) addPhase(d1, v_in, vp);
+    const double cruise = L - d1 - d2;
+    if (cruise > 1e-12 * L) addPhase(cruise, vp, vp);
+    if (d2 > 0.0) addPhase(d2, vp, v_out);
+    if (i + 1 < n) addPhase(turn_.length(), vt, vt);
+  }
+}
+
+void FieldPath::arcLength(double t, double& s, double& sd, double& sdd, double& sddd) const {
+  sd = sdd = sddd = 0.0;
+  if (!(t > 0.0)) t = 0.0;
+  if (t >= duration_ || phases_.empty()) {
+    s = total_length_;
+    if (phases_.empty()) s = 0.0;
+    return;
+  }
+  auto it = std::upper_bound(phases_.begin(), phases_.end(), t, [](double v, const Phase& p) { return v < p.t0; });
+  const Phase& ph = *(it == phases_.begin() ? it : it - 1);
+  const double tau = t - ph.t0;
+  if (ph.v0 == ph.v1) {
+    s = ph.s0 + ph.v0 * tau;
+    sd = ph.v0;
+    return;
+  }
+  const double dv = ph.v1 - ph.v0, w = M_PI / ph.duration;
+  s = ph.s0 + ph.v0 * tau + 0.5 * dv * (tau - std::sin(w * tau) / w);
+  sd = ph.v0 + 0.5 * dv * (1.0 - std::cos(w * tau));
+  sdd = 0.5 * dv * w * std::sin(w * tau);
+  sddd = 0.5 * dv * w * w * std::cos(w * tau);
+}
+
+TargetState FieldPath::at(double t) const {
+  double s, sd, sdd, sddd;
+  arcLength(t, s, sd, sdd, sddd);
+  s = std::clamp(s, 0.0, total_length_);
+  auto it = std::upper_bound(elements_.begin(), elements_.end(), s, [](double v, const Element& e) { return v < e.s0; });
+  const Element& el = *(it == elements_.begin() ? it : it - 1);
+  const double sigma = std::clamp(s - el.s0, 0.0, el.length);
+
+  Eigen::Vector2d p;
+  double theta, kappa = 0.0, dkappa = 0.0;
+  if (el.turn) {
+    Eigen::Vector2d local;
+    double th_l, k_l, dk_l;
+    turn_.evaluate(sigma, local, th_l, k_l, dk_l);
+    const double c = std::cos(el.heading), sn = std::sin(el.heading);
+    const double ly = el.side * local.y();
+    p = el.p0 + Eigen::Vector2d(c * local.x() - sn * ly, sn * local.x() + c * ly);
+    theta = el.heading + el.side * th_l;
+    kappa = el.side * k_l;
+    dkappa = el.side * dk_l;
+  } else {
+    p = el.p0 + sigma * Eigen::Vector2d(std::cos(el.heading), std::sin(el.heading));
+    theta = el.heading;
+  }
+  const Eigen::Vector2d T(std::cos(theta), std::sin(theta)), N(-T.y(), T.x());
+  TargetState out;
+  out.p = p;
+  out.v = sd * T;
+  out.a = sdd * T + (sd * sd * kappa) * N;
+  out.j = sddd * T + (3.0 * sd * sdd * kappa) * N + (sd * sd * sd) * (dkappa * N - kappa * kappa * T);
+  out.heading = wrapAngle(theta);
+  out.tool_down = !el.turn && t < duration_;
+  return out;
+}
+
+bool FieldPath::onTurn(double t) const {
+  double s, sd, sdd, sddd;
+  arcLength(t, s, sd, sdd, sddd);
+  auto it = std::upper_bound(elements_.begin(), elements_.end(), s, [](double v, const Element& e) { return v < e.s0; });
+  return (it == elements_.begin() ? it : it - 1)->turn && t < duration_;
+}
+
+// ---------------------------------------------------------------------------------------------------
+// FieldReference
+
+namespace {
+std::unique_ptr<TargetTrajectory> makePath(const FieldParams& p) { return std::make_unique<FieldPath>(p); }
+}  // namespace
+
+FieldReference::FieldReference(const FieldParams& params, std::vector<Obstacle> obstacles)
+    : params_(params), field_(params.potential, makePath(params), std::move(obstacles)), duration_(path().duration()) {}
+
+Reference FieldReference::next(double t) { return field_.next(t); }
+
+std::unique_ptr<ReferenceSource> FieldReference::clone() const {
+  auto c = std::make_unique<FieldReference>(*this);
+  c->reset();
+  return c;
+}
+
+}  // namespace core
+}  // namespace sowing_robot

@@ -1,0 +1,120 @@
+#include "sowing_robot/core/metrics.h"
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+namespace sowing_robot {
+namespace core {
+
+void MetricsAccumulator::reserve(std::size_t n) {
+  if (!keep_) return;
+  t_.reserve(n);
+  for (auto& v : e_) v.reserve(n);
+}
+
+void MetricsAccumulator::reset() {
+  count_ = 0;
+  acc_ = {};
+  t_.clear();
+  for (auto& v : e_) v.clear();
+}
+
+void MetricsAccumulator::add(double t, double ex, double ey, double etheta) {
+  const std::array<double, AXIS_COUNT> e{ex, ey, etheta};
+  if (count_ > 0) {
+    const double h = t - last_t_;
+    for (int a = 0; a < AXIS_COUNT; ++a) {
+      const double e0 = last_e_[a], e1 = e[a];
+      acc_[a].ise += 0.5 * h * (e0 * e0 + e1 * e1);
+      acc_[a].itse += 0.5 * h * (last_t_ * e0 * e0 + t * e1 * e1);
+      acc_[a].iae += 0.5 * h * (std::fabs(e0) + std::fabs(e1));
+      acc_[a].itae += 0.5 * h * (last_t_ * std::fabs(e0) + t * std::fabs(e1));
+    }
+  }
+  last_t_ = t;
+  last_e_ = e;
+  ++count_;
+  if (keep_) {
+    t_.push_back(t);
+    for (int a = 0; a < AXIS_COUNT; ++a) e_[a].push_back(e[a]);
+  }
+}
+
+std::array<AxisMetrics, AXIS_COUNT> MetricsAccumulator::result() const {
+  auto r = acc_;
+  if (keep_ && !t_.empty())
+    for (int a = 0; a < AXIS_COUNT; ++a) timeDomainMetrics(t_, e_[a], r[a]);
+  return r;
+}
+
+void timeDomainMetrics(const std::vector<double>& t, const std::vector<double>& e, AxisMetrics& m) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  m.rise_time = m.settling_time = nan;
+  m.overshoot = m.peak = 0.0;
+  const std::size_t n = e.size();
+  if (n == 0) return;
+  std::size_t ip = 0;
+  for (std::size_t i = 0; i < n; ++i)
+    if (std::fabs(e[i]) > std::fabs(e[ip])) ip = i;
+  const double E = std::fabs(e[ip]);
+  m.peak = E;
+  if (!(E > 0.0)) {
+    m.rise_time = m.settling_time = 0.0;
+    return;
+  }
+  double t90 = nan, t10 = nan;
+  for (std::size_t i = ip; i < n; ++i) {
+    if (std::isnan(t90) && std::fabs(e[i]) <= 0.9 * E) t90 = t[i];
+    if (std::fabs(e[i]) <= 0.1 * E) {
+      t10 = t[i];
+      break;
+    }
+  }
+  m.rise_time = std::isnan(t90) || std::isnan(t10) ? nan : t10 - t90;
+  m.settling_time = t.front();
+  for (std::size_t i = n; i-- > 0;)
+    if (std::fabs(e[i]) > 0.02 * E) {
+      m.settling_time = i + 1 < n ? t[i + 1] : t[i];
+      break;
+    }
+  const double sign = e[ip] > 0.0 ? 1.0 : -1.0;
+  double worst = 0.0;
+  for (std::size_t i = ip; i < n; ++i) worst = std::max(worst, -sign * e[i]);
+  m.overshoot = 100.0 * worst / E;
+}
+
+std::string metricsTable(const std::vector<std::string>& names,
+                         const std::vector<std::array<AxisMetrics, AXIS_COUNT>>& runs) {
+  std::string s = "| metric | axis |";
+  for (const auto& n : names) s += " " + n + " |";
+  s += "\n|---|---|";
+  for (std::size_t i = 0; i < names.size(); ++i) s += "---:|";
+  s += "\n";
+  const char* axes[AXIS_COUNT] = {"x", "y", "theta"};
+  struct Row {
+    const char* name;
+    double AxisMetrics::*field;
+  };
+  const Row rows[] = {{"ISE", &AxisMetrics::ise},
+                      {"ITSE", &AxisMetrics::itse},
+                      {"IAE", &AxisMetrics::iae},
+                      {"ITAE", &AxisMetrics::itae},
+                      {"rise time [s]", &AxisMetrics::rise_time},
+                      {"settling time [s]", &AxisMetrics::settling_time},
+                      {"overshoot [%]", &AxisMetrics::overshoot}};
+  char buf[64];
+  for (const auto& row : rows)
+    for (int a = 0; a < AXIS_COUNT; ++a) {
+      s += std::string("| ") + row.name + " | " + axes[a] + " |";
+      for (const auto& r : runs) {
+        std::snprintf(buf, sizeof buf, " %.4g |", r[a].*row.field);
+        s += buf;
+      }
+      s += "\n";
+    }
+  return s;
+}
+
+}  // namespace core
+}  // namespace sowing_robot

@@ -1,0 +1,103 @@
+#include "sowing_robot/core/sliding_mode.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "sowing_robot/core/validation.h"
+
+namespace sowing_robot {
+namespace core {
+
+double realPower(double x, int num, int den) {
+  const double mag = std::pow(std::fabs(x), static_cast<double>(num) / den);
+  if (num % 2 == 0 || x >= 0.0) return mag;  // even numerator: the real root squared is non-negative
+  return -mag;
+}
+
+std::string SlidingModeParams::validate() const {
+  std::string e;
+  if (p <= 0 || q <= 0 || p % 2 == 0 || q % 2 == 0 || !(p > q && p < 2 * q))
+    return "p/q = " + std::to_string(p) + "/" + std::to_string(q) +
+           " must be a ratio of odd positive integers with 1 < p/q < 2";
+  e = firstError({checkPositive("beta_v", beta_v), checkPositive("beta_omega", beta_omega),
+                  checkPositive("k1", k1), checkPositive("k2", k2), checkNonNegative("eta1", eta1, "N·m"),
+                  checkNonNegative("eta2", eta2, "N·m"), checkNonNegative("rate_m", rate_m),
+                  checkNonNegative("rate_i", rate_i), checkPositive("m0_min", m0_min, "kg"),
+                  checkOrdered("m0_min", m0_min, "m0_max", m0_max), checkPositive("i0_min", i0_min, "kg·m^2"),
+                  checkOrdered("i0_min", i0_min, "i0_max", i0_max), checkPositive("max_torque", max_torque, "N·m"),
+                  switching.validate()});
+  if (!e.empty()) return e;
+  if (m0_initial > 0.0) e = checkRange("m0_initial", m0_initial, m0_min, m0_max, "kg (the projection bounds)");
+  if (e.empty() && i0_initial > 0.0)
+    e = checkRange("i0_initial", i0_initial, i0_min, i0_max, "kg·m^2 (the projection bounds)");
+  return e;
+}
+
+SlidingModeController::SlidingModeController(const SlidingModeParams& params, const RobotParams& nominal)
+    : params_(params),
+      R_(nominal.R),
+      L_(nominal.L),
+      m0_initial_(params.m0_initial > 0.0 ? params.m0_initial : nominal.m0()),
+      i0_initial_(params.i0_initial > 0.0 ? params.i0_initial : nominal.I0()) {
+  reset();
+}
+
+void SlidingModeController::reset() {
+  linear_ = angular_ = Channel{};
+  m0_hat_ = m0_initial_;
+  i0_hat_ = i0_initial_;
+  if (params_.adaptive) {
+    m0_hat_ = std::clamp(m0_hat_, params_.m0_min, params_.m0_max);
+    i0_hat_ = std::clamp(i0_hat_, params_.i0_min, params_.i0_max);
+  }
+}
+
+void SlidingModeController::setParams(const SlidingModeParams& params) {
+  params_ = params;
+  if (params_.adaptive) {
+    m0_hat_ = std::clamp(m0_hat_, params_.m0_min, params_.m0_max);
+    i0_hat_ = std::clamp(i0_hat_, params_.i0_min, params_.i0_max);
+  }
+}
+
+void SlidingModeController::surface(Channel& c, double e, double xd_dot, double beta, double dt, double& s,
+                                    double& phi) const {
+  c.integral += e * dt;
+  // S = e + beta (int e)^(p/q)  (eq 4.7).  The derivative term uses (int e)^(p/q - 1): for 1 < p/q < 2
+  // its exponent (p-q)/q lies in (0, 1), so it is finite and equals 0 at int e = 0 (no division, no
+  // singularity); only its own derivative would be unbounded there, and that never enters the law.
+  s = e + beta * realPower(c.integral, params_.p, params_.q);
+  phi = xd_dot + beta * (static_cast<double>(params_.p) / params_.q) * e *
+                     realPower(c.integral, params_.p - params_.q, params_.q);
+}
+
+SlidingModeOutput SlidingModeController::update(const VelocityCommand& desired, double v, double omega, double dt) {
+  SlidingModeOutput out;
+  out.e_v = desired.v - v;  // e = X_d - X: the sign eq 4.9 onwards uses (eq 4.5 prints X - X_d)
+  out.e_omega = desired.omega - omega;
+  double phi_v, phi_w;
+  surface(linear_, out.e_v, desired.v_dot, params_.beta_v, dt, out.s_v, phi_v);
+  surface(angular_, out.e_omega, desired.omega_dot, params_.beta_omega, dt, out.s_omega, phi_w);
+
+  // eq 4.13 with gamma_hat = m0_hat R and alpha_hat = I0_hat R / L (eq 4.10).
+  const double gamma_hat = m0_hat_ * R_, alpha_hat = i0_hat_ * R_ / L_;
+  out.u1 = gamma_hat * phi_v + params_.k1 * out.s_v + params_.eta1 * params_.switching(out.s_v);
+  out.u2 = alpha_hat * phi_w + params_.k2 * out.s_omega + params_.eta2 * params_.switching(out.s_omega);
+
+  if (params_.adaptive) {
+    // Adaptive law with the sign that makes the Lyapunov derivative (4.21) negative for e = X_d - X:
+    // m0_hat' = +rate S1 phi1 (4.22 prints a minus). Euler step followed by the projection onto the
+    // bounds, the discrete form of the discontinuous projection (Liu 2011).
+    m0_hat_ = std::clamp(m0_hat_ + dt * params_.rate_m * out.s_v * phi_v, params_.m0_min, params_.m0_max);
+    i0_hat_ = std::clamp(i0_hat_ + dt * params_.rate_i * out.s_omega * phi_w, params_.i0_min, params_.i0_max);
+  }
+
+  const double right = 0.5 * (out.u1 + out.u2), left = 0.5 * (out.u1 - out.u2);
+  out.torques.right = std::clamp(right, -params_.max_torque, params_.max_torque);
+  out.torques.left = std::clamp(left, -params_.max_torque, params_.max_torque);
+  out.saturated = out.torques.right != right || out.torques.left != left;
+  return out;
+}
+
+}  // namespace core
+}  // namespace sowing_robot

@@ -1,0 +1,56 @@
+#include "sowing_robot/core/switching.h"
+
+#include <cmath>
+
+#include "sowing_robot/core/validation.h"
+
+namespace sowing_robot {
+namespace core {
+
+double SwitchFunction::operator()(double s) const {
+  switch (type) {
+    case SwitchType::Sign:
+      return s > 0.0 ? 1.0 : (s < 0.0 ? -1.0 : 0.0);
+    case SwitchType::Saturation: {  // eq 4.47
+      const double r = s / width;
+      return r > 1.0 ? 1.0 : (r < -1.0 ? -1.0 : r);
+    }
+    case SwitchType::Relay:  // eq 4.46
+      return s / (std::fabs(s) + width);
+    case SwitchType::Atan:  // eq 4.48, scaled by 2/pi so that eta keeps its meaning as the switching gain
+      return M_2_PI * std::atan(s / width);
+    case SwitchType::Tanh:
+      return std::tanh(s / width);
+  }
+  return 0.0;
+}
+
+std::string SwitchFunction::validate() const {
+  if (type == SwitchType::Sign) return "";
+  return checkPositive("switch_width", width);
+}
+
+bool SwitchFunction::parse(const std::string& n, SwitchType& t) {
+  for (SwitchType c : {SwitchType::Sign, SwitchType::Saturation, SwitchType::Relay, SwitchType::Atan,
+                       SwitchType::Tanh}) {
+    if (n == name(c)) {
+      t = c;
+      return true;
+    }
+  }
+  return false;
+}
+
+const char* SwitchFunction::name(SwitchType t) {
+  switch (t) {
+    case SwitchType::Sign: return "sign";
+    case SwitchType::Saturation: return "sat";
+    case SwitchType::Relay: return "relay";
+    case SwitchType::Atan: return "atan";
+    case SwitchType::Tanh: return "tanh";
+  }
+  return "?";
+}
+
+}  // namespace core
+}  // namespace sowing_robot

@@ -1,0 +1,260 @@
+#include "sowing_robot/ros/plant_sim.h"
+
+#include <ros/callback_queue.h>
+#include <rosgraph_msgs/Clock.h>
+
+#include <cmath>
+
+#include "sowing_robot/core/validation.h"
+#include "sowing_robot/ros/component_params.h"
+
+namespace sowing_robot {
+
+namespace {
+ros::Time stampOf(std::int64_t k, std::int64_t period_ns) {
+  ros::Time t;
+  t.fromNSec(static_cast<std::uint64_t>(k * period_ns));
+  return t;
+}
+}  // namespace
+
+PlantSim::PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh) {
+  ParamReader p(pnh);
+  core::RobotParams robot;
+  std::string error = loadRobotParams(pnh, robot);
+  const std::string mode = p.get("mode", "realtime");
+  if (error.empty() && mode != "realtime" && mode != "lockstep")
+    error = "mode = '" + mode + "' must be 'realtime' or 'lockstep'";
+  cfg_.lockstep = mode == "lockstep";
+  cfg_.period_ns = loadControlPeriod(p, error);
+  cfg_.duration = p.get("duration", cfg_.duration);
+  cfg_.realtime_factor = p.get("realtime_factor", cfg_.realtime_factor);
+  cfg_.torque_timeout = p.get("torque_timeout", cfg_.torque_timeout);
+  cfg_.publish_rate = p.get("publish_rate", cfg_.publish_rate);
+  cfg_.lockstep_retry = p.get("lockstep_retry", cfg_.lockstep_retry);
+  cfg_.lockstep_timeout = p.get("lockstep_timeout", cfg_.lockstep_timeout);
+  cfg_.min_subscribers = p.get("min_subscribers", cfg_.min_subscribers);
+  cfg_.startup_delay = p.get("startup_delay", cfg_.startup_delay);
+  cfg_.max_speed = p.get("max_speed", cfg_.max_speed);
+  cfg_.exit_at_end = p.get("exit_at_end", cfg_.exit_at_end);
+  start_ = loadStartPose(p);
+  const core::PlantDisturbance disturbance = loadDisturbance(p);
+  if (error.empty())
+    error = core::firstError(
+        {robot.validate(), disturbance.validate(), core::checkRange("duration", cfg_.duration, 0.0, 1e7, "s"),
+         core::checkRange("realtime_factor", cfg_.realtime_factor, 0.01, 1000.0),
+         core::checkPositive("torque_timeout", cfg_.torque_timeout, "s"),
+         core::checkRange("publish_rate", cfg_.publish_rate, 0.1, 1000.0, "Hz"),
+         core::checkPositive("lockstep_retry", cfg_.lockstep_retry, "s"),
+         core::checkPositive("lockstep_timeout", cfg_.lockstep_timeout, "s"),
+         core::checkRange("min_subscribers", cfg_.min_subscribers, 0, 100),
+         core::checkNonNegative("startup_delay", cfg_.startup_delay, "s"),
+         core::checkPositive("max_speed", cfg_.max_speed, "m/s"),
+         core::allFinite(start_.x, start_.y, start_.theta) ? "" : "start pose must be finite"});
+  requireValid(p, error);
+
+  plant_ = std::make_unique<core::Plant>(robot, disturbance);
+  core::State x0 = core::State::Zero();
+  x0[core::X] = start_.x;
+  x0[core::Y] = start_.y;
+  x0[core::THETA] = start_.theta;
+  plant_->reset(x0, 0.0);
+  visual_every_ = std::max<std::int64_t>(1, std::llround(1e9 / cfg_.publish_rate / cfg_.period_ns));
+
+  ROS_INFO("plant_sim: %s mode, %.0f Hz, duration %.3f s, m0 %.4f kg (true %.4f), I0 %.5f kg·m^2 (true %.5f), "
+           "sinusoidal disturbance %s, noise std %.3f N·m, start (%.3f, %.3f, %.3f)",
+           mode.c_str(), 1e9 / cfg_.period_ns, cfg_.duration, robot.m0(), plant_->trueM0(), robot.I0(),
+           plant_->trueI0(), disturbance.sinusoidal ? "on" : "off", disturbance.noise_std, start_.x, start_.y,
+           start_.theta);
+
+  clock_pub_ = nh_.advertise<rosgraph_msgs::Clock>("/clock", 10);
+  odom_pub_ = nh_.advertise<nav_msgs::Odometry>("odom", 50);
+  joint_pub_ = nh_.advertise<sensor_msgs::JointState>("joint_states", 10);
+  path_pub_ = nh_.advertise<nav_msgs::Path>("travelled_path", 1, true);
+  torque_sub_ = nh_.subscribe("wheel_torque", 50, &PlantSim::torqueCallback, this,
+                              ros::TransportHints().tcpNoDelay());
+
+  odom_msg_.header.frame_id = "odom";
+  odom_msg_.child_frame_id = "base_link";
+  joint_msg_.name = {"right_wheel_joint", "left_wheel_joint"};
+  joint_msg_.position.resize(2);
+  joint_msg_.velocity.resize(2);
+  path_msg_.header.frame_id = "odom";
+}
+
+void PlantSim::torqueCallback(const WheelTorque::ConstPtr& msg) {
+  if (!core::allFinite(msg->right, msg->left)) {
+    ++rejected_;
+    ROS_WARN_THROTTLE(1.0, "plant_sim: rejected non-finite wheel torque (right %f, left %f); %ld so far",
+                      msg->right, msg->left, static_cast<long>(rejected_));
+    return;
+  }
+  std::lock_guard<std::mutex> lock(torque_mutex_);
+  if (cfg_.lockstep) {
+    if (msg->header.stamp != waiting_for_) {
+      if (msg->header.stamp < waiting_for_) {
+        ++late_;
+        ROS_WARN_THROTTLE(1.0, "plant_sim: late wheel torque for t=%.6f while at t=%.6f ignored (%ld so far)",
+                          msg->header.stamp.toSec(), waiting_for_.toSec(), static_cast<long>(late_));
+      }
+      return;
+    }
+    if (got_torque_) return;  // a repeat of the same answer
+  }
+  torque_ = {msg->right, msg->left};
+  torque_stamp_ = msg->header.stamp;
+  torque_valid_ = true;
+  got_torque_ = true;
+}
+
+void PlantSim::publishState(const ros::Time& stamp, bool visuals) {
+  rosgraph_msgs::Clock clock;
+  clock.clock = stamp;
+  clock_pub_.publish(clock);
+  const core::State& s = plant_->state();
+  odom_msg_.header.stamp = stamp;
+  odom_msg_.pose.pose.position.x = s[core::X];
+  odom_msg_.pose.pose.position.y = s[core::Y];
+  odom_msg_.pose.pose.orientation.z = std::sin(0.5 * s[core::THETA]);
+  odom_msg_.pose.pose.orientation.w = std::cos(0.5 * s[core::THETA]);
+  odom_msg_.twist.twist.linear.x = s[core::V];
+  odom_msg_.twist.twist.angular.z = s[core::OMEGA];
+  odom_pub_.publish(odom_msg_);
+  if (!visuals) return;
+
+  geometry_msgs::TransformStamped tf;
+  tf.header = odom_msg_.header;
+  tf.child_frame_id = "base_link";
+  tf.transform.translation.x = s[core::X];
+  tf.transform.translation.y = s[core::Y];
+  tf.transform.rotation = odom_msg_.pose.pose.orientation;
+  tf_.sendTransform(tf);
+
+  joint_msg_.header.stamp = stamp;
+  joint_msg_.position[0] = s[core::PHI_R];
+  joint_msg_.position[1] = s[core::PHI_L];
+  const core::State ds = plant_->derivative(s, 0.0, 0.0);  // wheel rates do not depend on torque
+  joint_msg_.velocity[0] = ds[core::PHI_R];
+  joint_msg_.velocity[1] = ds[core::PHI_L];
+  joint_pub_.publish(joint_msg_);
+
+  geometry_msgs::PoseStamped pose;
+  pose.header = odom_msg_.header;
+  pose.pose = odom_msg_.pose.pose;
+  if (path_msg_.poses.size() >= 20000) path_msg_.poses.erase(path_msg_.poses.begin(), path_msg_.poses.begin() + 10000);
+  path_msg_.poses.push_back(pose);
+  path_msg_.header.stamp = stamp;
+  path_pub_.publish(path_msg_);
+}
+
+bool PlantSim::healthy() {
+  const core::State& s = plant_->state();
+  if (std::isfinite(s.sum()) && std::fabs(s[core::V]) <= cfg_.max_speed) return true;
+  ROS_FATAL("plant_sim: state diverged at t=%.6f s (x %g, y %g, theta %g, v %g, omega %g; max_speed %g m/s): "
+            "stopping the run instead of publishing garbage",
+            plant_->time(), s[core::X], s[core::Y], s[core::THETA], s[core::V], s[core::OMEGA], cfg_.max_speed);
+  return false;
+}
+
+void PlantSim::runLockstep() {
+  ros::CallbackQueue* queue = ros::getGlobalCallbackQueue();
+  // Wait for the loop to be wired: every odom subscriber and a torque publisher.
+  ros::WallTime waited = ros::WallTime::now();
+  while (ros::ok() && (static_cast<int>(odom_pub_.getNumSubscribers()) < cfg_.min_subscribers ||
+                       torque_sub_.getNumPublishers() < 1)) {
+    queue->callAvailable(ros::WallDuration(0.01));
+    if ((ros::WallTime::now() - waited).toSec() > cfg_.lockstep_timeout) {
+      ROS_WARN("plant_sim: lockstep waiting for the loop: %u/%d odom subscribers, %u wheel_torque publishers",
+               odom_pub_.getNumSubscribers(), cfg_.min_subscribers, torque_sub_.getNumPublishers());
+      waited = ros::WallTime::now();
+    }
+  }
+  ros::WallDuration(cfg_.startup_delay).sleep();
+  const std::int64_t n = cfg_.duration > 0.0 ? std::llround(cfg_.duration * 1e9 / cfg_.period_ns) : -1;
+  const double dt = core::secondsFromNanos(cfg_.period_ns);
+  const ros::WallTime wall_start = ros::WallTime::now();
+  for (std::int64_t k = 0; ros::ok() && (n < 0 || k <= n); ++k) {
+    const ros::Time stamp = stampOf(k, cfg_.period_ns);
+    {
+      std::lock_guard<std::mutex> lock(torque_mutex_);
+      waiting_for_ = stamp;
+      got_torque_ = false;
+    }
+    publishState(stamp, k % visual_every_ == 0 || k == n);
+    ros::WallTime sent = ros::WallTime::now(), reported = sent;
+    while (ros::ok() && !got_torque_) {
+      queue->callAvailable(ros::WallDuration(0.001));
+      const ros::WallTime now = ros::WallTime::now();
+      if (!got_torque_ && (now - sent).toSec() > cfg_.lockstep_retry) {
+        publishState(stamp, false);  // a connection that came late gets the state again
+        sent = now;
+      }
+      if (!got_torque_ && (now - reported).toSec() > cfg_.lockstep_timeout) {
+        ROS_ERROR("plant_sim: lockstep stalled at t=%.6f s: no wheel_torque stamped for it after %.1f s wall "
+                  "(%u publisher(s) on %s%s); waiting",
+                  stamp.toSec(), cfg_.lockstep_timeout, torque_sub_.getNumPublishers(),
+                  torque_sub_.getTopic().c_str(),
+                  torque_sub_.getNumPublishers() == 0 ? ": is torque_controller running?" : "");
+        reported = now;
+      }
+    }
+    if (!ros::ok() || k == n) break;
+    core::WheelTorques u;
+    {
+      std::lock_guard<std::mutex> lock(torque_mutex_);
+      u = torque_;
+    }
+    plant_->step(u.right, u.left, dt);
+    if (!healthy()) {
+      ros::shutdown();
+      std::exit(2);
+    }
+  }
+  const double wall = (ros::WallTime::now() - wall_start).toSec();
+  ROS_INFO("plant_sim: lockstep scenario finished: %.3f s simulated in %.3f s wall (real-time factor %.2f); "
+           "%ld late and %ld non-finite torques ignored",
+           cfg_.duration, wall, wall > 0 ? cfg_.duration / wall : 0.0, static_cast<long>(late_),
+           static_cast<long>(rejected_));
+  if (cfg_.exit_at_end) return;
+  ros::spin();
+}
+
+void PlantSim::runRealtime() {
+  ros::AsyncSpinner spinner(1);
+  spinner.start();
+  const double dt = core::secondsFromNanos(cfg_.period_ns);
+  const ros::WallTime wall_start = ros::WallTime::now();
+  std::int64_t zero_hold = 0;
+  for (std::int64_t k = 0; ros::ok(); ++k) {
+    const ros::Time stamp = stampOf(k, cfg_.period_ns);
+    publishState(stamp, k % visual_every_ == 0);
+    const ros::WallTime due = wall_start + ros::WallDuration((k + 1) * dt / cfg_.realtime_factor);
+    const ros::WallDuration remaining = due - ros::WallTime::now();
+    if (remaining > ros::WallDuration(0)) remaining.sleep();
+    core::WheelTorques u;
+    {
+      std::lock_guard<std::mutex> lock(torque_mutex_);
+      const bool fresh = torque_valid_ && (stamp - torque_stamp_).toSec() <= cfg_.torque_timeout;
+      if (fresh) u = torque_;
+      if (!fresh && torque_valid_) {
+        ++zero_hold;
+        ROS_WARN_THROTTLE(2.0, "plant_sim: no wheel_torque for %.3f s (timeout %.3f s): applying zero torque",
+                          (stamp - torque_stamp_).toSec(), cfg_.torque_timeout);
+      }
+    }
+    plant_->step(u.right, u.left, dt);
+    if (!healthy()) {
+      ros::shutdown();
+      std::exit(2);
+    }
+  }
+}
+
+void PlantSim::run() {
+  if (cfg_.lockstep)
+    runLockstep();
+  else
+    runRealtime();
+}
+
+}  // namespace sowing_robot

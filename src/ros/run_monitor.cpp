@@ -1,0 +1,61 @@
+#include "sowing_robot/ros/run_monitor.h"
+
+#include <cstdio>
+#include <fstream>
+#include <iomanip>
+
+#include "sowing_robot/core/validation.h"
+#include "sowing_robot/ros/component_params.h"
+
+namespace sowing_robot {
+
+RunMonitor::RunMonitor(ros::NodeHandle nh, ros::NodeHandle pnh) {
+  ParamReader p(pnh);
+  duration_ = p.get("duration", duration_);
+  output_ = p.get("output", "");
+  label_ = p.get("label", "run");
+  exit_at_end_ = p.get("exit_at_end", exit_at_end_);
+  requireValid(p, core::checkPositive("duration", duration_, "s"));
+  metrics_.reserve(static_cast<std::size_t>(duration_ * 1000.0) + 2);
+  sub_ = nh.subscribe("tracking_error", 1000, &RunMonitor::errorCallback, this, ros::TransportHints().tcpNoDelay());
+}
+
+void RunMonitor::errorCallback(const TrackingError::ConstPtr& msg) {
+  if (done_) return;
+  if (metrics_.samples() > 0 && msg->header.stamp <= last_) return;  // repeats answer a retried state
+  if (!core::allFinite(msg->x, msg->y, msg->theta)) {
+    ROS_WARN_THROTTLE(1.0, "run_monitor: non-finite tracking error ignored");
+    return;
+  }
+  last_ = msg->header.stamp;
+  metrics_.add(msg->header.stamp.toSec(), msg->x, msg->y, msg->theta);
+  if (msg->header.stamp.toSec() >= duration_ - 1e-9) finish();
+}
+
+void RunMonitor::finish() {
+  done_ = true;
+  const auto m = metrics_.result();
+  const std::string table = core::metricsTable({label_}, {m});
+  ROS_INFO("run_monitor: %zu samples up to t = %.3f s\n%s", metrics_.samples(), last_.toSec(), table.c_str());
+  std::printf("%s", table.c_str());
+  std::fflush(stdout);
+  if (!output_.empty() && !writeMetricsYaml(output_, label_, m))
+    ROS_ERROR("run_monitor: could not write %s", output_.c_str());
+  if (exit_at_end_) ros::shutdown();
+}
+
+bool writeMetricsYaml(const std::string& path, const std::string& label,
+                      const std::array<core::AxisMetrics, core::AXIS_COUNT>& m) {
+  std::ofstream f(path);
+  if (!f) return false;
+  f << std::setprecision(17) << label << ":\n";
+  const char* axes[] = {"x", "y", "theta"};
+  for (int a = 0; a < core::AXIS_COUNT; ++a) {
+    f << "  " << axes[a] << ": {ise: " << m[a].ise << ", itse: " << m[a].itse << ", iae: " << m[a].iae
+      << ", itae: " << m[a].itae << ", rise_time: " << m[a].rise_time << ", settling_time: " << m[a].settling_time
+      << ", overshoot: " << m[a].overshoot << "}\n";
+  }
+  return static_cast<bool>(f);
+}
+
+}  // namespace sowing_robot

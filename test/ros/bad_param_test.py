@@ -1,0 +1,60 @@
+#!/usr/bin/env python3
+"""rostest: start a node with one bad parameter at a time; it must refuse to start (exit 1) with a line
+naming the parameter, and never begin publishing."""
+import os
+import subprocess
+import unittest
+
+import rospy
+import rostest
+import rospkg
+
+URDF = os.path.join(rospkg.RosPack().get_path("sowing_robot"), "urdf", "sowing_robot.urdf")
+
+CASES = [
+    # (node type, {private param: value}, text that must appear)
+    ("plant_sim", {"mode": "bogus"}, "mode"),
+    ("plant_sim", {"duration": -1.0}, "duration"),
+    ("plant_sim", {"disturbance/amplitude": float("nan")}, "disturbance.amplitude"),
+    ("plant_sim", {"mismatch/mass_scale": 0.0}, "mass_scale"),
+    ("plant_sim", {"torque_timout": 0.2}, "torque_timout"),  # typo: unknown key
+    ("plant_sim", {"control_rate": "fast"}, "control_rate"),  # wrong type
+    ("plant_sim", {"robot_description": "ZERO_RADIUS"}, "radius"),
+    ("plant_sim", {"robot_description": "<robot name='x'>"}, "robot_description"),
+    ("torque_controller", {"p": 4}, "p/q"),
+    ("torque_controller", {"m0_min": 40.0}, "m0_min"),
+    ("torque_controller", {"m0_initial": 50.0}, "m0_initial"),
+    ("torque_controller", {"switching": "magic"}, "switching"),
+    ("torque_controller", {"mode": "pid"}, "mode"),
+    ("kinematic_controller", {"kx": -1.0}, "kx"),
+    ("kinematic_controller", {"ky": float("inf")}, "ky"),
+    ("reference_generator", {"line/v_r": -1.0}, "v_r"),
+]
+
+
+def zero_radius_urdf():
+    with open(URDF) as f:
+        text = f.read()
+    return text.replace('radius="0.095"', 'radius="0.0"')
+
+
+class BadParameters(unittest.TestCase):
+    def test_each_bad_parameter_stops_the_node(self):
+        rospy.init_node("bad_param_test")
+        for i, (node, params, needle) in enumerate(CASES):
+            ns = "/bad_%d" % i
+            for key, value in params.items():
+                if value == "ZERO_RADIUS":
+                    value = zero_radius_urdf()
+                rospy.set_param("%s/%s" % (ns, key), value)
+            cmd = ["rosrun", "sowing_robot", node, "__name:=bad_%d" % i]
+            proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=60,
+                                  universal_newlines=True)
+            out = proc.stdout
+            self.assertEqual(proc.returncode, 1, "%s %s: exit %d\n%s" % (node, params, proc.returncode, out))
+            self.assertIn("refusing to start", out, "%s %s:\n%s" % (node, params, out))
+            self.assertIn(needle, out, "%s %s: message does not name '%s':\n%s" % (node, params, needle, out))
+
+
+if __name__ == "__main__":
+    rostest.rosrun("sowing_robot", "bad_param_test", BadParameters)
