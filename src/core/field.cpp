@@ -44,16 +44,23 @@ std::string FieldParams::validate() const {
        checkPositive("min_turn_radius", min_turn_radius, "m"), checkPositive("max_accel", max_accel, "m/s^2"),
        checkPositive("max_curvature_rate", max_curvature_rate, "1/m^2"), potential.validate()});
   if (!e.empty()) return e;
+  if (turn_speed <= potential.heading_hold_speed)
+    return "turn_speed = " + formatNumber(turn_speed) + " m/s must be above potential.heading_hold_speed = " +
+           formatNumber(potential.heading_hold_speed) + " m/s";
   const double rate_min = 0.5 / (min_turn_radius * min_turn_radius);
   if (max_curvature_rate < rate_min)
     return "max_curvature_rate = " + formatNumber(max_curvature_rate) + " 1/m^2 must be >= 1/(2 min_turn_radius^2) = " +
            formatNumber(rate_min) + " 1/m^2";
-  double v_in, v_out;
-  rowSpeeds(*this, 0, v_in, v_out);
-  const double need = rampDistance(v_in, v_out, max_accel);
-  if (v_in > v_out && row_length < need * (1.0 - 1e-12))
-    return "row_length = " + formatNumber(row_length) + " m is too short to change speed from " + formatNumber(v_in) +
-           " to " + formatNumber(v_out) + " m/s at max_accel (needs >= " + formatNumber(need) + " m)";
+  // Rows in between go turn_speed -> turn_speed and always fit; the first and last may have to slow down.
+  for (const int i : {0, rows - 1}) {
+    double v_in, v_out;
+    rowSpeeds(*this, i, v_in, v_out);
+    const double need = rampDistance(v_in, v_out, max_accel);
+    if (v_in > v_out && row_length < need * (1.0 - 1e-12))
+      return "row_length = " + formatNumber(row_length) + " m is too short to change speed from " +
+             formatNumber(v_in) + " to " + formatNumber(v_out) + " m/s at max_accel (needs >= " + formatNumber(need) +
+             " m)";
+  }
   return "";
 }
 

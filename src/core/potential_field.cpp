@@ -13,7 +13,6 @@ namespace core {
 namespace {
 constexpr double kStopSpeed = 1e-4;     ///< below this speed [m/s] theta is held
 constexpr double kGridSlack = 1e-9;     ///< a call within 1 ns of a grid point is that grid point [s]
-constexpr double kOnLineOffset = 1e-9;  ///< |obstacle offset from the line| counted as "on the line" [m]
 
 std::string indexed(const std::string& name, std::size_t i) { return name + "[" + std::to_string(i) + "]"; }
 
@@ -41,7 +40,8 @@ std::string PotentialFieldParams::validate() const {
                      checkPositive("influence_distance", influence_distance, "m"),
                      checkNonNegative("gain", gain, "m^2/s^2"), checkNonNegative("tangential_ratio", tangential_ratio),
                      checkRange("core_fraction", core_fraction, 1e-3, 0.9),
-                     checkRange("step", step, 1e-6, 1e-3, "s")});
+                     checkNonNegative("side_band", side_band, "m"), checkRange("step", step, 1e-6, 1e-3, "s"),
+                     checkNonNegative("heading_hold_speed", heading_hold_speed, "m/s")});
 }
 
 LineTarget::LineTarget(const RowLine& row) : row_(row), u_(std::cos(row.heading), std::sin(row.heading)) {}
@@ -79,6 +79,7 @@ PotentialField::PotentialField(const PotentialField& o)
     : params_(o.params_),
       target_(o.target_->clone()),
       obstacles_(o.obstacles_),
+      sides_(o.sides_),
       state_(o.state_),
       steps_(o.steps_),
       last_theta_(o.last_theta_),
@@ -102,6 +103,8 @@ void PotentialField::reset() {
   out_p_ = t0.p;
   out_v_ = t0.v;
   out_a_ = t0.a;
+  sides_.assign(obstacles_.size(), 0);
+  updateSides(t0.p, t0);
 }
 
 std::unique_ptr<ReferenceSource> PotentialField::clone() const {
@@ -113,6 +116,46 @@ std::unique_ptr<ReferenceSource> PotentialField::clone() const {
 void PotentialField::setObstacles(std::vector<Obstacle> obstacles) {
   validateObstacles(obstacles);
   obstacles_ = std::move(obstacles);
+  sides_.assign(obstacles_.size(), 0);
+  const double t = static_cast<double>(steps_) * params_.step;
+  const TargetState tgt = target_->at(t);
+  updateSides(tgt.p + state_.e, tgt);
+}
+
+double PotentialField::sideFor(std::size_t i, const Eigen::Vector2d& p, const TargetState& target) const {
+  const double fixed = params_.avoid_side == AvoidSide::kLeft ? 1.0 : -1.0;
+  if (!params_.nearest_side) return fixed;
+  if (sides_[i] != 0) return sides_[i];
+  // A neighbour whose zone the reference is in already has a side: share it (no squeezing between).
+  const double d = params_.influence_distance;
+  Eigen::Vector2d centroid = Eigen::Vector2d::Zero();
+  int count = 0;
+  for (std::size_t j = 0; j < obstacles_.size(); ++j) {
+    const Obstacle& o = obstacles_[j];
+    if (std::hypot(p.x() - o.x, p.y() - o.y) - o.radius >= d && j != i) continue;
+    if (sides_[j] != 0) return sides_[j];
+    centroid += Eigen::Vector2d(o.x, o.y);
+    ++count;
+  }
+  centroid /= count;
+  const Eigen::Vector2d left(-std::sin(target.heading), std::cos(target.heading));
+  const double offset = (p - centroid).dot(left);
+  if (offset > params_.side_band) return 1.0;
+  if (offset < -params_.side_band) return -1.0;
+  return fixed;
+}
+
+void PotentialField::updateSides(const Eigen::Vector2d& p, const TargetState& target) {
+  const double d = params_.influence_distance;
+  for (std::size_t i = 0; i < obstacles_.size(); ++i) {
+    const Obstacle& o = obstacles_[i];
+    if (std::hypot(p.x() - o.x, p.y() - o.y) - o.radius >= d) sides_[i] = 0;
+  }
+  for (std::size_t i = 0; i < obstacles_.size(); ++i) {
+    const Obstacle& o = obstacles_[i];
+    if (sides_[i] == 0 && std::hypot(p.x() - o.x, p.y() - o.y) - o.radius < d)
+      sides_[i] = static_cast<signed char>(sideFor(i, p, target));
+  }
 }
 
 void PotentialField::clearanceDerivatives(double rho, double& dv, double& ddv) const {
@@ -173,23 +216,12 @@ Eigen::Vector2d PotentialField::mu(const Eigen::Vector2d& p, const TargetState& 
   if (params_.gain <= 0.0) return f;
   const Eigen::Vector2d left(-std::sin(target.heading), std::cos(target.heading));
   const double k = params_.gain, kt = params_.tangential_ratio;
-  for (const Obstacle& o : obstacles_) {
+  for (std::size_t i = 0; i < obstacles_.size(); ++i) {
+    const Obstacle& o = obstacles_[i];
     const Eigen::Vector2d rel(p.x() - o.x, p.y() - o.y);
     const double dist = rel.norm();
     if (dist - o.radius >= params_.influence_distance) continue;
-    double s;
-    switch (params_.avoid_side) {
-      case AvoidSide::kLeft:
-        s = 1.0;
-        break;
-      case AvoidSide::kRight:
-        s = -1.0;
-        break;
-      default: {
-        const double offset = (Eigen::Vector2d(o.x, o.y) - target.p).dot(left);
-        s = offset > kOnLineOffset ? -1.0 : 1.0;
-      }
-    }
+    const double s = sideFor(i, p, target);
     // At the exact centre the direction is undefined: push along the left normal of travel.
     const Eigen::Vector2d n = dist > 1e-12 ? Eigen::Vector2d(rel / dist) : left;
     double dv, ddv;
@@ -238,6 +270,10 @@ Reference PotentialField::next(double t) {
   while (static_cast<double>(steps_ + 1) * h <= t + kGridSlack) {
     state_ = rk4(state_, static_cast<double>(steps_) * h, h);
     ++steps_;
+    if (!obstacles_.empty()) {
+      const TargetState tg = target_->at(static_cast<double>(steps_) * h);
+      updateSides(tg.p + state_.e, tg);
+    }
   }
   const double t_grid = static_cast<double>(steps_) * h;
   const double tau = t - t_grid;
@@ -261,7 +297,9 @@ Reference PotentialField::next(double t) {
   r.tool_down = tgt.tool_down;
   const double speed = v.norm();
   r.v = speed;
-  if (speed >= kStopSpeed) {
+  const double hold_speed = params_.heading_hold_speed;
+  const bool hold = speed < kStopSpeed || (speed < hold_speed && tgt.v.norm() < hold_speed);
+  if (!hold) {
     const double v2 = speed * speed;
     r.pose.theta = std::atan2(v.y(), v.x());
     r.omega = (v.x() * a.y() - v.y() * a.x()) / v2;

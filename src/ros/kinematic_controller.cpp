@@ -12,8 +12,8 @@ KinematicController::KinematicController(ros::NodeHandle nh, ros::NodeHandle pnh
   requireValid(p, gains.validate());
   kanayama_.setGains(gains);
   ROS_INFO("kinematic_controller: kx %.4g, ky %.4g, ktheta %.4g", gains.kx, gains.ky, gains.ktheta);
-  desired_pub_ = nh.advertise<DesiredVelocity>("desired_velocity", 50);
-  error_pub_ = nh.advertise<TrackingError>("tracking_error", 50);
+  desired_pub_ = nh.advertise<DesiredVelocity>("desired_velocity", kLockstepQueue);
+  error_pub_ = nh.advertise<TrackingError>("tracking_error", kLockstepQueue);
   const auto hints = ros::TransportHints().tcpNoDelay();
   odom_sub_ = nh.subscribe("odom", 50, &KinematicController::odomCallback, this, hints);
   ref_sub_ = nh.subscribe("reference", 50, &KinematicController::referenceCallback, this, hints);

@@ -7,6 +7,7 @@
 
 #include "sowing_robot/core/validation.h"
 #include "sowing_robot/ros/component_params.h"
+#include "sowing_robot/ros/msg_checks.h"
 
 namespace sowing_robot {
 
@@ -21,6 +22,7 @@ ros::Time stampOf(std::int64_t k, std::int64_t period_ns) {
 PlantSim::PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh) {
   ParamReader p(pnh);
   core::RobotParams robot;
+  p.allow("robot_description");  // a private URDF may override the global one
   std::string error = loadRobotParams(pnh, robot);
   const std::string mode = p.get("mode", "realtime");
   if (error.empty() && mode != "realtime" && mode != "lockstep")
@@ -61,14 +63,14 @@ PlantSim::PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh) {
   plant_->reset(x0, 0.0);
   visual_every_ = std::max<std::int64_t>(1, std::llround(1e9 / cfg_.publish_rate / cfg_.period_ns));
 
-  ROS_INFO("plant_sim: %s mode, %.0f Hz, duration %.3f s, m0 %.4f kg (true %.4f), I0 %.5f kg·m^2 (true %.5f), "
-           "sinusoidal disturbance %s, noise std %.3f N·m, start (%.3f, %.3f, %.3f)",
+  ROS_INFO("plant_sim: %s mode, %.0f Hz, duration %.3f s, m0 %.4f kg (true %.4f), I0 %.5f kg m^2 (true %.5f), "
+           "sinusoidal disturbance %s, noise std %.3f N m, start (%.3f, %.3f, %.3f)",
            mode.c_str(), 1e9 / cfg_.period_ns, cfg_.duration, robot.m0(), plant_->trueM0(), robot.I0(),
            plant_->trueI0(), disturbance.sinusoidal ? "on" : "off", disturbance.noise_std, start_.x, start_.y,
            start_.theta);
 
   clock_pub_ = nh_.advertise<rosgraph_msgs::Clock>("/clock", 10);
-  odom_pub_ = nh_.advertise<nav_msgs::Odometry>("odom", 50);
+  odom_pub_ = nh_.advertise<nav_msgs::Odometry>("odom", kLockstepQueue);
   joint_pub_ = nh_.advertise<sensor_msgs::JointState>("joint_states", 10);
   path_pub_ = nh_.advertise<nav_msgs::Path>("travelled_path", 1, true);
   torque_sub_ = nh_.subscribe("wheel_torque", 50, &PlantSim::torqueCallback, this,

@@ -4,6 +4,7 @@
 
 #include "sowing_robot/core/validation.h"
 #include "sowing_robot/ros/component_params.h"
+#include "sowing_robot/ros/msg_checks.h"
 
 namespace sowing_robot {
 
@@ -20,7 +21,7 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
   requireValid(p, error);
   source_ = std::make_unique<core::LineReference>(v_r, row_y, x0);
   ROS_INFO("reference_generator: line x = %.3f + %.3f t, y = %.3f", x0, v_r, row_y);
-  ref_pub_ = nh.advertise<ReferenceState>("reference", 50);
+  ref_pub_ = nh.advertise<ReferenceState>("reference", kLockstepQueue);
   path_pub_ = nh.advertise<nav_msgs::Path>("reference_path", 1, true);
   path_.header.frame_id = "odom";
   odom_sub_ = nh.subscribe("odom", 50, &ReferenceGenerator::odomCallback, this, ros::TransportHints().tcpNoDelay());

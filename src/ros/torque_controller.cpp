@@ -8,6 +8,7 @@ namespace sowing_robot {
 TorqueController::TorqueController(ros::NodeHandle nh, ros::NodeHandle pnh) {
   ParamReader p(pnh);
   core::RobotParams robot;
+  p.allow("robot_description");  // a private URDF may override the global one
   std::string error = loadRobotParams(pnh, robot);
   const std::int64_t period = loadControlPeriod(p, error);
   const core::SlidingModeParams params = loadSlidingMode(p, error);
@@ -15,15 +16,15 @@ TorqueController::TorqueController(ros::NodeHandle nh, ros::NodeHandle pnh) {
   dt_ = core::secondsFromNanos(period);
   smc_ = std::make_unique<core::SlidingModeController>(params, robot);
   ROS_INFO("torque_controller: %s, p/q %d/%d, beta %.4g/%.4g, K %.4g/%.4g, eta %.4g/%.4g, rates %.4g/%.4g, "
-           "m0 in [%.4g, %.4g] from %.4f kg, I0 in [%.4g, %.4g] from %.5f kg·m^2, switching %s (width %.4g), "
-           "max torque %.4g N·m, %.0f Hz",
+           "m0 in [%.4g, %.4g] from %.4f kg, I0 in [%.4g, %.4g] from %.5f kg m^2, switching %s (width %.4g), "
+           "max torque %.4g N m, %.0f Hz",
            params.adaptive ? "ATSMC" : "TSMC", params.p, params.q, params.beta_v, params.beta_omega, params.k1,
            params.k2, params.eta1, params.eta2, params.rate_m, params.rate_i, params.m0_min, params.m0_max,
            smc_->m0Hat(), params.i0_min, params.i0_max, smc_->i0Hat(),
            core::SwitchFunction::name(params.switching.type), params.switching.width, params.max_torque, 1.0 / dt_);
   state_.mode = params.adaptive ? "atsmc" : "tsmc";
-  torque_pub_ = nh.advertise<WheelTorque>("wheel_torque", 50);
-  state_pub_ = pnh.advertise<TorqueControllerState>("state", 50);
+  torque_pub_ = nh.advertise<WheelTorque>("wheel_torque", kLockstepQueue);
+  state_pub_ = pnh.advertise<TorqueControllerState>("state", kLockstepQueue);
   const auto hints = ros::TransportHints().tcpNoDelay();
   odom_sub_ = nh.subscribe("odom", 50, &TorqueController::odomCallback, this, hints);
   desired_sub_ = nh.subscribe("desired_velocity", 50, &TorqueController::desiredCallback, this, hints);
@@ -60,7 +61,7 @@ void TorqueController::compute() {
   torque_.left = out.torques.left;
   torque_pub_.publish(torque_);
   if (out.saturated)
-    ROS_WARN_THROTTLE(2.0, "torque_controller: wheel torque saturated at %.4g N·m (%ld periods so far)",
+    ROS_WARN_THROTTLE(2.0, "torque_controller: wheel torque saturated at %.4g N m (%ld periods so far)",
                       smc_->params().max_torque, ++saturated_);
 
   state_.header.stamp = odom.header.stamp;

@@ -199,7 +199,7 @@ std::string fromModel(const urdf::ModelInterface& model, core::RobotParams& p) {
   const Eigen::Matrix3d inertia_base = r * inertiaInLinkFrame(ci) * r.transpose();
   p.mc = ci.mass;
   p.d = com.x();
-  p.Ic = inertia_base(2, 2) + ci.mass * (com.x() * com.x() + com.y() * com.y());
+  p.Ic = inertia_base(2, 2);  // about the chassis COM: eq 3.27 adds mc d^2 itself
 
   // Wheels: mw, Iw, Im, L, R.
   Wheel right, left;

@@ -49,6 +49,8 @@ TEST(PotentialFieldParams, ValidateNamesTheBadParameter) {
   bad([](PotentialFieldParams& p) { p.tangential_ratio = std::nan(""); }, "tangential_ratio");
   bad([](PotentialFieldParams& p) { p.step = 2e-3; }, "step");
   bad([](PotentialFieldParams& p) { p.core_fraction = 1.0; }, "core_fraction");
+  bad([](PotentialFieldParams& p) { p.side_band = -0.01; }, "side_band");
+  bad([](PotentialFieldParams& p) { p.heading_hold_speed = -1.0; }, "heading_hold_speed");
   EXPECT_NE((Obstacle{0.0, 0.0, 0.0}.validate().find("radius")), std::string::npos);
   EXPECT_NE((RowLine{0.0, 0.0, 0.0, 0.0}.validate().find("speed")), std::string::npos);
 
@@ -205,6 +207,7 @@ TEST(PotentialField, SymmetricCaseDoesNotStall) {
 }
 
 TEST(PotentialField, AvoidSideIsDeterministicAndConfigurable) {
+  // On the line the tie-break side is used: right when asked.
   PotentialFieldParams right;
   right.avoid_side = AvoidSide::kRight;
   const PassResult r = runPast(right, 0.0, 20.0);
@@ -212,19 +215,53 @@ TEST(PotentialField, AvoidSideIsDeterministicAndConfigurable) {
   EXPECT_LE(r.max_left, 1e-9);
   EXPECT_GT(r.min_clearance, 0.1);
 
-  // kShorter: an obstacle 0.2 m left of the line is passed on the right, one 0.2 m right on the left.
+  // nearest_side: an obstacle 0.2 m left of the line is passed on the right, one 0.2 m right on the left,
+  // without ever crossing the line.
   const PassResult a = runPast({}, 0.2, 20.0), b = runPast({}, -0.2, 20.0);
   EXPECT_LT(a.min_left, -0.1);
   EXPECT_LE(a.max_left, 1e-9);
   EXPECT_GT(b.max_left, 0.1);
   EXPECT_GE(b.min_left, -1e-9);
-  // kLeft forces the long way round for the obstacle left of the line, still without touching it.
-  PotentialFieldParams left;
-  left.avoid_side = AvoidSide::kLeft;
-  const PassResult c = runPast(left, 0.2, 25.0);
-  EXPECT_GT(c.max_left, 0.2 + 0.3);
-  EXPECT_GT(c.min_clearance, 0.05);
-  EXPECT_GT(c.t_pass, 0.0);
+  EXPECT_GT(a.min_clearance, 0.1);
+  // Inside the tie band (|offset| <= side_band) the tie-break side wins.
+  const PassResult c = runPast({}, 0.03, 20.0);
+  EXPECT_GT(c.max_left, 0.3 + 0.03);
+  // Fixed side: the obstacle left of the line is passed on the left (the long way), still clear of it.
+  PotentialFieldParams fixed;
+  fixed.nearest_side = false;
+  const PassResult f = runPast(fixed, 0.2, 25.0);
+  EXPECT_GT(f.max_left, 0.2 + 0.3);
+  EXPECT_GT(f.min_clearance, 0.1);
+  EXPECT_GT(f.t_pass, 0.0);
+}
+
+TEST(PotentialField, CloseObstaclesShareASideInsteadOfSqueezingBetween) {
+  // Two obstacles 4 cm apart (surfaces), symmetric about the line, and a staggered pair.
+  for (const bool staggered : {false, true}) {
+    const std::vector<Obstacle> obs{{10.0, 3.32, 0.3}, {staggered ? 10.4 : 10.0, 2.68, 0.3}};
+    PotentialField pf({}, RowLine{}, obs);
+    double min_clearance = 1e9, max_y = -1e9, min_y = 1e9;
+    bool passed = false;
+    sampleEveryMs(pf, 25000, [&](double, const Reference& ref) {
+      min_clearance = std::min(min_clearance, pf.minObstacleClearance({ref.pose.x, ref.pose.y}));
+      if (ref.pose.x > 9.7 && ref.pose.x < 10.7) {
+        max_y = std::max(max_y, ref.pose.y);
+        min_y = std::min(min_y, ref.pose.y);
+      }
+      passed = passed || ref.pose.x > 13.0;
+    });
+    // Through the 4 cm gap the clearance would be <= 2 cm: the pair is passed as one, on one side.
+    EXPECT_GT(min_clearance, 0.1) << staggered;
+    EXPECT_TRUE(max_y > 3.32 + 0.3 || min_y < 2.68 - 0.3) << staggered << " " << min_y << " " << max_y;
+    // Symmetric pair: the tie-break side (left); staggered: the reference meets the upper one first
+    // while right of its centre, so both are passed on the right.
+    if (staggered) {
+      EXPECT_LT(min_y, 2.68 - 0.3);
+    } else {
+      EXPECT_GT(max_y, 3.32 + 0.3);
+    }
+    EXPECT_TRUE(passed);
+  }
 }
 
 TEST(PotentialField, MatlabAppendixObstaclesAreAllPassed) {

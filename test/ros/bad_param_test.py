@@ -5,6 +5,7 @@ import os
 import subprocess
 import unittest
 
+import roslib.packages
 import rospy
 import rostest
 import rospkg
@@ -47,7 +48,8 @@ class BadParameters(unittest.TestCase):
                 if value == "ZERO_RADIUS":
                     value = zero_radius_urdf()
                 rospy.set_param("%s/%s" % (ns, key), value)
-            cmd = ["rosrun", "sowing_robot", node, "__name:=bad_%d" % i]
+            # roslib finds the binary through catkin (rosrun's find would crawl the .ws symlink loop)
+            cmd = [roslib.packages.find_node("sowing_robot", node)[0], "__name:=bad_%d" % i]
             proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=60,
                                   universal_newlines=True)
             out = proc.stdout

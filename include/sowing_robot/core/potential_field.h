@@ -35,24 +35,33 @@ struct RowLine {
   std::string validate() const;
 };
 
-/// Which way the reference goes around an obstacle (seen along the target's direction of travel).
+/// A side of the direction of travel.
 enum class AvoidSide {
-  kLeft,     ///< always pass with the obstacle on the right
-  kRight,    ///< always pass with the obstacle on the left
-  kShorter,  ///< pass on the side away from the obstacle centre; a centre on the line (|offset| <= 1 nm) -> left
+  kLeft,   ///< pass with the obstacle on the right
+  kRight,  ///< pass with the obstacle on the left
 };
 
 struct PotentialFieldParams {
   double alpha = 4.0;                ///< position gain alpha [1/s^2] (thesis: 4)
   double beta = 16.0;                ///< damping of the velocity relative to the target, beta [1/s] (thesis: 16)
   double influence_distance = 0.5;   ///< d: no repulsion beyond this clearance from the obstacle SURFACE [m]
-  double gain = 2.5;                 ///< k: mu_radial = -k grad V_a [m^2/s^2], >= 0 (0 disables avoidance)
+  double gain = 5.0;                 ///< k: mu_radial = -k grad V_a [m^2/s^2], >= 0 (0 disables avoidance)
   double tangential_ratio = 1.0;     ///< |tangential| / |radial| repulsion [-], >= 0
-  AvoidSide avoid_side = AvoidSide::kShorter;
+  /// true: when the reference enters an obstacle's influence zone it picks the side it is already on
+  /// (offset from the centre of the obstacles whose zones it is in, along the left normal of travel,
+  /// beyond +-side_band) and keeps it until it leaves the zone; obstacles with overlapping zones share
+  /// the side. false: always avoid_side.
+  bool nearest_side = true;
+  /// Forced side (nearest_side = false) and tie-break inside the band: the on-line case goes this way.
+  AvoidSide avoid_side = AvoidSide::kLeft;
+  double side_band = 0.05;           ///< half-width of the tie band [m], >= 0
   /// Below this fraction of d the clearance potential continues linearly (finite force, so a reference
   /// that starts inside an obstacle is pushed out instead of blowing up the integrator) [-], (0, 1).
   double core_fraction = 0.1;
   double step = 1e-3;                ///< internal RK4 step h [s], (0, 1e-3]
+  /// While both the reference and the target move slower than this [m/s], theta is held and
+  /// omega = omega_dot = 0 (stops: a residual sideways creep must not turn the heading), >= 0.
+  double heading_hold_speed = 0.02;
   std::string validate() const;
 };
 
@@ -95,13 +104,16 @@ class LineTarget : public TargetTrajectory {
 /// * mu = sum_i f_i (n_i + s_i tangential_ratio R n_i), f_i = -k dV_a/drho >= 0, n_i = (p - c_i)/|p - c_i|,
 ///   R n = (n_y, -n_x) (n turned 90 deg clockwise) and s_i = +1 to pass obstacle i on the left of the
 ///   direction of travel, -1 on the right. The tangential part breaks the symmetric stall in front of
-///   an obstacle on the line and always turns to the same, deterministic side.
+///   an obstacle on the line and always turns to the same, deterministic side. s_i is fixed when the
+///   reference enters the zone (see nearest_side) and held while it stays in it; the force is zero on
+///   the zone boundary, so choosing or releasing a side never makes a step.
 /// * RK4 with a fixed step h on the grid t = n h; next(t) integrates to the last grid point <= t and
 ///   evaluates t by a partial RK4 step that is not kept, so the output depends only on t (and on when
 ///   setObstacles() was called).
 /// * Output: theta = atan2(y', x'), v = |p'|, omega = (x'y'' - y'x'')/v^2, v_dot = p'.p''/v and an
 ///   analytic omega_dot from the jerk p''' = p_d''' + e''' with e''' = -alpha e' - beta e'' + J_mu p'
-///   (J_mu the Jacobian of mu). Below 1e-4 m/s the last theta is held and omega = omega_dot = 0.
+///   (J_mu the Jacobian of mu). Below 1e-4 m/s, or when the reference and the target are both slower
+///   than heading_hold_speed, the last theta is held and omega = omega_dot = 0.
 class PotentialField : public ReferenceSource {
  public:
   /// Straight row. Throws std::invalid_argument on invalid parameters or obstacles.
@@ -130,7 +142,8 @@ class PotentialField : public ReferenceSource {
   double repulsivePotential(const Eigen::Vector2d& p) const;
   /// Gradient of repulsivePotential() [1/m]; the radial repulsion is -k times this.
   Eigen::Vector2d repulsiveGradient(const Eigen::Vector2d& p) const;
-  /// Full repulsive acceleration mu [m/s^2] (radial + tangential) for a target with the given state.
+  /// Full repulsive acceleration mu [m/s^2] (radial + tangential) for a target with the given state
+  /// (with the sides currently held; an obstacle without one gets the side it would choose at p).
   Eigen::Vector2d repulsiveAcceleration(const Eigen::Vector2d& p, const TargetState& target) const;
   /// Smallest |p - c_i| - r_i over the obstacles [m]; +infinity without obstacles.
   double minObstacleClearance(const Eigen::Vector2d& p) const;
@@ -148,6 +161,10 @@ class PotentialField : public ReferenceSource {
   };
   /// V_a'(rho) and V_a''(rho) for one clearance (zero beyond d).
   void clearanceDerivatives(double rho, double& dv, double& ddv) const;
+  /// +1/-1: side to pass obstacle i at p (held one, or the one it would choose now).
+  double sideFor(std::size_t i, const Eigen::Vector2d& p, const TargetState& target) const;
+  /// Releases the sides of zones the reference at p has left and picks sides for zones it entered.
+  void updateSides(const Eigen::Vector2d& p, const TargetState& target);
   /// mu at p; adds d mu/d p into *jacobian when given.
   Eigen::Vector2d mu(const Eigen::Vector2d& p, const TargetState& target, Eigen::Matrix2d* jacobian) const;
   /// e'' for an error state at time t with the target state tgt.
@@ -157,6 +174,7 @@ class PotentialField : public ReferenceSource {
   PotentialFieldParams params_;
   std::unique_ptr<TargetTrajectory> target_;
   std::vector<Obstacle> obstacles_;
+  std::vector<signed char> sides_;  ///< held side per obstacle: +1 left, -1 right, 0 none (outside its zone)
 
   ErrorState state_;  ///< error state at the grid time steps_ * h
   long long steps_ = 0;

@@ -15,7 +15,7 @@ struct RobotParams {
   double d = 0.05;     ///< centre of mass ahead of the axle midpoint [m]
   double L = 0.24;     ///< half track: axle midpoint to each wheel [m]
   double R = 0.095;    ///< drive wheel radius [m]
-  double Ic = 0.537;   ///< chassis yaw inertia about the axle midpoint [kg·m^2]
+  double Ic = 0.537;   ///< chassis yaw inertia about its own centre of mass [kg·m^2] (see I())
   double Im = 0.0011;  ///< one wheel's inertia about a vertical (diameter) axis [kg·m^2]
   double Iw = 0.0023;  ///< one wheel's spin inertia about its axle [kg·m^2]
 

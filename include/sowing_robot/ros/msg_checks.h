@@ -3,6 +3,8 @@
 
 #include <nav_msgs/Odometry.h>
 
+#include <cstdint>
+
 #include "sowing_robot/core/types.h"
 
 namespace sowing_robot {
@@ -21,4 +23,10 @@ inline bool odomIsFinite(const nav_msgs::Odometry& o) {
                          o.twist.twist.angular.z);
 }
 
+}  // namespace sowing_robot
+
+namespace sowing_robot {
+/// Publisher queue of every per-period topic: a recorder that falls behind in lockstep (which does not
+/// wait for it) must not lose messages, so the queue holds several seconds of a 1 kHz run.
+constexpr std::uint32_t kLockstepQueue = 20000;
 }  // namespace sowing_robot

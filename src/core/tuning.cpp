@@ -1,0 +1,220 @@
+#include "sowing_robot/core/tuning.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <limits>
+#include <stdexcept>
+#include <thread>
+
+#include "sowing_robot/core/validation.h"
+
+namespace sowing_robot {
+namespace core {
+
+namespace {
+
+constexpr double INF = std::numeric_limits<double>::infinity();
+
+double* gainSlot(Scenario& sc, const std::string& n) {
+  if (n == "kx") return &sc.kanayama.kx;
+  if (n == "ky") return &sc.kanayama.ky;
+  if (n == "ktheta") return &sc.kanayama.ktheta;
+  if (n == "k1") return &sc.sliding.k1;
+  if (n == "k2") return &sc.sliding.k2;
+  if (n == "eta1") return &sc.sliding.eta1;
+  if (n == "eta2") return &sc.sliding.eta2;
+  if (n == "beta_v") return &sc.sliding.beta_v;
+  if (n == "beta_omega") return &sc.sliding.beta_omega;
+  if (n == "rate_m") return &sc.sliding.rate_m;
+  if (n == "rate_i") return &sc.sliding.rate_i;
+  return nullptr;
+}
+
+std::string num(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.6g", v);
+  return b;
+}
+
+/// Effort and chattering of one run, accumulated by the runner's trace (no allocation per step).
+struct TorqueTally {
+  double effort = 0.0, chattering = 0.0;
+  double last_t = 0.0, last_r = 0.0, last_l = 0.0;
+  bool any = false;
+  void add(const LoopSample& s) {
+    const double r = s.control->torques.right, l = s.control->torques.left;
+    if (any) {
+      // The previous command was held over [last_t, t] (zero-order hold, as the plant applies it).
+      effort += (last_r * last_r + last_l * last_l) * (s.t - last_t);
+      chattering += std::fabs(r - last_r) + std::fabs(l - last_l);
+    }
+    any = true;
+    last_t = s.t;
+    last_r = r;
+    last_l = l;
+  }
+};
+
+}  // namespace
+
+bool parseCostType(const std::string& name, CostType& out) {
+  if (name == "itae") out = CostType::ITAE;
+  else if (name == "ise") out = CostType::ISE;
+  else if (name == "iae") out = CostType::IAE;
+  else if (name == "itse") out = CostType::ITSE;
+  else return false;
+  return true;
+}
+
+const char* costTypeName(CostType type) {
+  switch (type) {
+    case CostType::ITAE: return "itae";
+    case CostType::ISE: return "ise";
+    case CostType::IAE: return "iae";
+    case CostType::ITSE: return "itse";
+  }
+  return "?";
+}
+
+const std::vector<std::string>& tunableGainNames() {
+  static const std::vector<std::string> names{"kx",   "ky",     "ktheta",     "k1",     "k2",    "eta1",
+                                              "eta2", "beta_v", "beta_omega", "rate_m", "rate_i"};
+  return names;
+}
+
+std::string gainNode(const std::string& name) {
+  if (name == "kx" || name == "ky" || name == "ktheta") return "kinematic_controller";
+  const auto& n = tunableGainNames();
+  return std::find(n.begin(), n.end(), name) != n.end() ? "torque_controller" : "";
+}
+
+bool setGain(Scenario& sc, const std::string& name, double value) {
+  double* slot = gainSlot(sc, name);
+  if (!slot) return false;
+  *slot = value;
+  return true;
+}
+
+double getGain(const Scenario& sc, const std::string& name) {
+  double* slot = gainSlot(const_cast<Scenario&>(sc), name);
+  return slot ? *slot : std::numeric_limits<double>::quiet_NaN();
+}
+
+std::vector<GainBounds> defaultGainBounds() {
+  return {{"kx", 0.1, 10.0}, {"ky", 0.1, 10.0},     {"ktheta", 0.1, 10.0}, {"k1", 0.1, 1000.0},
+          {"k2", 0.1, 1000.0}, {"eta1", 0.1, 10.0}, {"eta2", 0.1, 10.0}};
+}
+
+std::string validateGainBounds(const Scenario& base, const std::vector<GainBounds>& gains) {
+  if (gains.empty()) return "gains is empty: give at least one {name, lower, upper} to tune";
+  for (std::size_t i = 0; i < gains.size(); ++i) {
+    const GainBounds& g = gains[i];
+    const std::string at = "gains[" + std::to_string(i) + "] (" + g.name + ")";
+    if (gainNode(g.name).empty()) {
+      std::string known;
+      for (const auto& n : tunableGainNames()) known += (known.empty() ? "" : ", ") + n;
+      return at + ": unknown gain '" + g.name + "' (tunable: " + known + ")";
+    }
+    for (std::size_t j = 0; j < i; ++j)
+      if (gains[j].name == g.name) return at + ": '" + g.name + "' is listed twice (also gains[" + std::to_string(j) + "])";
+    if (!allFinite(g.lower, g.upper))
+      return at + ": bounds must be finite numbers, got lower = " + num(g.lower) + ", upper = " + num(g.upper);
+    if (!(g.lower < g.upper))
+      return at + ": lower = " + num(g.lower) + " must be < upper = " + num(g.upper);
+  }
+  // Every constraint validate() puts on one of these gains is an interval, so the two corners suffice.
+  for (int corner = 0; corner < 2; ++corner) {
+    Scenario sc = base;
+    for (const auto& g : gains) setGain(sc, g.name, corner == 0 ? g.lower : g.upper);
+    const std::string e = firstError({sc.kanayama.validate(), sc.sliding.validate()});
+    if (!e.empty())
+      return std::string("gains: with every gain at its ") + (corner == 0 ? "lower" : "upper") +
+             " bound the controller refuses it: " + e;
+  }
+  return "";
+}
+
+std::string TuningObjective::validate() const {
+  return firstError({checkNonNegative("torque_weight", torque_weight), checkNonNegative("chattering_weight", chattering_weight)});
+}
+
+TuningProblem::TuningProblem(const Scenario& base, const ReferenceSource& reference, std::vector<GainBounds> gains,
+                             const TuningObjective& objective, int threads)
+    : base_(base), gains_(std::move(gains)), objective_(objective) {
+  for (int t = 0; t < std::max(threads, 1); ++t) references_.push_back(reference.clone());
+}
+
+Scenario TuningProblem::scenarioFor(const std::vector<double>& x) const {
+  Scenario sc = base_;
+  for (std::size_t d = 0; d < gains_.size() && d < x.size(); ++d) setGain(sc, gains_[d].name, x[d]);
+  return sc;
+}
+
+TuningCost TuningProblem::evaluate(const std::vector<double>& x, int thread_index) const {
+  const Scenario sc = scenarioFor(x);
+  ReferenceSource& ref = *references_.at(static_cast<std::size_t>(thread_index));
+  TorqueTally tally;
+  const bool traced = objective_.torque_weight > 0.0 || objective_.chattering_weight > 0.0;
+  std::function<void(const LoopSample&)> trace;
+  if (traced) {
+    TorqueTally* t = &tally;  // one pointer: fits std::function's small buffer, no allocation
+    trace = [t](const LoopSample& s) { t->add(s); };
+  }
+  const RunResult r = runClosedLoop(sc, ref, false, trace);
+
+  TuningCost c;
+  c.diverged = r.diverged;
+  for (const AxisMetrics& m : r.metrics) {
+    switch (objective_.cost) {
+      case CostType::ITAE: c.tracking += m.itae; break;
+      case CostType::ISE: c.tracking += m.ise; break;
+      case CostType::IAE: c.tracking += m.iae; break;
+      case CostType::ITSE: c.tracking += m.itse; break;
+    }
+  }
+  c.effort = tally.effort;
+  c.chattering = tally.chattering;
+  c.total = c.tracking;
+  if (objective_.torque_weight > 0.0) c.total += objective_.torque_weight * c.effort;
+  if (objective_.chattering_weight > 0.0) c.total += objective_.chattering_weight * c.chattering;
+  if (r.diverged || !std::isfinite(c.total)) c.total = INF;
+  return c;
+}
+
+int psoThreads(const PsoParams& p) {
+  int threads = p.threads > 0 ? p.threads : static_cast<int>(std::thread::hardware_concurrency());
+  return std::clamp(threads, 1, std::max(p.particles, 1));
+}
+
+TuningResult tuneGains(const Scenario& base, const ReferenceSource& reference, const std::vector<GainBounds>& gains,
+                       const TuningObjective& objective, PsoParams params, const PsoProgressCallback& progress) {
+  std::string e = firstError({base.validate(), validateGainBounds(base, gains), objective.validate()});
+  if (!e.empty()) throw std::invalid_argument(e);
+  params.lower.clear();
+  params.upper.clear();
+  for (const auto& g : gains) {
+    params.lower.push_back(g.lower);
+    params.upper.push_back(g.upper);
+  }
+  e = params.validate();
+  if (!e.empty()) throw std::invalid_argument(e);
+
+  TuningResult out;
+  out.threads = psoThreads(params);
+  const TuningProblem problem(base, reference, gains, objective, out.threads);
+  const auto t0 = std::chrono::steady_clock::now();
+  out.pso = psoMinimize(
+      params, [&problem](const std::vector<double>& x, int thread) { return problem.evaluate(x, thread).total; },
+      progress);
+  out.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  out.best_gains = out.pso.best_position;
+  out.best = problem.evaluate(out.best_gains, 0);
+  out.initial_best_cost = out.pso.best_cost_per_iteration.empty() ? INF : out.pso.best_cost_per_iteration.front();
+  return out;
+}
+
+}  // namespace core
+}  // namespace sowing_robot

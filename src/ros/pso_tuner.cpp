@@ -1,0 +1,294 @@
+#include "sowing_robot/ros/pso_tuner.h"
+
+#include <std_msgs/Float64MultiArray.h>
+#include <unistd.h>
+
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+
+#include "sowing_robot/core/validation.h"
+#include "sowing_robot/ros/component_params.h"
+
+namespace sowing_robot {
+
+namespace {
+
+std::string fmt(const char* f, double v) {
+  char b[64];
+  std::snprintf(b, sizeof b, f, v);
+  return b;
+}
+
+std::string g(double v) { return fmt("%.6g", v); }
+
+std::string defaultOutput() {
+  const char* ros_home = std::getenv("ROS_HOME");
+  if (ros_home && *ros_home) return std::string(ros_home) + "/tuned_gains.yaml";
+  const char* home = std::getenv("HOME");
+  return std::string(home && *home ? home : ".") + "/.ros/tuned_gains.yaml";
+}
+
+/// ~gains: a list of {name: str, lower: number, upper: number}. "" or one line naming the bad entry.
+std::string parseGains(const ros::NodeHandle& pnh, std::vector<core::GainBounds>& out) {
+  const std::string full = pnh.resolveName("gains");
+  if (!pnh.hasParam("gains")) {
+    out = core::defaultGainBounds();
+    return "";
+  }
+  XmlRpc::XmlRpcValue list;
+  pnh.getParam("gains", list);
+  if (list.getType() != XmlRpc::XmlRpcValue::TypeArray)
+    return "parameter " + full + " must be a list of {name, lower, upper}";
+  out.clear();
+  for (int i = 0; i < list.size(); ++i) {
+    XmlRpc::XmlRpcValue& e = list[i];
+    const std::string at = full + "[" + std::to_string(i) + "]";
+    if (e.getType() != XmlRpc::XmlRpcValue::TypeStruct) return at + " must be a map {name, lower, upper}";
+    core::GainBounds b;
+    for (auto it = e.begin(); it != e.end(); ++it) {
+      const std::string& key = it->first;
+      XmlRpc::XmlRpcValue& v = it->second;
+      if (key == "name") {
+        if (v.getType() != XmlRpc::XmlRpcValue::TypeString) return at + "/name must be a string";
+        b.name = static_cast<std::string>(v);
+      } else if (key == "lower" || key == "upper") {
+        double x;
+        if (v.getType() == XmlRpc::XmlRpcValue::TypeDouble) x = static_cast<double>(v);
+        else if (v.getType() == XmlRpc::XmlRpcValue::TypeInt) x = static_cast<int>(v);
+        else return at + "/" + key + " must be a number";
+        (key == "lower" ? b.lower : b.upper) = x;
+      } else {
+        return at + ": unknown key '" + key + "' (expected name, lower, upper)";
+      }
+    }
+    for (const char* k : {"name", "lower", "upper"})
+      if (!e.hasMember(k)) return at + " has no '" + k + "'";
+    out.push_back(b);
+  }
+  return "";
+}
+
+}  // namespace
+
+std::string yamlFloat(double v) {
+  if (std::isnan(v)) return ".nan";
+  if (std::isinf(v)) return v > 0 ? ".inf" : "-.inf";
+  char b[64];
+  const auto r = std::to_chars(b, b + sizeof b, v);
+  std::string s(b, r.ptr);
+  if (s.find('.') == std::string::npos) {  // YAML 1.1 needs the dot: "2" is an int, "1e-05" a string
+    const auto e = s.find('e');
+    if (e == std::string::npos) s += ".0";
+    else s.insert(e, ".0");
+  }
+  return s;
+}
+
+std::string writeGainsYaml(const std::string& path, const std::string& header, const core::Scenario& tuned,
+                           const std::vector<core::GainBounds>& searched) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path target(path);
+  if (target.has_parent_path()) fs::create_directories(target.parent_path(), ec);
+  if (ec) return "cannot create " + target.parent_path().string() + ": " + ec.message();
+  const std::string tmp = path + ".tmp" + std::to_string(::getpid());
+  {
+    std::ofstream f(tmp);
+    if (!f) return "cannot open " + tmp + " for writing";
+    f << header;
+    std::string node;
+    for (const std::string& name : core::tunableGainNames()) {
+      const std::string n = core::gainNode(name);
+      if (n != node) {
+        node = n;
+        f << node << ":\n";
+      }
+      std::string comment = "# base value (not tuned)";
+      for (const auto& b : searched)
+        if (b.name == name) comment = "# tuned in [" + g(b.lower) + ", " + g(b.upper) + "]";
+      std::string line = "  " + name + ": " + yamlFloat(core::getGain(tuned, name));
+      line.resize(std::max<std::size_t>(line.size() + 1, 36), ' ');
+      f << line << comment << "\n";
+    }
+    f.flush();
+    if (!f) return "write to " + tmp + " failed";
+  }
+  fs::rename(tmp, target, ec);
+  if (ec) {
+    fs::remove(tmp, ec);
+    return "cannot rename " + tmp + " to " + path;
+  }
+  return "";
+}
+
+PsoTuner::PsoTuner(ros::NodeHandle nh, ros::NodeHandle pnh) {
+  ParamReader p(pnh);
+  pso_.particles = p.get("particles", pso_.particles);
+  pso_.iterations = p.get("iterations", pso_.iterations);
+  const int seed = p.get("seed", 1);
+  pso_.threads = p.get("threads", 0);
+  pso_.max_velocity_fraction = p.get("velocity_clamp", 0.2);
+  pso_.w_max = p.get("w_max", pso_.w_max);
+  pso_.w_min = p.get("w_min", pso_.w_min);
+  pso_.c1 = p.get("c1", pso_.c1);
+  pso_.c2 = p.get("c2", pso_.c2);
+  const std::string cost = p.get("cost", "itae");
+  objective_.torque_weight = p.get("torque_weight", 0.0);
+  objective_.chattering_weight = p.get("chattering_weight", 0.0);
+  const double duration = p.get("duration", 25.0);
+  std::string error;
+  const std::int64_t period = loadControlPeriod(p, error);
+  const std::string mode = p.get("mode", "atsmc");
+  output_ = p.get("output", "");
+  if (output_.empty()) output_ = defaultOutput();
+  p.allow("gains");
+  p.allow("gains/");
+
+  // The base scenario, read with the nodes' own loaders from the nodes' namespaces.
+  ParamReader plant(ros::NodeHandle("/plant_sim")), kin(ros::NodeHandle("/kinematic_controller")),
+      torque(ros::NodeHandle("/torque_controller")), refp(ros::NodeHandle("/reference_generator"));
+  const std::string robot_error = loadRobotParams(pnh, base_.robot);
+  base_.duration = duration;
+  base_.control_period_ns = period > 0 ? period : base_.control_period_ns;
+  base_.start = loadStartPose(plant);
+  base_.disturbance = loadDisturbance(plant);
+  base_.kanayama = loadKanayama(kin);
+  std::string torque_error;
+  base_.sliding = loadSlidingMode(torque, torque_error);
+  base_.sliding.adaptive = mode == "atsmc";
+  line_v_ = refp.get("line/v_r", line_v_);
+  line_y_ = refp.get("line/y", line_y_);
+  line_x0_ = refp.get("line/x0", line_x0_);
+  reference_ = core::LineReference(line_v_, line_y_, line_x0_);
+
+  const std::string gains_error = parseGains(pnh, gains_);
+  std::string e = core::firstError(
+      {plant.error(), kin.error(), torque.error(), refp.error(), error, robot_error, torque_error,
+       mode == "atsmc" || mode == "tsmc" ? "" : "mode = '" + mode + "' must be 'atsmc' or 'tsmc'",
+       core::parseCostType(cost, objective_.cost) ? "" : "cost = '" + cost + "' must be itae, ise, iae or itse",
+       seed >= 0 ? "" : "seed = " + std::to_string(seed) + " must be >= 0",
+       core::checkRange("duration", duration, 1e-3, 1e5, "s"),
+       core::checkRange("velocity_clamp", pso_.max_velocity_fraction, 0.0, 10.0, "(0 = no clamp)"), gains_error,
+       core::allFinite(line_v_, line_y_, line_x0_) ? "" : "reference_generator/line must be finite"});
+  pso_.seed = static_cast<std::uint64_t>(seed);
+  if (e.empty()) e = core::firstError({base_.validate(), core::validateGainBounds(base_, gains_), objective_.validate()});
+  if (e.empty()) {
+    for (const auto& b : gains_) {
+      pso_.lower.push_back(b.lower);
+      pso_.upper.push_back(b.upper);
+    }
+    e = pso_.validate();
+  }
+  // Type errors of our own keys first, then typos among them, then ranges.
+  requireValid(p, e);
+
+  progress_pub_ = nh.advertise<std_msgs::Float64MultiArray>("pso/progress", 10, true);
+  std::string dims;
+  for (const auto& b : gains_) dims += (dims.empty() ? "" : ", ") + b.name + " [" + g(b.lower) + ", " + g(b.upper) + "]";
+  ROS_INFO("pso_tuner: %d particles x %d iterations (+ initial), seed %d, %d thread(s), velocity clamp %.3g, "
+           "w %.3g..%.3g, c1 %.3g, c2 %.3g; cost %s (x + y + theta)%s%s",
+           pso_.particles, pso_.iterations, seed, core::psoThreads(pso_), pso_.max_velocity_fraction, pso_.w_max,
+           pso_.w_min, pso_.c1, pso_.c2, cost.c_str(),
+           objective_.torque_weight > 0 ? (" + " + g(objective_.torque_weight) + " * int tau^2 dt").c_str() : "",
+           objective_.chattering_weight > 0 ? (" + " + g(objective_.chattering_weight) + " * sum |dtau|").c_str() : "");
+  ROS_INFO("pso_tuner: scenario %s", scenarioText().c_str());
+  ROS_INFO("pso_tuner: searching %s", dims.c_str());
+  ROS_INFO("pso_tuner: output %s", output_.c_str());
+}
+
+std::string PsoTuner::scenarioText() const {
+  const core::PlantDisturbance& d = base_.disturbance;
+  std::string s = g(base_.duration) + " s at " + g(1e9 / static_cast<double>(base_.control_period_ns)) + " Hz, " +
+                  (base_.sliding.adaptive ? "atsmc" : "tsmc") + ", start (" + g(base_.start.x) + ", " +
+                  g(base_.start.y) + ", " + g(base_.start.theta) + "), line x = " + g(line_x0_) + " + " +
+                  g(line_v_) + " t, y = " + g(line_y_) + ", ";
+  s += d.sinusoidal ? "sinusoidal disturbance A " + g(d.amplitude) + " N.m w " + g(d.frequency) + " rad/s"
+                    : "no sinusoidal disturbance";
+  s += ", mismatch mass x" + g(d.mass_scale) + " inertia x" + g(d.inertia_scale);
+  s += ", noise std " + g(d.noise_std) + " N.m (seed " + std::to_string(d.seed) + ")";
+  return s;
+}
+
+void PsoTuner::onProgress(const core::PsoProgress& p) {
+  if (!ros::ok()) throw std::runtime_error("interrupted");
+  if (p.iteration == 0) initial_best_ = p.best_cost;
+  ROS_INFO("pso_tuner: iteration %d/%d  best cost %.6g  (initial %.6g)  elapsed %.2f s  ETA %.2f s", p.iteration,
+           p.iterations, p.best_cost, initial_best_, p.elapsed_s, p.eta_s);
+  std_msgs::Float64MultiArray m;
+  std::string labels = "iteration,iterations,best_cost,initial_best_cost,elapsed_s,eta_s,evaluations";
+  m.data = {static_cast<double>(p.iteration), static_cast<double>(p.iterations), p.best_cost, initial_best_,
+            p.elapsed_s, p.eta_s, static_cast<double>(pso_.particles) * (p.iteration + 1)};
+  for (std::size_t d = 0; d < gains_.size(); ++d) {
+    labels += "," + gains_[d].name;
+    m.data.push_back((*p.best_position)[d]);
+  }
+  m.layout.dim.resize(1);
+  m.layout.dim[0].label = labels;
+  m.layout.dim[0].size = static_cast<std::uint32_t>(m.data.size());
+  m.layout.dim[0].stride = static_cast<std::uint32_t>(m.data.size());
+  progress_pub_.publish(m);
+}
+
+int PsoTuner::run() {
+  core::TuningResult r;
+  try {
+    r = core::tuneGains(base_, reference_, gains_, objective_, pso_,
+                        [this](const core::PsoProgress& p) { onProgress(p); });
+  } catch (const std::exception& e) {
+    ROS_ERROR("pso_tuner: stopped: %s; nothing written", e.what());
+    return 1;
+  }
+  if (!std::isfinite(r.pso.best_cost)) {
+    ROS_ERROR("pso_tuner: every run diverged (no finite cost); nothing written. Narrow the gain bounds.");
+    return 1;
+  }
+  const core::Scenario tuned = core::TuningProblem(base_, reference_, gains_, objective_, 1).scenarioFor(r.best_gains);
+
+  char date[64];
+  const std::time_t now = std::time(nullptr);
+  std::strftime(date, sizeof date, "%Y-%m-%d %H:%M:%S %z", std::localtime(&now));
+  std::string searched;
+  for (const auto& b : gains_) searched += (searched.empty() ? "" : ", ") + b.name + " [" + g(b.lower) + ", " + g(b.upper) + "]";
+  std::string h;
+  h += "# Controller gains tuned offline by pso_tuner (PSO, thesis eqs 4.26-4.31, Table 5.4).\n";
+  h += "# Load with: roslaunch sowing_robot sim.launch gains:=THIS_FILE controller:=" +
+       std::string(base_.sliding.adaptive ? "atsmc" : "tsmc") + "\n";
+  h += "# date: " + std::string(date) + "\n";
+  h += "# scenario: " + scenarioText() + "\n";
+  h += "# cost: " + std::string(core::costTypeName(objective_.cost)) + " summed over x, y, theta";
+  if (objective_.torque_weight > 0) h += " + " + g(objective_.torque_weight) + " * int (tau_R^2 + tau_L^2) dt";
+  if (objective_.chattering_weight > 0) h += " + " + g(objective_.chattering_weight) + " * sum (|dtau_R| + |dtau_L|)";
+  h += "\n";
+  h += "# best_cost: " + yamlFloat(r.pso.best_cost) + "\n";
+  h += "# initial_best_cost: " + yamlFloat(r.initial_best_cost) + "   (best of the random initial swarm)\n";
+  h += "# best cost terms: tracking " + g(r.best.tracking) + ", effort " + g(r.best.effort) + " N^2.m^2.s, chattering " +
+       g(r.best.chattering) + " N.m\n";
+  h += "# pso: particles " + std::to_string(pso_.particles) + ", iterations " + std::to_string(pso_.iterations) +
+       ", seed " + std::to_string(pso_.seed) + ", w " + g(pso_.w_max) + "..." + g(pso_.w_min) + ", c1 " + g(pso_.c1) +
+       ", c2 " + g(pso_.c2) + ", velocity clamp " + g(pso_.max_velocity_fraction) + ", evaluations " +
+       std::to_string(r.pso.evaluations) + ", " + std::to_string(r.threads) + " thread(s), " + fmt("%.2f", r.wall_s) +
+       " s wall\n";
+  h += "# searched: " + searched + "\n";
+  h += "# Other torque_controller parameters (p, q, switching, bounds, max_torque) were those of the base config.\n";
+  const std::string e = writeGainsYaml(output_, h, tuned, gains_);
+  if (!e.empty()) {
+    ROS_ERROR("pso_tuner: %s", e.c_str());
+    return 1;
+  }
+  std::string best;
+  for (std::size_t d = 0; d < gains_.size(); ++d)
+    best += (d ? ", " : "") + gains_[d].name + " " + fmt("%.5g", r.best_gains[d]);
+  ROS_INFO("pso_tuner: done in %.2f s (%ld evaluations, %d thread(s)): cost %.6g -> %.6g; %s", r.wall_s,
+           r.pso.evaluations, r.threads, r.initial_best_cost, r.pso.best_cost, best.c_str());
+  ROS_INFO("pso_tuner: wrote %s", output_.c_str());
+  if (progress_pub_.getNumSubscribers() > 0) ros::WallDuration(0.3).sleep();  // let the last message go out
+  return 0;
+}
+
+}  // namespace sowing_robot
