@@ -7,6 +7,9 @@ int main(int argc, char** argv) {
   ros::init(argc, argv, "plant_sim");
   ros::NodeHandle nh, pnh("~");
   sowing_robot::PlantSim node(nh, pnh);
+  ros::AsyncSpinner spinner(1);  // callbacks; the simulation loop runs on this thread
+  spinner.start();
   node.run();
+  if (!node.exitAtEnd()) ros::waitForShutdown();
   return 0;
 }

@@ -1,5 +1,7 @@
 #include "sowing_robot/ros/component_params.h"
 
+#include <XmlRpcValue.h>
+
 #include <cmath>
 
 #include "sowing_robot/ros/urdf_params.h"
@@ -78,6 +80,85 @@ core::Pose2D loadStartPose(ParamReader& p) {
   s.y = p.get("start/y", s.y);
   s.theta = p.get("start/theta", s.theta);
   return s;
+}
+
+core::PotentialFieldParams loadPotentialField(ParamReader& p, std::string& error) {
+  core::PotentialFieldParams f;
+  f.alpha = p.get("potential/alpha", f.alpha);
+  f.beta = p.get("potential/beta", f.beta);
+  f.influence_distance = p.get("potential/influence_distance", f.influence_distance);
+  f.gain = p.get("potential/gain", f.gain);
+  f.tangential_ratio = p.get("potential/tangential_ratio", f.tangential_ratio);
+  f.nearest_side = p.get("potential/nearest_side", f.nearest_side);
+  const std::string side = p.get("potential/avoid_side", "left");
+  if (side != "left" && side != "right" && error.empty())
+    error = "potential/avoid_side = '" + side + "' must be 'left' or 'right'";
+  f.avoid_side = side == "right" ? core::AvoidSide::kRight : core::AvoidSide::kLeft;
+  f.side_band = p.get("potential/side_band", f.side_band);
+  f.core_fraction = p.get("potential/core_fraction", f.core_fraction);
+  f.step = p.get("potential/step", f.step);
+  f.heading_hold_speed = p.get("potential/heading_hold_speed", f.heading_hold_speed);
+  return f;
+}
+
+core::FieldParams loadFieldParams(ParamReader& p, std::string& error) {
+  core::FieldParams f;
+  f.rows = p.get("field/rows", f.rows);
+  f.row_length = p.get("field/row_length", f.row_length);
+  f.row_spacing = p.get("field/row_spacing", f.row_spacing);
+  f.start_x = p.get("field/start_x", f.start_x);
+  f.start_y = p.get("field/start_y", f.start_y);
+  f.heading = p.get("field/heading", f.heading);
+  f.rows_to_left = p.get("field/rows_to_left", f.rows_to_left);
+  f.row_speed = p.get("field/row_speed", f.row_speed);
+  f.turn_speed = p.get("field/turn_speed", f.turn_speed);
+  f.min_turn_radius = p.get("field/min_turn_radius", f.min_turn_radius);
+  f.max_accel = p.get("field/max_accel", f.max_accel);
+  f.max_curvature_rate = p.get("field/max_curvature_rate", f.max_curvature_rate);
+  f.start_from_rest = p.get("field/start_from_rest", f.start_from_rest);
+  f.potential = loadPotentialField(p, error);
+  return f;
+}
+
+namespace {
+/// A number (int or double) from an XmlRpc value; false for any other type.
+bool xmlNumber(const XmlRpc::XmlRpcValue& v, double& out) {
+  if (v.getType() == XmlRpc::XmlRpcValue::TypeDouble) {
+    out = static_cast<const double&>(v);
+    return true;
+  }
+  if (v.getType() == XmlRpc::XmlRpcValue::TypeInt) {
+    out = static_cast<const int&>(v);
+    return true;
+  }
+  return false;
+}
+}  // namespace
+
+std::string loadObstacles(ParamReader& p, const std::string& key, std::vector<core::Obstacle>& out) {
+  out.clear();
+  p.allow(key);
+  const std::string full = p.handle().resolveName(key);
+  if (!p.handle().hasParam(key)) return "";
+  XmlRpc::XmlRpcValue list;
+  if (!p.handle().getParam(key, list) || list.getType() != XmlRpc::XmlRpcValue::TypeArray)
+    return "parameter " + full + " must be a list of {x, y, radius} maps";
+  for (int i = 0; i < list.size(); ++i) {
+    const std::string name = full + "[" + std::to_string(i) + "]";
+    XmlRpc::XmlRpcValue& item = list[i];
+    if (item.getType() != XmlRpc::XmlRpcValue::TypeStruct) return name + " must be a map {x, y, radius}";
+    core::Obstacle o;
+    for (auto it = item.begin(); it != item.end(); ++it) {
+      double* field = it->first == "x" ? &o.x : it->first == "y" ? &o.y : it->first == "radius" ? &o.radius : nullptr;
+      if (!field) return name + ": unknown key '" + it->first + "' (allowed: x, y, radius)";
+      if (!xmlNumber(it->second, *field)) return name + "/" + it->first + " must be a number";
+    }
+    if (!item.hasMember("x") || !item.hasMember("y")) return name + " needs both x and y";
+    const std::string e = o.validate();
+    if (!e.empty()) return name + ": " + e;
+    out.push_back(o);
+  }
+  return "";
 }
 
 void requireValid(const ParamReader& p, const std::string& validate_message) {

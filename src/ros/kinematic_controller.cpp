@@ -2,6 +2,7 @@
 
 #include "sowing_robot/core/runner.h"
 #include "sowing_robot/ros/component_params.h"
+#include "sowing_robot/core/validation.h"
 #include "sowing_robot/ros/msg_checks.h"
 
 namespace sowing_robot {
@@ -9,14 +10,34 @@ namespace sowing_robot {
 KinematicController::KinematicController(ros::NodeHandle nh, ros::NodeHandle pnh) {
   ParamReader p(pnh);
   const core::KanayamaGains gains = loadKanayama(p);
-  requireValid(p, gains.validate());
+  input_timeout_ = p.get("input_timeout", input_timeout_);
+  requireValid(p, core::firstError({gains.validate(), core::checkPositive("input_timeout", input_timeout_, "s")}));
   kanayama_.setGains(gains);
   ROS_INFO("kinematic_controller: kx %.4g, ky %.4g, ktheta %.4g", gains.kx, gains.ky, gains.ktheta);
+  reconfigure_ = std::make_unique<dynamic_reconfigure::Server<KinematicControllerConfig>>(pnh);
+  reconfigure_->setCallback([this](KinematicControllerConfig& c, uint32_t level) { reconfigure(c, level); });
   desired_pub_ = nh.advertise<DesiredVelocity>("desired_velocity", kLockstepQueue);
   error_pub_ = nh.advertise<TrackingError>("tracking_error", kLockstepQueue);
   const auto hints = ros::TransportHints().tcpNoDelay();
   odom_sub_ = nh.subscribe("odom", 50, &KinematicController::odomCallback, this, hints);
   ref_sub_ = nh.subscribe("reference", 50, &KinematicController::referenceCallback, this, hints);
+}
+
+void KinematicController::reconfigure(KinematicControllerConfig& config, uint32_t) {
+  const core::KanayamaGains g{config.kx, config.ky, config.ktheta};
+  const core::KanayamaGains& old = kanayama_.gains();
+  if (g.kx == old.kx && g.ky == old.ky && g.ktheta == old.ktheta) return;
+  const std::string error = g.validate();
+  if (!error.empty()) {
+    ROS_WARN("kinematic_controller: rejected gain change: %s; keeping kx %g, ky %g, ktheta %g", error.c_str(),
+             old.kx, old.ky, old.ktheta);
+    config.kx = old.kx;  // the server then reports (and stores) the values really in force
+    config.ky = old.ky;
+    config.ktheta = old.ktheta;
+    return;
+  }
+  kanayama_.setGains(g);
+  ROS_INFO("kinematic_controller: gains now kx %g, ky %g, ktheta %g", g.kx, g.ky, g.ktheta);
 }
 
 void KinematicController::odomCallback(const nav_msgs::Odometry::ConstPtr& msg) {
@@ -25,10 +46,24 @@ void KinematicController::odomCallback(const nav_msgs::Odometry::ConstPtr& msg) 
     return;
   }
   if (inputs_.isRepeat(msg->header.stamp)) {  // the plant asked again: answer with the same numbers
-    desired_pub_.publish(desired_);
+    publishShared(desired_pub_, desired_);
     return;
   }
-  if (inputs_.setFirst(*msg)) compute();
+  if (inputs_.setFirst(*msg))
+    compute();
+  else
+    stopIfStale(*msg);
+}
+
+void KinematicController::stopIfStale(const nav_msgs::Odometry& odom) {
+  const double age = (odom.header.stamp - (inputs_.any() ? inputs_.lastStamp() : ros::Time(0))).toSec();
+  if (age <= input_timeout_) return;
+  // No reference (generator dead or restarting): ask the inner loop to stop the robot.
+  ROS_WARN_THROTTLE(1.0, "kinematic_controller: no reference for %.3f s (input_timeout %.3f s): commanding stop",
+                    age, input_timeout_);
+  desired_.header.stamp = odom.header.stamp;
+  desired_.v = desired_.omega = desired_.v_dot = desired_.omega_dot = 0.0;
+  publishShared(desired_pub_, desired_);
 }
 
 void KinematicController::referenceCallback(const ReferenceState::ConstPtr& msg) {
@@ -56,7 +91,7 @@ void KinematicController::compute() {
   desired_.omega = cmd.omega;
   desired_.v_dot = cmd.v_dot;
   desired_.omega_dot = cmd.omega_dot;
-  desired_pub_.publish(desired_);
+  publishShared(desired_pub_, desired_);
 
   const core::PostureError pe = core::Kanayama::postureError(ref.pose, pose);
   error_.header.stamp = odom.header.stamp;
@@ -64,7 +99,7 @@ void KinematicController::compute() {
   error_.xe = pe.xe;
   error_.ye = pe.ye;
   error_.thetae = pe.thetae;
-  error_pub_.publish(error_);
+  publishShared(error_pub_, error_);
 }
 
 }  // namespace sowing_robot

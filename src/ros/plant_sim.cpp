@@ -1,8 +1,8 @@
 #include "sowing_robot/ros/plant_sim.h"
 
-#include <ros/callback_queue.h>
 #include <rosgraph_msgs/Clock.h>
 
+#include <chrono>
 #include <cmath>
 
 #include "sowing_robot/core/validation.h"
@@ -33,6 +33,7 @@ PlantSim::PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh) {
   cfg_.realtime_factor = p.get("realtime_factor", cfg_.realtime_factor);
   cfg_.torque_timeout = p.get("torque_timeout", cfg_.torque_timeout);
   cfg_.publish_rate = p.get("publish_rate", cfg_.publish_rate);
+  cfg_.clock_rate = p.get("clock_rate", cfg_.clock_rate);
   cfg_.lockstep_retry = p.get("lockstep_retry", cfg_.lockstep_retry);
   cfg_.lockstep_timeout = p.get("lockstep_timeout", cfg_.lockstep_timeout);
   cfg_.min_subscribers = p.get("min_subscribers", cfg_.min_subscribers);
@@ -47,6 +48,7 @@ PlantSim::PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh) {
          core::checkRange("realtime_factor", cfg_.realtime_factor, 0.01, 1000.0),
          core::checkPositive("torque_timeout", cfg_.torque_timeout, "s"),
          core::checkRange("publish_rate", cfg_.publish_rate, 0.1, 1000.0, "Hz"),
+         core::checkRange("clock_rate", cfg_.clock_rate, 0.0, 1e6, "Hz"),
          core::checkPositive("lockstep_retry", cfg_.lockstep_retry, "s"),
          core::checkPositive("lockstep_timeout", cfg_.lockstep_timeout, "s"),
          core::checkRange("min_subscribers", cfg_.min_subscribers, 0, 100),
@@ -62,6 +64,8 @@ PlantSim::PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh) {
   x0[core::THETA] = start_.theta;
   plant_->reset(x0, 0.0);
   visual_every_ = std::max<std::int64_t>(1, std::llround(1e9 / cfg_.publish_rate / cfg_.period_ns));
+  if (cfg_.clock_rate > 0.0)
+    clock_every_ = std::max<std::int64_t>(1, std::llround(1e9 / cfg_.clock_rate / cfg_.period_ns));
 
   ROS_INFO("plant_sim: %s mode, %.0f Hz, duration %.3f s, m0 %.4f kg (true %.4f), I0 %.5f kg m^2 (true %.5f), "
            "sinusoidal disturbance %s, noise std %.3f N m, start (%.3f, %.3f, %.3f)",
@@ -107,12 +111,17 @@ void PlantSim::torqueCallback(const WheelTorque::ConstPtr& msg) {
   torque_stamp_ = msg->header.stamp;
   torque_valid_ = true;
   got_torque_ = true;
+  torque_cv_.notify_one();
 }
 
 void PlantSim::publishState(const ros::Time& stamp, bool visuals) {
-  rosgraph_msgs::Clock clock;
-  clock.clock = stamp;
-  clock_pub_.publish(clock);
+  // Nothing in the control loop reads /clock (every node works on header stamps); it serves ROS time
+  // for logs, rosbag and rviz, so it may be published less often than every step (clock_rate).
+  if (step_ % clock_every_ == 0 || visuals) {
+    rosgraph_msgs::Clock clock;
+    clock.clock = stamp;
+    clock_pub_.publish(clock);
+  }
   const core::State& s = plant_->state();
   odom_msg_.header.stamp = stamp;
   odom_msg_.pose.pose.position.x = s[core::X];
@@ -121,7 +130,7 @@ void PlantSim::publishState(const ros::Time& stamp, bool visuals) {
   odom_msg_.pose.pose.orientation.w = std::cos(0.5 * s[core::THETA]);
   odom_msg_.twist.twist.linear.x = s[core::V];
   odom_msg_.twist.twist.angular.z = s[core::OMEGA];
-  odom_pub_.publish(odom_msg_);
+  publishShared(odom_pub_, odom_msg_);
   if (!visuals) return;
 
   geometry_msgs::TransformStamped tf;
@@ -140,13 +149,23 @@ void PlantSim::publishState(const ros::Time& stamp, bool visuals) {
   joint_msg_.velocity[1] = ds[core::PHI_L];
   joint_pub_.publish(joint_msg_);
 
-  geometry_msgs::PoseStamped pose;
-  pose.header = odom_msg_.header;
-  pose.pose = odom_msg_.pose.pose;
-  if (path_msg_.poses.size() >= 20000) path_msg_.poses.erase(path_msg_.poses.begin(), path_msg_.poses.begin() + 10000);
-  path_msg_.poses.push_back(pose);
-  path_msg_.header.stamp = stamp;
-  path_pub_.publish(path_msg_);
+  // The travelled path keeps a point every 5 cm and goes out at 1/10 of the visual rate: it is the
+  // largest message here and grows with the run, so it must not be re-sent at 50 Hz.
+  const bool moved = path_msg_.poses.empty() ||
+                     std::hypot(s[core::X] - path_msg_.poses.back().pose.position.x,
+                                s[core::Y] - path_msg_.poses.back().pose.position.y) >= 0.05;
+  if (moved) {
+    geometry_msgs::PoseStamped pose;
+    pose.header = odom_msg_.header;
+    pose.pose = odom_msg_.pose.pose;
+    if (path_msg_.poses.size() >= 20000)
+      path_msg_.poses.erase(path_msg_.poses.begin(), path_msg_.poses.begin() + 10000);
+    path_msg_.poses.push_back(pose);
+  }
+  if (++visual_count_ % 10 == 1) {
+    path_msg_.header.stamp = stamp;
+    path_pub_.publish(path_msg_);
+  }
 }
 
 bool PlantSim::healthy() {
@@ -159,12 +178,12 @@ bool PlantSim::healthy() {
 }
 
 void PlantSim::runLockstep() {
-  ros::CallbackQueue* queue = ros::getGlobalCallbackQueue();
-  // Wait for the loop to be wired: every odom subscriber and a torque publisher.
+  // Callbacks run on other threads (the node's AsyncSpinner or the nodelet manager): this thread only
+  // publishes, waits on the condition variable the torque callback signals, and integrates.
   ros::WallTime waited = ros::WallTime::now();
-  while (ros::ok() && (static_cast<int>(odom_pub_.getNumSubscribers()) < cfg_.min_subscribers ||
+  while (running() && (static_cast<int>(odom_pub_.getNumSubscribers()) < cfg_.min_subscribers ||
                        torque_sub_.getNumPublishers() < 1)) {
-    queue->callAvailable(ros::WallDuration(0.01));
+    ros::WallDuration(0.01).sleep();
     if ((ros::WallTime::now() - waited).toSec() > cfg_.lockstep_timeout) {
       ROS_WARN("plant_sim: lockstep waiting for the loop: %u/%d odom subscribers, %u wheel_torque publishers",
                odom_pub_.getNumSubscribers(), cfg_.min_subscribers, torque_sub_.getNumPublishers());
@@ -175,37 +194,36 @@ void PlantSim::runLockstep() {
   const std::int64_t n = cfg_.duration > 0.0 ? std::llround(cfg_.duration * 1e9 / cfg_.period_ns) : -1;
   const double dt = core::secondsFromNanos(cfg_.period_ns);
   const ros::WallTime wall_start = ros::WallTime::now();
-  for (std::int64_t k = 0; ros::ok() && (n < 0 || k <= n); ++k) {
+  const auto retry = std::chrono::duration<double>(cfg_.lockstep_retry);
+  for (std::int64_t k = 0; running() && (n < 0 || k <= n); ++k) {
     const ros::Time stamp = stampOf(k, cfg_.period_ns);
     {
       std::lock_guard<std::mutex> lock(torque_mutex_);
       waiting_for_ = stamp;
       got_torque_ = false;
     }
+    step_ = k;
     publishState(stamp, k % visual_every_ == 0 || k == n);
-    ros::WallTime sent = ros::WallTime::now(), reported = sent;
-    while (ros::ok() && !got_torque_) {
-      queue->callAvailable(ros::WallDuration(0.001));
-      const ros::WallTime now = ros::WallTime::now();
-      if (!got_torque_ && (now - sent).toSec() > cfg_.lockstep_retry) {
-        publishState(stamp, false);  // a connection that came late gets the state again
-        sent = now;
-      }
-      if (!got_torque_ && (now - reported).toSec() > cfg_.lockstep_timeout) {
-        ROS_ERROR("plant_sim: lockstep stalled at t=%.6f s: no wheel_torque stamped for it after %.1f s wall "
-                  "(%u publisher(s) on %s%s); waiting",
-                  stamp.toSec(), cfg_.lockstep_timeout, torque_sub_.getNumPublishers(),
-                  torque_sub_.getTopic().c_str(),
-                  torque_sub_.getNumPublishers() == 0 ? ": is torque_controller running?" : "");
-        reported = now;
-      }
-    }
-    if (!ros::ok() || k == n) break;
+    ros::WallTime stalled_since = ros::WallTime::now();
     core::WheelTorques u;
     {
-      std::lock_guard<std::mutex> lock(torque_mutex_);
+      std::unique_lock<std::mutex> lock(torque_mutex_);
+      while (running() && !torque_cv_.wait_for(lock, retry, [this] { return got_torque_.load(); })) {
+        lock.unlock();
+        publishState(stamp, false);  // a connection that came late gets the state again
+        if ((ros::WallTime::now() - stalled_since).toSec() > cfg_.lockstep_timeout) {
+          ROS_ERROR("plant_sim: lockstep stalled at t=%.6f s: no wheel_torque stamped for it after %.1f s wall "
+                    "(%u publisher(s) on %s%s); waiting",
+                    stamp.toSec(), cfg_.lockstep_timeout, torque_sub_.getNumPublishers(),
+                    torque_sub_.getTopic().c_str(),
+                    torque_sub_.getNumPublishers() == 0 ? ": is torque_controller running?" : "");
+          stalled_since = ros::WallTime::now();
+        }
+        lock.lock();
+      }
       u = torque_;
     }
+    if (!running() || k == n) break;
     plant_->step(u.right, u.left, dt);
     if (!healthy()) {
       ros::shutdown();
@@ -217,18 +235,15 @@ void PlantSim::runLockstep() {
            "%ld late and %ld non-finite torques ignored",
            cfg_.duration, wall, wall > 0 ? cfg_.duration / wall : 0.0, static_cast<long>(late_),
            static_cast<long>(rejected_));
-  if (cfg_.exit_at_end) return;
-  ros::spin();
 }
 
 void PlantSim::runRealtime() {
-  ros::AsyncSpinner spinner(1);
-  spinner.start();
   const double dt = core::secondsFromNanos(cfg_.period_ns);
   const ros::WallTime wall_start = ros::WallTime::now();
   std::int64_t zero_hold = 0;
-  for (std::int64_t k = 0; ros::ok(); ++k) {
+  for (std::int64_t k = 0; running(); ++k) {
     const ros::Time stamp = stampOf(k, cfg_.period_ns);
+    step_ = k;
     publishState(stamp, k % visual_every_ == 0);
     const ros::WallTime due = wall_start + ros::WallDuration((k + 1) * dt / cfg_.realtime_factor);
     const ros::WallDuration remaining = due - ros::WallTime::now();

@@ -1,6 +1,8 @@
 #include "sowing_robot/ros/reference_generator.h"
 
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include "sowing_robot/core/validation.h"
 #include "sowing_robot/ros/component_params.h"
@@ -13,24 +15,163 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
   const std::string type = p.get("type", "line");
   const double v_r = p.get("line/v_r", 1.0), row_y = p.get("line/y", 3.0), x0 = p.get("line/x0", 0.0);
   path_spacing_ = p.get("path_spacing", path_spacing_);
-  std::string error = type == "line" ? "" : "type = '" + type + "' must be 'line'";
-  if (error.empty())
+  // The field keys are read whatever the type (so a field block left in a line run is not "unknown"),
+  // but only the active type is validated.
+  std::string field_error;
+  const core::FieldParams field = loadFieldParams(p, field_error);
+  std::vector<core::Obstacle> obstacles;
+  const std::string obstacle_error = loadObstacles(p, "obstacles", obstacles);
+  std::string error = type == "line" || type == "field" ? "" : "type = '" + type + "' must be 'line' or 'field'";
+  if (error.empty() && type == "line")
     error = core::firstError({core::checkRange("line/v_r", v_r, 0.0, 10.0, "m/s"),
                               core::allFinite(row_y, x0) ? "" : "line/y and line/x0 must be finite",
                               core::checkPositive("path_spacing", path_spacing_, "m")});
+  if (error.empty() && type == "field") {
+    error = core::firstError({field_error, obstacle_error, core::checkPositive("path_spacing", path_spacing_, "m")});
+    const std::string pe = field.potential.validate();
+    if (error.empty() && !pe.empty()) error = "potential/" + pe;
+    const std::string fe = error.empty() ? field.validate() : "";
+    if (!fe.empty()) error = "field/" + fe;
+  }
   requireValid(p, error);
-  source_ = std::make_unique<core::LineReference>(v_r, row_y, x0);
-  ROS_INFO("reference_generator: line x = %.3f + %.3f t, y = %.3f", x0, v_r, row_y);
+  if (type == "line") {
+    source_ = std::make_unique<core::LineReference>(v_r, row_y, x0);
+    ROS_INFO("reference_generator: line x = %.3f + %.3f t, y = %.3f", x0, v_r, row_y);
+  } else {
+    std::unique_ptr<core::FieldReference> f;
+    try {
+      f = std::make_unique<core::FieldReference>(field, obstacles);
+    } catch (const std::invalid_argument& e) {
+      refuseToStart(e.what());
+    }
+    field_ = f.get();
+    obstacles_ = obstacles;
+    source_ = std::move(f);
+    const core::PotentialFieldParams& pf = field.potential;
+    ROS_INFO("reference_generator: field of %d row(s) of %.3f m, spacing %.3f m, first row from (%.3f, %.3f) "
+             "heading %.4f rad, next rows to the %s; row_speed %.3f m/s, turn_speed %.3f m/s, min_turn_radius %.3f m, "
+             "max_accel %.3f m/s^2, max_curvature_rate %.3f 1/m^2, start_from_rest %s; path %.3f m in %.3f s%s",
+             field.rows, field.row_length, field.row_spacing, field.start_x, field.start_y, field.heading,
+             field.rows_to_left ? "left" : "right", field.row_speed, field.turn_speed, field.min_turn_radius,
+             field.max_accel, field.max_curvature_rate, field.start_from_rest ? "true" : "false",
+             field_->path().length(), field_->duration(),
+             field.rows > 1 ? (field_->path().turn().isBulb() ? ", bulb turns" : ", rounded turns") : "");
+    ROS_INFO("reference_generator: potential alpha %.3f 1/s^2, beta %.3f 1/s, influence_distance %.3f m, gain %.3f "
+             "m^2/s^2, tangential_ratio %.3f, nearest_side %s, avoid_side %s, side_band %.3f m, core_fraction %.3f, "
+             "step %.6f s, heading_hold_speed %.3f m/s",
+             pf.alpha, pf.beta, pf.influence_distance, pf.gain, pf.tangential_ratio, pf.nearest_side ? "true" : "false",
+             pf.avoid_side == core::AvoidSide::kLeft ? "left" : "right", pf.side_band, pf.core_fraction, pf.step,
+             pf.heading_hold_speed);
+    for (std::size_t i = 0; i < obstacles_.size(); ++i)
+      ROS_INFO("reference_generator: obstacle %zu at (%.3f, %.3f), radius %.3f m", i, obstacles_[i].x, obstacles_[i].y,
+               obstacles_[i].radius);
+  }
   ref_pub_ = nh.advertise<ReferenceState>("reference", kLockstepQueue);
   path_pub_ = nh.advertise<nav_msgs::Path>("reference_path", 1, true);
   path_.header.frame_id = "odom";
+  if (field_) {
+    marker_pub_ = nh.advertise<visualization_msgs::MarkerArray>("field_markers", 1, true);
+    publishMarkers();
+    obstacles_sub_ = nh.subscribe("obstacles", 10, &ReferenceGenerator::obstaclesCallback, this);
+  }
   odom_sub_ = nh.subscribe("odom", 50, &ReferenceGenerator::odomCallback, this, ros::TransportHints().tcpNoDelay());
+}
+
+void ReferenceGenerator::obstaclesCallback(const visualization_msgs::MarkerArray::ConstPtr& msg) {
+  using visualization_msgs::Marker;
+  std::vector<core::Obstacle> obstacles;
+  for (const Marker& m : msg->markers) {
+    if (m.type != Marker::CYLINDER || m.action != Marker::ADD) continue;
+    if (!m.header.frame_id.empty() && m.header.frame_id != "odom") {
+      ROS_WARN_THROTTLE(1.0, "reference_generator: dropping obstacles message: marker %s/%d is in frame '%s', not odom",
+                        m.ns.c_str(), m.id, m.header.frame_id.c_str());
+      return;
+    }
+    core::Obstacle o;
+    o.x = m.pose.position.x;
+    o.y = m.pose.position.y;
+    o.radius = 0.5 * m.scale.x;
+    const std::string e = o.validate();
+    if (!e.empty()) {
+      ROS_WARN_THROTTLE(1.0, "reference_generator: dropping obstacles message: marker %s/%d: %s", m.ns.c_str(), m.id,
+                        e.c_str());
+      return;
+    }
+    obstacles.push_back(o);
+  }
+  try {
+    field_->setObstacles(obstacles);
+  } catch (const std::invalid_argument& e) {
+    ROS_WARN_THROTTLE(1.0, "reference_generator: dropping obstacles message: %s", e.what());
+    return;
+  }
+  obstacles_ = std::move(obstacles);
+  ROS_INFO("reference_generator: %zu obstacle(s) in force now", obstacles_.size());
+  publishMarkers();
+}
+
+void ReferenceGenerator::publishMarkers() {
+  using visualization_msgs::Marker;
+  visualization_msgs::MarkerArray out;
+  Marker clear;
+  clear.header.frame_id = "odom";
+  clear.action = Marker::DELETEALL;
+  out.markers.push_back(clear);
+  auto marker = [](const std::string& ns, int id, int type, float r, float g, float b, float a) {
+    Marker m;
+    m.header.frame_id = "odom";  // stamp 0: rviz uses the latest transform
+    m.ns = ns;
+    m.id = id;
+    m.type = type;
+    m.action = Marker::ADD;
+    m.pose.orientation.w = 1.0;
+    m.color.r = r;
+    m.color.g = g;
+    m.color.b = b;
+    m.color.a = a;
+    return m;
+  };
+  const double d = field_->potentialField().params().influence_distance;
+  for (std::size_t i = 0; i < obstacles_.size(); ++i) {
+    const core::Obstacle& o = obstacles_[i];
+    Marker body = marker("obstacles", static_cast<int>(i), Marker::CYLINDER, 0.55f, 0.35f, 0.17f, 1.0f);
+    body.pose.position.x = o.x;
+    body.pose.position.y = o.y;
+    body.pose.position.z = 0.25;
+    body.scale.x = body.scale.y = 2.0 * o.radius;
+    body.scale.z = 0.5;
+    out.markers.push_back(body);
+    Marker zone = marker("influence_zones", static_cast<int>(i), Marker::CYLINDER, 1.0f, 0.6f, 0.0f, 0.25f);
+    zone.pose.position.x = o.x;
+    zone.pose.position.y = o.y;
+    zone.pose.position.z = 0.01;
+    zone.scale.x = zone.scale.y = 2.0 * (o.radius + d);
+    zone.scale.z = 0.02;
+    out.markers.push_back(zone);
+  }
+  const core::FieldParams& fp = field_->params();
+  Marker rows = marker("rows", 0, Marker::LINE_LIST, 0.1f, 0.8f, 0.1f, 1.0f);
+  rows.scale.x = 0.03;
+  for (int i = 0; i < fp.rows; ++i) {
+    const Eigen::Vector2d a = field_->path().rowStart(i);
+    const double h = fp.heading + (i % 2 == 1 ? M_PI : 0.0);
+    const Eigen::Vector2d b = a + fp.row_length * Eigen::Vector2d(std::cos(h), std::sin(h));
+    geometry_msgs::Point pa, pb;
+    pa.x = a.x();
+    pa.y = a.y();
+    pb.x = b.x();
+    pb.y = b.y();
+    rows.points.push_back(pa);
+    rows.points.push_back(pb);
+  }
+  out.markers.push_back(rows);
+  marker_pub_.publish(out);
 }
 
 void ReferenceGenerator::odomCallback(const nav_msgs::Odometry::ConstPtr& msg) {
   const ros::Time& stamp = msg->header.stamp;
   if (any_ && stamp <= ref_.header.stamp) {  // a repeat (or an old state): answer with what we said
-    if (stamp == ref_.header.stamp) ref_pub_.publish(ref_);
+    if (stamp == ref_.header.stamp) publishShared(ref_pub_, ref_);
     return;
   }
   const core::Reference r = source_->next(stamp.toSec());
@@ -44,7 +185,7 @@ void ReferenceGenerator::odomCallback(const nav_msgs::Odometry::ConstPtr& msg) {
   ref_.v_dot = r.v_dot;
   ref_.omega_dot = r.omega_dot;
   ref_.tool_down = r.tool_down;
-  ref_pub_.publish(ref_);
+  publishShared(ref_pub_, ref_);
   any_ = true;
 
   const bool far = path_.poses.empty() || std::hypot(r.pose.x - path_.poses.back().pose.position.x,

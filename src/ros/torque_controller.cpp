@@ -1,6 +1,7 @@
 #include "sowing_robot/ros/torque_controller.h"
 
 #include "sowing_robot/ros/component_params.h"
+#include "sowing_robot/core/validation.h"
 #include "sowing_robot/ros/msg_checks.h"
 
 namespace sowing_robot {
@@ -12,7 +13,9 @@ TorqueController::TorqueController(ros::NodeHandle nh, ros::NodeHandle pnh) {
   std::string error = loadRobotParams(pnh, robot);
   const std::int64_t period = loadControlPeriod(p, error);
   const core::SlidingModeParams params = loadSlidingMode(p, error);
-  requireValid(p, error.empty() ? params.validate() : error);
+  input_timeout_ = p.get("input_timeout", input_timeout_);
+  if (error.empty()) error = core::firstError({params.validate(), core::checkPositive("input_timeout", input_timeout_, "s")});
+  requireValid(p, error);
   dt_ = core::secondsFromNanos(period);
   smc_ = std::make_unique<core::SlidingModeController>(params, robot);
   ROS_INFO("torque_controller: %s, p/q %d/%d, beta %.4g/%.4g, K %.4g/%.4g, eta %.4g/%.4g, rates %.4g/%.4g, "
@@ -23,6 +26,8 @@ TorqueController::TorqueController(ros::NodeHandle nh, ros::NodeHandle pnh) {
            smc_->m0Hat(), params.i0_min, params.i0_max, smc_->i0Hat(),
            core::SwitchFunction::name(params.switching.type), params.switching.width, params.max_torque, 1.0 / dt_);
   state_.mode = params.adaptive ? "atsmc" : "tsmc";
+  reconfigure_ = std::make_unique<dynamic_reconfigure::Server<TorqueControllerConfig>>(pnh);
+  reconfigure_->setCallback([this](TorqueControllerConfig& c, uint32_t level) { reconfigure(c, level); });
   torque_pub_ = nh.advertise<WheelTorque>("wheel_torque", kLockstepQueue);
   state_pub_ = pnh.advertise<TorqueControllerState>("state", kLockstepQueue);
   const auto hints = ros::TransportHints().tcpNoDelay();
@@ -30,12 +35,73 @@ TorqueController::TorqueController(ros::NodeHandle nh, ros::NodeHandle pnh) {
   desired_sub_ = nh.subscribe("desired_velocity", 50, &TorqueController::desiredCallback, this, hints);
 }
 
+void TorqueController::reconfigure(TorqueControllerConfig& config, uint32_t) {
+  const core::SlidingModeParams& old = smc_->params();
+  core::SlidingModeParams p = old;
+  p.beta_v = config.beta_v;
+  p.beta_omega = config.beta_omega;
+  p.k1 = config.k1;
+  p.k2 = config.k2;
+  p.eta1 = config.eta1;
+  p.eta2 = config.eta2;
+  p.rate_m = config.rate_m;
+  p.rate_i = config.rate_i;
+  p.max_torque = config.max_torque;
+  p.switching.width = config.switch_width;
+  std::string error;
+  if (!core::SwitchFunction::parse(config.switching, p.switching.type))
+    error = "switching = '" + config.switching + "' must be one of sign, sat, relay, atan, tanh";
+  if (error.empty()) error = p.validate();
+  if (!error.empty()) {
+    ROS_WARN("torque_controller: rejected gain change: %s; keeping the previous gains", error.c_str());
+    config.beta_v = old.beta_v;  // the server then reports (and stores) the values really in force
+    config.beta_omega = old.beta_omega;
+    config.k1 = old.k1;
+    config.k2 = old.k2;
+    config.eta1 = old.eta1;
+    config.eta2 = old.eta2;
+    config.rate_m = old.rate_m;
+    config.rate_i = old.rate_i;
+    config.max_torque = old.max_torque;
+    config.switching = core::SwitchFunction::name(old.switching.type);
+    config.switch_width = old.switching.width;
+    return;
+  }
+  const bool changed = p.beta_v != old.beta_v || p.beta_omega != old.beta_omega || p.k1 != old.k1 ||
+                       p.k2 != old.k2 || p.eta1 != old.eta1 || p.eta2 != old.eta2 || p.rate_m != old.rate_m ||
+                       p.rate_i != old.rate_i || p.max_torque != old.max_torque ||
+                       p.switching.type != old.switching.type || p.switching.width != old.switching.width;
+  if (!changed) return;  // the server's first call repeats the start-up values
+  smc_->setParams(p);
+  ROS_INFO("torque_controller: gains now beta %g/%g, K %g/%g, eta %g/%g, rates %g/%g, max torque %g, %s (%g)",
+           p.beta_v, p.beta_omega, p.k1, p.k2, p.eta1, p.eta2, p.rate_m, p.rate_i, p.max_torque,
+           core::SwitchFunction::name(p.switching.type), p.switching.width);
+}
+
 void TorqueController::odomCallback(const nav_msgs::Odometry::ConstPtr& msg) {
   if (!odomIsFinite(*msg)) {
     ROS_WARN_THROTTLE(1.0, "torque_controller: rejected non-finite odom (%ld so far)", ++rejected_);
     return;
   }
-  if (inputs_.setFirst(*msg)) compute();
+  if (inputs_.setFirst(*msg)) {
+    compute();
+  } else {
+    holdZeroIfStale(*msg);
+  }
+}
+
+bool TorqueController::holdZeroIfStale(const nav_msgs::Odometry& odom) {
+  const bool have = inputs_.any();
+  const double age = have ? (odom.header.stamp - inputs_.lastStamp()).toSec() : odom.header.stamp.toSec();
+  if (age <= input_timeout_) return false;
+  // The kinematic controller is silent (dead or restarting): command zero torque, the robot coasts.
+  ROS_WARN_THROTTLE(1.0, "torque_controller: no desired_velocity for %.3f s (input_timeout %.3f s): zero torque",
+                    age, input_timeout_);
+  stale_ = true;
+  torque_.header.stamp = odom.header.stamp;
+  torque_.right = torque_.left = 0.0;
+  publishShared(torque_pub_, torque_);
+  return true;
 }
 
 void TorqueController::desiredCallback(const DesiredVelocity::ConstPtr& msg) {
@@ -44,7 +110,7 @@ void TorqueController::desiredCallback(const DesiredVelocity::ConstPtr& msg) {
     return;
   }
   if (inputs_.isRepeat(msg->header.stamp)) {  // the same period again: never integrate twice
-    torque_pub_.publish(torque_);
+    publishShared(torque_pub_, torque_);
     return;
   }
   if (inputs_.setSecond(*msg)) compute();
@@ -54,12 +120,17 @@ void TorqueController::compute() {
   const nav_msgs::Odometry& odom = inputs_.first();
   const DesiredVelocity& d = inputs_.second();
   const core::VelocityCommand cmd{d.v, d.omega, d.v_dot, d.omega_dot};
+  if (stale_) {  // input is back after a gap: restart the sliding integrals, keep the estimates
+    smc_->resetSurfaces();
+    stale_ = false;
+    ROS_INFO("torque_controller: desired_velocity is back at t = %.3f s: resuming", odom.header.stamp.toSec());
+  }
   const core::SlidingModeOutput out =
       smc_->update(cmd, odom.twist.twist.linear.x, odom.twist.twist.angular.z, dt_);
   torque_.header.stamp = odom.header.stamp;
   torque_.right = out.torques.right;
   torque_.left = out.torques.left;
-  torque_pub_.publish(torque_);
+  publishShared(torque_pub_, torque_);
   if (out.saturated)
     ROS_WARN_THROTTLE(2.0, "torque_controller: wheel torque saturated at %.4g N m (%ld periods so far)",
                       smc_->params().max_torque, ++saturated_);
@@ -74,7 +145,7 @@ void TorqueController::compute() {
   state_.u1 = out.u1;
   state_.u2 = out.u2;
   state_.saturated = out.saturated;
-  state_pub_.publish(state_);
+  publishShared(state_pub_, state_);
 }
 
 }  // namespace sowing_robot

@@ -46,6 +46,8 @@ class SlidingModeController {
 
   /// Zero the integrals and return the estimates to their initial values.
   void reset();
+  /// Zero only the sliding-surface integrals (estimates kept): a clean restart after an input gap.
+  void resetSurfaces() { linear_ = angular_ = Channel{}; }
 
   /// One control period of length dt [s]. Non-finite inputs must be rejected by the caller.
   SlidingModeOutput update(const VelocityCommand& desired, double v, double omega, double dt);

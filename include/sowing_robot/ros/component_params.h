@@ -5,7 +5,9 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
+#include "sowing_robot/core/field.h"
 #include "sowing_robot/core/kanayama.h"
 #include "sowing_robot/core/plant.h"
 #include "sowing_robot/core/robot_params.h"
@@ -33,6 +35,18 @@ core::SlidingModeParams loadSlidingMode(ParamReader& p, std::string& error);
 
 /// start/{x, y, theta}.
 core::Pose2D loadStartPose(ParamReader& p);
+
+/// potential/{alpha, beta, influence_distance, gain, tangential_ratio, nearest_side, avoid_side (left|right),
+/// side_band, core_fraction, step, heading_hold_speed}.
+core::PotentialFieldParams loadPotentialField(ParamReader& p, std::string& error);
+
+/// field/{rows, row_length, row_spacing, start_x, start_y, heading, rows_to_left, row_speed, turn_speed,
+/// min_turn_radius, max_accel, max_curvature_rate, start_from_rest} plus potential/ (loadPotentialField).
+core::FieldParams loadFieldParams(ParamReader& p, std::string& error);
+
+/// The list `key` of {x, y, radius} maps (radius optional, default core::Obstacle's); marks `key` as read.
+/// Returns "" or one line naming the bad entry (absent key: empty list).
+std::string loadObstacles(ParamReader& p, const std::string& key, std::vector<core::Obstacle>& out);
 
 /// Everything one node needs checked: reader errors, unknown keys, then the given validate() text.
 /// Refuses to start (exit 1) on the first problem.

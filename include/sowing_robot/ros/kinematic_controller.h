@@ -3,9 +3,13 @@
 #pragma once
 
 #include <nav_msgs/Odometry.h>
+#include <dynamic_reconfigure/server.h>
 #include <ros/ros.h>
 
+#include <memory>
+
 #include "sowing_robot/DesiredVelocity.h"
+#include "sowing_robot/KinematicControllerConfig.h"
 #include "sowing_robot/ReferenceState.h"
 #include "sowing_robot/TrackingError.h"
 #include "sowing_robot/core/kanayama.h"
@@ -21,6 +25,10 @@ class KinematicController {
   void odomCallback(const nav_msgs::Odometry::ConstPtr& msg);
   void referenceCallback(const ReferenceState::ConstPtr& msg);
   void compute();
+  /// Live gain change: validated like the start-up values; a rejected change keeps the old gains.
+  void reconfigure(KinematicControllerConfig& config, uint32_t level);
+  /// Command a stop for this odom stamp when the reference is older than input_timeout.
+  void stopIfStale(const nav_msgs::Odometry& odom);
 
   core::Kanayama kanayama_;
   ros::Subscriber odom_sub_, ref_sub_;
@@ -29,6 +37,8 @@ class KinematicController {
   DesiredVelocity desired_;
   TrackingError error_;
   long rejected_ = 0;
+  double input_timeout_ = 0.1;  // [s] sim
+  std::unique_ptr<dynamic_reconfigure::Server<KinematicControllerConfig>> reconfigure_;
 };
 
 }  // namespace sowing_robot

@@ -30,3 +30,15 @@ namespace sowing_robot {
 /// wait for it) must not lose messages, so the queue holds several seconds of a 1 kHz run.
 constexpr std::uint32_t kLockstepQueue = 20000;
 }  // namespace sowing_robot
+
+#include <boost/make_shared.hpp>
+#include <ros/publisher.h>
+
+namespace sowing_robot {
+/// Publish a copy as a shared pointer: inside a nodelet manager subscribers get the pointer itself
+/// (no serialisation); to other processes it is serialised as usual.
+template <typename M>
+void publishShared(const ros::Publisher& pub, const M& msg) {
+  pub.publish(boost::make_shared<M>(msg));
+}
+}  // namespace sowing_robot

@@ -13,6 +13,7 @@
 #include <tf2_ros/transform_broadcaster.h>
 
 #include <atomic>
+#include <condition_variable>
 #include <memory>
 #include <mutex>
 
@@ -26,8 +27,16 @@ class PlantSim {
  public:
   /// Loads and validates all parameters; refuses to start (exit 1) on a bad one.
   PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh);
-  /// Runs the simulation until shutdown (or the end of a lockstep scenario, then keeps serving).
+  /// Runs the simulation on the calling thread until shutdown, stop(), or the end of a lockstep
+  /// scenario. Callbacks must be served by other threads (an AsyncSpinner, or the nodelet manager).
   void run();
+  /// Ask run() to return (nodelet unload).
+  void stop() {
+    stop_ = true;
+    torque_cv_.notify_all();
+  }
+  /// exit_at_end: the process should end when run() returns after a lockstep scenario.
+  bool exitAtEnd() const { return cfg_.lockstep && cfg_.exit_at_end; }
 
  private:
   struct Config {
@@ -37,6 +46,7 @@ class PlantSim {
     double realtime_factor = 1.0;    // sim seconds per wall second in realtime mode
     double torque_timeout = 0.1;     // [s] sim, realtime mode: older torques are replaced by zero
     double publish_rate = 50.0;      // [Hz] sim, tf / joint_states / path
+    double clock_rate = 0.0;         // [Hz] sim, /clock; 0 = every step
     double lockstep_retry = 0.5;     // [s] wall: republish the state if no torque came
     double lockstep_timeout = 5.0;   // [s] wall: report the missing input
     int min_subscribers = 3;         // odom subscribers to wait for before step 0 (lockstep)
@@ -48,6 +58,7 @@ class PlantSim {
   void torqueCallback(const WheelTorque::ConstPtr& msg);
   void publishState(const ros::Time& stamp, bool visuals);
   bool healthy();
+  bool running() const { return ros::ok() && !stop_; }
   void runLockstep();
   void runRealtime();
 
@@ -63,6 +74,9 @@ class PlantSim {
   sensor_msgs::JointState joint_msg_;
   nav_msgs::Path path_msg_;
   std::int64_t visual_every_ = 20;  // publish visuals every n steps
+  std::int64_t clock_every_ = 1;    // publish /clock every n steps
+  std::int64_t step_ = 0;           // index of the state being published
+  std::int64_t visual_count_ = 0;   // visual publications so far
 
   std::mutex torque_mutex_;
   core::WheelTorques torque_;       // last accepted torque
@@ -70,6 +84,8 @@ class PlantSim {
   bool torque_valid_ = false;
   ros::Time waiting_for_;           // lockstep: the stamp we need a torque for
   std::atomic<bool> got_torque_{false};
+  std::condition_variable torque_cv_;
+  std::atomic<bool> stop_{false};
   std::int64_t rejected_ = 0, late_ = 0;
 };
 

@@ -1,14 +1,21 @@
 // reference_generator: publishes the reference posture, velocities and accelerations for every state
 // the plant publishes (same stamp), plus the reference path for rviz.
+//   type line:  core::LineReference (the thesis's sowing line).
+//   type field: core::FieldReference (rows + headland turns through the potential field) with the
+//               obstacles from the `obstacles` parameter; `obstacles` (MarkerArray) replaces them at
+//               run time, and `field_markers` (latched) shows obstacles, influence zones and rows.
 #pragma once
 
 #include <nav_msgs/Odometry.h>
 #include <nav_msgs/Path.h>
 #include <ros/ros.h>
+#include <visualization_msgs/MarkerArray.h>
 
 #include <memory>
+#include <vector>
 
 #include "sowing_robot/ReferenceState.h"
+#include "sowing_robot/core/field.h"
 #include "sowing_robot/core/reference.h"
 
 namespace sowing_robot {
@@ -19,10 +26,17 @@ class ReferenceGenerator {
 
  private:
   void odomCallback(const nav_msgs::Odometry::ConstPtr& msg);
+  /// type field: every ADD CYLINDER marker is an obstacle (centre = pose.position, radius = scale.x / 2);
+  /// the message replaces the whole list. A message with a non-finite or non-positive value is dropped.
+  void obstaclesCallback(const visualization_msgs::MarkerArray::ConstPtr& msg);
+  /// type field: obstacles, influence zones and row lines on field_markers.
+  void publishMarkers();
 
   std::unique_ptr<core::ReferenceSource> source_;
-  ros::Subscriber odom_sub_;
-  ros::Publisher ref_pub_, path_pub_;
+  core::FieldReference* field_ = nullptr;  ///< source_ when type is field, else null
+  std::vector<core::Obstacle> obstacles_;  ///< the obstacles in force (type field)
+  ros::Subscriber odom_sub_, obstacles_sub_;
+  ros::Publisher ref_pub_, path_pub_, marker_pub_;
   ReferenceState ref_;
   nav_msgs::Path path_;
   bool any_ = false;

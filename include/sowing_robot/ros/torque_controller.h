@@ -3,11 +3,13 @@
 #pragma once
 
 #include <nav_msgs/Odometry.h>
+#include <dynamic_reconfigure/server.h>
 #include <ros/ros.h>
 
 #include <memory>
 
 #include "sowing_robot/DesiredVelocity.h"
+#include "sowing_robot/TorqueControllerConfig.h"
 #include "sowing_robot/TorqueControllerState.h"
 #include "sowing_robot/WheelTorque.h"
 #include "sowing_robot/core/sliding_mode.h"
@@ -23,9 +25,16 @@ class TorqueController {
   void odomCallback(const nav_msgs::Odometry::ConstPtr& msg);
   void desiredCallback(const DesiredVelocity::ConstPtr& msg);
   void compute();
+  /// Live gain change: validated like the start-up values; a rejected change keeps the old gains.
+  void reconfigure(TorqueControllerConfig& config, uint32_t level);
+  /// Zero torque for this odom stamp when the desired velocity is older than input_timeout.
+  bool holdZeroIfStale(const nav_msgs::Odometry& odom);
 
   std::unique_ptr<core::SlidingModeController> smc_;
   double dt_ = 0.001;
+  double input_timeout_ = 0.1;  // [s] sim
+  bool stale_ = false;          // the last output was the zero hold
+  std::unique_ptr<dynamic_reconfigure::Server<TorqueControllerConfig>> reconfigure_;
   ros::Subscriber odom_sub_, desired_sub_;
   ros::Publisher torque_pub_, state_pub_;
   StampPair<nav_msgs::Odometry, DesiredVelocity> inputs_;

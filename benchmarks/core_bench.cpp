@@ -1,0 +1,119 @@
+// core_bench: Google Benchmark figures of the ROS-free core (issue 8). Figures only, never a pass/fail.
+//   core_bench [--benchmark_min_time=0.2] [--benchmark_filter=Thesis] ...
+// BM_PlantRk4Step            one Plant::step (RK4, sinusoidal disturbance on)
+// BM_ControlStep             one period of runClosedLoop's loop: reference next + Kanayama + SMC + plant
+// BM_ThesisRun25s            runClosedLoop of the 25 s thesis scenario at 1 kHz (keep_samples = false);
+//                            items/s = control steps/s
+// BM_ThesisRunPotentialField same with the potential-field reference (obstacles (20,3), (50,3), (80,3))
+// BM_PsoIteration/threads:N  one PSO iteration: 20 particles evaluated on the thesis scenario (ITAE,
+//                            default gain box), N evaluation threads; wall time (UseRealTime)
+#include <benchmark/benchmark.h>
+
+#include <vector>
+
+#include "sowing_robot/core/plant.h"
+#include "sowing_robot/core/pso.h"
+#include "sowing_robot/core/runner.h"
+#include "sowing_robot/core/tuning.h"
+#include "thesis_scenario.h"
+
+using namespace sowing_robot;
+using namespace sowing_robot::core;
+
+namespace {
+
+volatile double g_sink = 0.0;  // keeps results alive (see thesisRun)
+
+void BM_PlantRk4Step(benchmark::State& state) {
+  const Scenario sc = bench::thesisScenario();
+  Plant plant(sc.robot, sc.disturbance);
+  State x0 = State::Zero();
+  x0[X] = -1.0;
+  x0[V] = 1.0;
+  plant.reset(x0, 0.0);
+  const double dt = 1e-3;
+  std::int64_t k = 0;
+  for (auto _ : state) {
+    // Small torques that keep the state bounded over any number of steps.
+    plant.step(0.5 * ((k & 1) ? 1.0 : -1.0), 0.3, dt);
+    if (++k == 25000) {
+      plant.reset(x0, 0.0);
+      k = 0;
+    }
+    benchmark::DoNotOptimize(plant.state().data());
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_PlantRk4Step);
+
+void BM_ControlStep(benchmark::State& state) {
+  const Scenario sc = bench::thesisScenario();
+  LineReference ref = bench::thesisLine();
+  bench::ControlLoop loop(sc, ref);
+  for (auto _ : state) {
+    loop.step();
+    benchmark::DoNotOptimize(loop.plant().state().data());
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_ControlStep);
+
+void thesisRun(benchmark::State& state, ReferenceSource& ref) {
+  const Scenario sc = bench::thesisScenario();
+  // A volatile sink, not DoNotOptimize(double&): libbenchmark 1.7's "+m,r" constraint can corrupt a
+  // double under GCC -O3 (fixed upstream in 1.8).
+  volatile double itae = 0.0;
+  for (auto _ : state) {
+    const RunResult r = runClosedLoop(sc, ref, false);
+    itae = r.metrics[AXIS_Y].itae;
+  }
+  // States are evaluated at k = 0..steps(); steps() plant steps per run.
+  state.SetItemsProcessed(state.iterations() * sc.steps());
+  state.counters["itae_y"] = benchmark::Counter(itae, benchmark::Counter::kDefaults);
+}
+
+void BM_ThesisRun25s(benchmark::State& state) {
+  LineReference ref = bench::thesisLine();
+  thesisRun(state, ref);
+}
+BENCHMARK(BM_ThesisRun25s)->Unit(benchmark::kMillisecond);
+
+void BM_ThesisRunPotentialField(benchmark::State& state) {
+  PotentialField ref = bench::thesisPotentialField();
+  thesisRun(state, ref);
+}
+BENCHMARK(BM_ThesisRunPotentialField)->Unit(benchmark::kMillisecond);
+
+void BM_PsoIteration(benchmark::State& state) {
+  const int threads = static_cast<int>(state.range(0));
+  const Scenario sc = bench::thesisScenario();
+  const LineReference ref = bench::thesisLine();
+  const std::vector<GainBounds> bounds = defaultGainBounds();
+  const TuningProblem problem(sc, ref, bounds, TuningObjective{}, threads);
+  PsoParams pso;  // 20 particles, config/pso.yaml's velocity clamp
+  pso.max_velocity_fraction = 0.2;
+  pso.iterations = 0;  // the initial evaluation only: one iteration's worth of 20 runs
+  pso.threads = threads;
+  for (const auto& b : bounds) {
+    pso.lower.push_back(b.lower);
+    pso.upper.push_back(b.upper);
+  }
+  std::uint64_t seed = 1;
+  long evaluations = 0;
+  for (auto _ : state) {
+    pso.seed = seed++;  // a fresh swarm each time, so no run is special
+    const PsoResult r = psoMinimize(
+        pso, [&problem](const std::vector<double>& x, int t) { return problem.evaluate(x, t).total; });
+    evaluations += r.evaluations;
+    g_sink = r.best_cost;
+  }
+  state.SetItemsProcessed(evaluations * sc.steps());
+  state.counters["evaluations/s"] = benchmark::Counter(static_cast<double>(evaluations), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_PsoIteration)->ArgName("threads")->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+}  // namespace
+
+BENCHMARK_MAIN();

@@ -1,0 +1,91 @@
+// The thesis scenario shared by core_bench and alloc_check (same as pso_tuning_bench): 25 s at 1 kHz,
+// start (-1, 0, 0), line x = t, y = 3 at 1 m/s, sinusoidal wheel disturbance (A 2.75 N·m, w 3 rad/s),
+// plant 20 % heavier than the controllers' model; optionally the potential field with the thesis's
+// three obstacles (20, 3), (50, 3), (80, 3), radius 0.3 m (config/field_thesis.yaml).
+#pragma once
+
+#include <vector>
+
+#include "sowing_robot/core/potential_field.h"
+#include "sowing_robot/core/reference.h"
+#include "sowing_robot/core/runner.h"
+
+namespace sowing_robot {
+namespace bench {
+
+inline core::Scenario thesisScenario() {
+  core::Scenario sc;
+  sc.disturbance.sinusoidal = true;
+  sc.disturbance.mass_scale = sc.disturbance.inertia_scale = 1.2;
+  return sc;
+}
+
+inline core::LineReference thesisLine() { return core::LineReference(1.0, 3.0, 0.0); }
+
+inline core::PotentialField thesisPotentialField() {
+  core::RowLine row;  // x0 = 0, y0 = 3, heading 0, speed 1 m/s
+  return core::PotentialField(core::PotentialFieldParams{}, row,
+                              std::vector<core::Obstacle>{{20.0, 3.0, 0.3}, {50.0, 3.0, 0.3}, {80.0, 3.0, 0.3}});
+}
+
+/// The body of runClosedLoop's loop, with its state carried from one call to the next (restarts after
+/// the scenario's last step so the trajectory stays the thesis one however many steps are run).
+class ControlLoop {
+ public:
+  ControlLoop(const core::Scenario& sc, core::ReferenceSource& reference)
+      : sc_(sc),
+        reference_(reference),
+        plant_(sc.robot, sc.disturbance),
+        kanayama_(sc.kanayama),
+        smc_(sc.sliding, sc.robot),
+        metrics_(false),
+        n_(sc.steps()),
+        dt_(core::secondsFromNanos(sc.control_period_ns)) {
+    restart();
+  }
+
+  void restart() {
+    core::State x0 = core::State::Zero();
+    x0[core::X] = sc_.start.x;
+    x0[core::Y] = sc_.start.y;
+    x0[core::THETA] = sc_.start.theta;
+    plant_.reset(x0, 0.0);
+    smc_.reset();
+    reference_.reset();
+    metrics_.reset();
+    k_ = 0;
+  }
+
+  /// One control period: reference, Kanayama, sliding-mode controller, plant step (as runClosedLoop).
+  void step() {
+    if (k_ >= n_) restart();
+    const double t = core::secondsFromNanos(k_ * sc_.control_period_ns);
+    const core::State& s = plant_.state();
+    const core::Pose2D pose{s[core::X], s[core::Y], core::yawThroughQuaternion(s[core::THETA])};
+    const core::Reference ref = reference_.next(t);
+    double ex, ey, eth;
+    core::worldErrors(ref, pose, ex, ey, eth);
+    metrics_.add(t, ex, ey, eth);
+    const core::VelocityCommand cmd = kanayama_.compute(ref, pose, s[core::V], s[core::OMEGA]);
+    const core::SlidingModeOutput u = smc_.update(cmd, s[core::V], s[core::OMEGA], dt_);
+    saturated_ += u.saturated ? 1 : 0;
+    plant_.step(u.torques.right, u.torques.left, dt_);
+    ++k_;
+  }
+
+  const core::Plant& plant() const { return plant_; }
+  std::int64_t saturated() const { return saturated_; }
+
+ private:
+  core::Scenario sc_;
+  core::ReferenceSource& reference_;
+  core::Plant plant_;
+  core::Kanayama kanayama_;
+  core::SlidingModeController smc_;
+  core::MetricsAccumulator metrics_;
+  std::int64_t n_, k_ = 0, saturated_ = 0;
+  double dt_;
+};
+
+}  // namespace bench
+}  // namespace sowing_robot

@@ -1,0 +1,56 @@
+// Every node as a nodelet: the same wrapper class, constructed in onInit() with the nodelet's handles,
+// so a manager can pass the lockstep messages as shared pointers without serialisation.
+#include <nodelet/nodelet.h>
+#include <pluginlib/class_list_macros.hpp>
+
+#include <memory>
+#include <thread>
+
+#include "sowing_robot/ros/kinematic_controller.h"
+#include "sowing_robot/ros/plant_sim.h"
+#include "sowing_robot/ros/reference_generator.h"
+#include "sowing_robot/ros/run_monitor.h"
+#include "sowing_robot/ros/torque_controller.h"
+
+namespace sowing_robot {
+
+/// Callback-driven nodes: the wrapper lives as long as the nodelet.
+template <typename Wrapper>
+class WrapperNodelet : public nodelet::Nodelet {
+ private:
+  void onInit() override { impl_ = std::make_unique<Wrapper>(getNodeHandle(), getPrivateNodeHandle()); }
+  std::unique_ptr<Wrapper> impl_;
+};
+
+using KinematicControllerNodelet = WrapperNodelet<KinematicController>;
+using TorqueControllerNodelet = WrapperNodelet<TorqueController>;
+using ReferenceGeneratorNodelet = WrapperNodelet<ReferenceGenerator>;
+using RunMonitorNodelet = WrapperNodelet<RunMonitor>;
+
+/// The plant runs its simulation loop on a thread of its own; the manager serves its callbacks.
+class PlantSimNodelet : public nodelet::Nodelet {
+ public:
+  ~PlantSimNodelet() override {
+    if (impl_) impl_->stop();
+    if (thread_.joinable()) thread_.join();
+  }
+
+ private:
+  void onInit() override {
+    impl_ = std::make_unique<PlantSim>(getNodeHandle(), getPrivateNodeHandle());
+    thread_ = std::thread([this] {
+      impl_->run();
+      if (impl_->exitAtEnd()) ros::shutdown();
+    });
+  }
+  std::unique_ptr<PlantSim> impl_;
+  std::thread thread_;
+};
+
+}  // namespace sowing_robot
+
+PLUGINLIB_EXPORT_CLASS(sowing_robot::PlantSimNodelet, nodelet::Nodelet)
+PLUGINLIB_EXPORT_CLASS(sowing_robot::KinematicControllerNodelet, nodelet::Nodelet)
+PLUGINLIB_EXPORT_CLASS(sowing_robot::TorqueControllerNodelet, nodelet::Nodelet)
+PLUGINLIB_EXPORT_CLASS(sowing_robot::ReferenceGeneratorNodelet, nodelet::Nodelet)
+PLUGINLIB_EXPORT_CLASS(sowing_robot::RunMonitorNodelet, nodelet::Nodelet)
