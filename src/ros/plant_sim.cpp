@@ -240,14 +240,22 @@ void PlantSim::runLockstep() {
 void PlantSim::runRealtime() {
   const double dt = core::secondsFromNanos(cfg_.period_ns);
   const ros::WallTime wall_start = ros::WallTime::now();
-  std::int64_t zero_hold = 0;
+  std::int64_t zero_hold = 0, slipped = 0;
   for (std::int64_t k = 0; running(); ++k) {
     const ros::Time stamp = stampOf(k, cfg_.period_ns);
     step_ = k;
     publishState(stamp, k % visual_every_ == 0);
-    const ros::WallTime due = wall_start + ros::WallDuration((k + 1) * dt / cfg_.realtime_factor);
+    const ros::WallTime due = wall_start + ros::WallDuration((k + 1 - slipped) * dt / cfg_.realtime_factor);
     const ros::WallDuration remaining = due - ros::WallTime::now();
-    if (remaining > ros::WallDuration(0)) remaining.sleep();
+    if (remaining > ros::WallDuration(0)) {
+      remaining.sleep();
+    } else if (remaining < ros::WallDuration(-0.05)) {
+      // More than 50 ms behind (an overloaded machine): slip the schedule instead of bursting steps,
+      // which would run simulated time ahead of the controllers and trip their timeouts.
+      slipped = k + 1 - static_cast<std::int64_t>((ros::WallTime::now() - wall_start).toSec() *
+                                                   cfg_.realtime_factor / dt);
+      ROS_WARN_THROTTLE(10.0, "plant_sim: realtime fell behind the wall clock; slipping (machine overloaded?)");
+    }
     core::WheelTorques u;
     {
       std::lock_guard<std::mutex> lock(torque_mutex_);
