@@ -35,43 +35,49 @@ TorqueController::TorqueController(ros::NodeHandle nh, ros::NodeHandle pnh) {
   desired_sub_ = nh.subscribe("desired_velocity", 50, &TorqueController::desiredCallback, this, hints);
 }
 
+namespace {
+/// The live-tunable subset of SlidingModeParams <-> its dynamic_reconfigure config (one mapping each way).
+void toParams(const TorqueControllerConfig& c, core::SlidingModeParams& p) {
+  p.beta_v = c.beta_v;
+  p.beta_omega = c.beta_omega;
+  p.k1 = c.k1;
+  p.k2 = c.k2;
+  p.eta1 = c.eta1;
+  p.eta2 = c.eta2;
+  p.rate_m = c.rate_m;
+  p.rate_i = c.rate_i;
+  p.max_torque = c.max_torque;
+  p.switching.width = c.switch_width;
+}
+void toConfig(const core::SlidingModeParams& p, TorqueControllerConfig& c) {
+  c.beta_v = p.beta_v;
+  c.beta_omega = p.beta_omega;
+  c.k1 = p.k1;
+  c.k2 = p.k2;
+  c.eta1 = p.eta1;
+  c.eta2 = p.eta2;
+  c.rate_m = p.rate_m;
+  c.rate_i = p.rate_i;
+  c.max_torque = p.max_torque;
+  c.switch_width = p.switching.width;
+  c.switching = core::SwitchFunction::name(p.switching.type);
+}
+}  // namespace
+
 void TorqueController::reconfigure(TorqueControllerConfig& config, uint32_t) {
-  const core::SlidingModeParams& old = smc_->params();
+  // The server's first call repeats the start-up values; applying them again changes nothing.
+  const core::SlidingModeParams old = smc_->params();
   core::SlidingModeParams p = old;
-  p.beta_v = config.beta_v;
-  p.beta_omega = config.beta_omega;
-  p.k1 = config.k1;
-  p.k2 = config.k2;
-  p.eta1 = config.eta1;
-  p.eta2 = config.eta2;
-  p.rate_m = config.rate_m;
-  p.rate_i = config.rate_i;
-  p.max_torque = config.max_torque;
-  p.switching.width = config.switch_width;
+  toParams(config, p);
   std::string error;
   if (!core::SwitchFunction::parse(config.switching, p.switching.type))
     error = "switching = '" + config.switching + "' must be one of sign, sat, relay, atan, tanh";
   if (error.empty()) error = p.validate();
   if (!error.empty()) {
     ROS_WARN("torque_controller: rejected gain change: %s; keeping the previous gains", error.c_str());
-    config.beta_v = old.beta_v;  // the server then reports (and stores) the values really in force
-    config.beta_omega = old.beta_omega;
-    config.k1 = old.k1;
-    config.k2 = old.k2;
-    config.eta1 = old.eta1;
-    config.eta2 = old.eta2;
-    config.rate_m = old.rate_m;
-    config.rate_i = old.rate_i;
-    config.max_torque = old.max_torque;
-    config.switching = core::SwitchFunction::name(old.switching.type);
-    config.switch_width = old.switching.width;
+    toConfig(old, config);  // the server then reports (and stores) the values really in force
     return;
   }
-  const bool changed = p.beta_v != old.beta_v || p.beta_omega != old.beta_omega || p.k1 != old.k1 ||
-                       p.k2 != old.k2 || p.eta1 != old.eta1 || p.eta2 != old.eta2 || p.rate_m != old.rate_m ||
-                       p.rate_i != old.rate_i || p.max_torque != old.max_torque ||
-                       p.switching.type != old.switching.type || p.switching.width != old.switching.width;
-  if (!changed) return;  // the server's first call repeats the start-up values
   smc_->setParams(p);
   ROS_INFO("torque_controller: gains now beta %g/%g, K %g/%g, eta %g/%g, rates %g/%g, max torque %g, %s (%g)",
            p.beta_v, p.beta_omega, p.k1, p.k2, p.eta1, p.eta2, p.rate_m, p.rate_i, p.max_torque,
