@@ -1,0 +1,72 @@
+// The seed drill: drops a seed every `spacing` metres the tool point travels while the tool is down,
+// and scores the sown line against the intended rows (cross-track error), with detours around
+// obstacles reported apart from the straight rows.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "sowing_robot/core/field.h"
+#include "sowing_robot/core/potential_field.h"
+
+namespace sowing_robot {
+namespace core {
+
+/// An intended sowing row: the straight segment from a to b [m].
+struct RowSegment {
+  Eigen::Vector2d a = Eigen::Vector2d::Zero(), b = Eigen::Vector2d::Zero();
+};
+
+/// The rows of a field (row i from rowStart(i), alternating direction, length row_length).
+std::vector<RowSegment> rowsOf(const FieldParams& field);
+
+struct SeedingParams {
+  double spacing = 0.1;        ///< distance between seeds along the tool's path [m] (> 0)
+  double tolerance = 0.02;     ///< cross-track error counted as "off the line" beyond this [m] (> 0)
+  double detour_margin = 0.5;  ///< seeds closer than radius + influence + margin to an obstacle are detour seeds [m]
+  std::string validate() const;
+};
+
+/// Cross-track figures of a set of seeds [m].
+struct SeedStats {
+  std::size_t count = 0;
+  double max = 0.0, rms = 0.0;
+  double fraction_over = 0.0;  ///< share of seeds with |error| > tolerance
+};
+
+class SeedDrill {
+ public:
+  /// influence: the potential field's influence distance, so the detour zone follows the avoidance.
+  SeedDrill(const SeedingParams& params, std::vector<RowSegment> rows, std::vector<Obstacle> obstacles,
+            double influence);
+
+  /// Advance the tool point to p. Returns true (and the seed position) when a seed falls here.
+  bool update(const Eigen::Vector2d& p, bool tool_down, Eigen::Vector2d& seed);
+
+  /// Distance from p to the nearest row segment [m].
+  double crossTrack(const Eigen::Vector2d& p) const;
+  /// True when p lies in an obstacle's detour zone.
+  bool inDetour(const Eigen::Vector2d& p) const;
+
+  const SeedStats& onRows() const { return rows_stats_; }      ///< seeds away from obstacles
+  const SeedStats& detours() const { return detour_stats_; }   ///< seeds in detour zones
+  std::string report() const;
+
+ private:
+  void score(SeedStats& s, double& sum_sq, std::size_t& over, double e);
+
+  SeedingParams params_;
+  std::vector<RowSegment> rows_;
+  std::vector<Obstacle> obstacles_;
+  double influence_;
+  bool has_last_ = false;
+  Eigen::Vector2d last_ = Eigen::Vector2d::Zero();
+  double travelled_ = 0.0;  // since the last seed, tool down only
+  SeedStats rows_stats_, detour_stats_;
+  double rows_sq_ = 0.0, detour_sq_ = 0.0;
+  std::size_t rows_over_ = 0, detour_over_ = 0;
+};
+
+}  // namespace core
+}  // namespace sowing_robot

@@ -1,0 +1,87 @@
+#include "sowing_robot/core/seeding.h"
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "sowing_robot/core/validation.h"
+
+namespace sowing_robot {
+namespace core {
+
+std::vector<RowSegment> rowsOf(const FieldParams& field) {
+  const FieldPath path(field);
+  std::vector<RowSegment> rows;
+  for (int i = 0; i < field.rows; ++i) {
+    const double h = field.heading + (i % 2 == 0 ? 0.0 : M_PI);
+    const Eigen::Vector2d a = path.rowStart(i);
+    rows.push_back({a, a + field.row_length * Eigen::Vector2d(std::cos(h), std::sin(h))});
+  }
+  return rows;
+}
+
+std::string SeedingParams::validate() const {
+  return firstError({checkPositive("seeding/spacing", spacing, "m"), checkPositive("seeding/tolerance", tolerance, "m"),
+                     checkNonNegative("seeding/detour_margin", detour_margin, "m")});
+}
+
+SeedDrill::SeedDrill(const SeedingParams& params, std::vector<RowSegment> rows, std::vector<Obstacle> obstacles,
+                     double influence)
+    : params_(params), rows_(std::move(rows)), obstacles_(std::move(obstacles)), influence_(influence) {}
+
+double SeedDrill::crossTrack(const Eigen::Vector2d& p) const {
+  double best = std::numeric_limits<double>::infinity();
+  for (const RowSegment& r : rows_) {
+    const Eigen::Vector2d ab = r.b - r.a;
+    const double len2 = ab.squaredNorm();
+    const double u = len2 > 0.0 ? std::clamp((p - r.a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+    best = std::min(best, (p - (r.a + u * ab)).norm());
+  }
+  return best;
+}
+
+bool SeedDrill::inDetour(const Eigen::Vector2d& p) const {
+  for (const Obstacle& o : obstacles_)
+    if (std::hypot(p.x() - o.x, p.y() - o.y) < o.radius + influence_ + params_.detour_margin) return true;
+  return false;
+}
+
+void SeedDrill::score(SeedStats& s, double& sum_sq, std::size_t& over, double e) {
+  ++s.count;
+  s.max = std::max(s.max, e);
+  sum_sq += e * e;
+  if (e > params_.tolerance) ++over;
+  s.rms = std::sqrt(sum_sq / s.count);
+  s.fraction_over = static_cast<double>(over) / s.count;
+}
+
+bool SeedDrill::update(const Eigen::Vector2d& p, bool tool_down, Eigen::Vector2d& seed) {
+  const bool first = !has_last_;
+  const Eigen::Vector2d last = last_;
+  has_last_ = true;
+  last_ = p;
+  if (first || !tool_down) return false;
+  travelled_ += (p - last).norm();
+  if (travelled_ < params_.spacing) return false;
+  travelled_ -= params_.spacing;
+  seed = p;
+  const double e = crossTrack(p);
+  if (inDetour(p))
+    score(detour_stats_, detour_sq_, detour_over_, e);
+  else
+    score(rows_stats_, rows_sq_, rows_over_, e);
+  return true;
+}
+
+std::string SeedDrill::report() const {
+  char buf[400];
+  std::snprintf(buf, sizeof buf,
+                "seeds on rows: %zu, cross-track max %.4f m, RMS %.4f m, %.1f %% beyond %.3f m; "
+                "detour seeds: %zu, max %.4f m, RMS %.4f m",
+                rows_stats_.count, rows_stats_.max, rows_stats_.rms, 100.0 * rows_stats_.fraction_over,
+                params_.tolerance, detour_stats_.count, detour_stats_.max, detour_stats_.rms);
+  return buf;
+}
+
+}  // namespace core
+}  // namespace sowing_robot
