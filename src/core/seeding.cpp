@@ -22,7 +22,8 @@ std::vector<RowSegment> rowsOf(const FieldParams& field) {
 
 std::string SeedingParams::validate() const {
   return firstError({checkPositive("seeding/spacing", spacing, "m"), checkPositive("seeding/tolerance", tolerance, "m"),
-                     checkNonNegative("seeding/detour_margin", detour_margin, "m")});
+                     checkNonNegative("seeding/detour_margin", detour_margin, "m"),
+                     checkPositive("seeding/engage_distance", engage_distance, "m")});
 }
 
 SeedDrill::SeedDrill(const SeedingParams& params, std::vector<RowSegment> rows, std::vector<Obstacle> obstacles,
@@ -38,6 +39,17 @@ double SeedDrill::crossTrack(const Eigen::Vector2d& p) const {
     best = std::min(best, (p - (r.a + u * ab)).norm());
   }
   return best;
+}
+
+bool SeedDrill::onRowSegment(const Eigen::Vector2d& p) const {
+  for (const RowSegment& r : rows_) {
+    const Eigen::Vector2d ab = r.b - r.a;
+    const double len2 = ab.squaredNorm();
+    if (!(len2 > 0.0)) continue;
+    const double u = (p - r.a).dot(ab) / len2;
+    if (u > 0.0 && u < 1.0 && (p - (r.a + u * ab)).norm() <= params_.engage_distance) return true;
+  }
+  return false;
 }
 
 bool SeedDrill::inDetour(const Eigen::Vector2d& p) const {
@@ -60,7 +72,12 @@ bool SeedDrill::update(const Eigen::Vector2d& p, bool tool_down, Eigen::Vector2d
   const Eigen::Vector2d last = last_;
   has_last_ = true;
   last_ = p;
-  if (first || !tool_down) return false;
+  if (!tool_down) lowered_ = false;
+  if (tool_down && !lowered_ && onRowSegment(p)) {
+    lowered_ = true;
+    travelled_ = 0.0;
+  }
+  if (first || !lowered_) return false;
   travelled_ += (p - last).norm();
   if (travelled_ < params_.spacing) return false;
   travelled_ -= params_.spacing;

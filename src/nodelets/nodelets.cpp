@@ -10,6 +10,7 @@
 #include "sowing_robot/ros/plant_sim.h"
 #include "sowing_robot/ros/reference_generator.h"
 #include "sowing_robot/ros/run_monitor.h"
+#include "sowing_robot/ros/seed_drill.h"
 #include "sowing_robot/ros/torque_controller.h"
 
 namespace sowing_robot {
@@ -26,6 +27,7 @@ using KinematicControllerNodelet = WrapperNodelet<KinematicController>;
 using TorqueControllerNodelet = WrapperNodelet<TorqueController>;
 using ReferenceGeneratorNodelet = WrapperNodelet<ReferenceGenerator>;
 using RunMonitorNodelet = WrapperNodelet<RunMonitor>;
+using SeedDrillNodelet = WrapperNodelet<SeedDrillNode>;
 
 /// The plant runs its simulation loop on a thread of its own; the manager serves its callbacks.
 class PlantSimNodelet : public nodelet::Nodelet {
@@ -54,3 +56,4 @@ PLUGINLIB_EXPORT_CLASS(sowing_robot::KinematicControllerNodelet, nodelet::Nodele
 PLUGINLIB_EXPORT_CLASS(sowing_robot::TorqueControllerNodelet, nodelet::Nodelet)
 PLUGINLIB_EXPORT_CLASS(sowing_robot::ReferenceGeneratorNodelet, nodelet::Nodelet)
 PLUGINLIB_EXPORT_CLASS(sowing_robot::RunMonitorNodelet, nodelet::Nodelet)
+PLUGINLIB_EXPORT_CLASS(sowing_robot::SeedDrillNodelet, nodelet::Nodelet)

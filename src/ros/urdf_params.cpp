@@ -254,3 +254,23 @@ std::string robotParamsFromUrdf(const std::string& urdf_xml, core::RobotParams& 
 }
 
 }  // namespace sowing_robot
+
+namespace sowing_robot {
+
+std::string linkPositionFromUrdf(const std::string& urdf_xml, const std::string& link, double& x, double& y) {
+  urdf::ModelInterfaceSharedPtr model;
+  try {
+    model = urdf::parseURDF(urdf_xml);
+  } catch (const std::exception& e) {
+    return std::string("URDF could not be parsed: ") + e.what();
+  }
+  if (!model) return "URDF could not be parsed (malformed XML or invalid URDF)";
+  Eigen::Isometry3d pose;
+  const std::string err = frameInBase(*model, link, false, pose);
+  if (!err.empty()) return "URDF " + quoted(model->getName()) + ": " + err;
+  x = pose.translation().x();
+  y = pose.translation().y();
+  return "";
+}
+
+}  // namespace sowing_robot

@@ -13,6 +13,7 @@ SeedDrill lineDrill(std::vector<Obstacle> obstacles = {}) {
   p.spacing = 0.1;
   p.tolerance = 0.02;
   p.detour_margin = 0.5;
+  p.engage_distance = 0.05;
   return SeedDrill(p, {{Eigen::Vector2d(0, 3), Eigen::Vector2d(100, 3)}}, std::move(obstacles), 0.5);
 }
 }  // namespace
@@ -34,6 +35,19 @@ TEST(Seeding, NoSeedsWithTheToolUp) {
   int n = 0;
   for (int i = 0; i <= 5000; ++i) n += d.update({i * 1e-3, 3.0}, false, seed);
   EXPECT_EQ(n, 0);
+}
+
+TEST(Seeding, TheToolIsLoweredOnlyOnceOnTheRow) {
+  // Approach from 0.5 m beside the row (slope 0.1) to x = 5, then 3 m along it.
+  SeedDrill d = lineDrill();
+  Eigen::Vector2d seed;
+  int approach = 0, along = 0;
+  for (int i = 0; i <= 5000; ++i) approach += d.update({i * 1e-3, 3.5 - 0.1 * i * 1e-3}, true, seed);
+  for (int i = 5001; i <= 8050; ++i) along += d.update({i * 1e-3, 3.0}, true, seed);
+  // Lowered within 5 cm of the row (engage_distance set so): the last 0.5 m of the approach.
+  EXPECT_EQ(approach, 5);
+  EXPECT_EQ(along, 30);
+  EXPECT_LE(d.onRows().max, 0.05 + 1e-9);
 }
 
 TEST(Seeding, CrossTrackErrorIsTheDistanceToTheNearestRow) {

@@ -25,6 +25,10 @@ struct SeedingParams {
   double spacing = 0.1;        ///< distance between seeds along the tool's path [m] (> 0)
   double tolerance = 0.02;     ///< cross-track error counted as "off the line" beyond this [m] (> 0)
   double detour_margin = 0.5;  ///< seeds closer than radius + influence + margin to an obstacle are detour seeds [m]
+  /// The tool is lowered only once the tool point is this close to a row, between its ends, and the
+  /// reference says tool down, as an operator would: the approach from a start off the row and the
+  /// end of a headland turn sow nothing [m] (> 0).
+  double engage_distance = 0.01;
   std::string validate() const;
 };
 
@@ -41,11 +45,15 @@ class SeedDrill {
   SeedDrill(const SeedingParams& params, std::vector<RowSegment> rows, std::vector<Obstacle> obstacles,
             double influence);
 
-  /// Advance the tool point to p. Returns true (and the seed position) when a seed falls here.
+  /// Advance the tool point to p; tool_down is the reference's request. Returns true (and the seed
+  /// position) when a seed falls here.
   bool update(const Eigen::Vector2d& p, bool tool_down, Eigen::Vector2d& seed);
 
   /// Distance from p to the nearest row segment [m].
   double crossTrack(const Eigen::Vector2d& p) const;
+  /// True when p is within engage_distance of a row and between its ends (not beyond them, as in a
+  /// headland turn): where the tool may be lowered.
+  bool onRowSegment(const Eigen::Vector2d& p) const;
   /// True when p lies in an obstacle's detour zone.
   bool inDetour(const Eigen::Vector2d& p) const;
 
@@ -61,6 +69,7 @@ class SeedDrill {
   std::vector<Obstacle> obstacles_;
   double influence_;
   bool has_last_ = false;
+  bool lowered_ = false;  // tool physically down
   Eigen::Vector2d last_ = Eigen::Vector2d::Zero();
   double travelled_ = 0.0;  // since the last seed, tool down only
   SeedStats rows_stats_, detour_stats_;

@@ -21,4 +21,8 @@ namespace sowing_robot {
 /// Besides chassis and the two wheels no link may carry mass: Table 5.1 lumps everything else into mc.
 std::string robotParamsFromUrdf(const std::string& urdf_xml, core::RobotParams& out);
 
+/// Planar position [m] of a link's frame in base_link, through fixed joints only (e.g. `tool_link`,
+/// the seed-drop point). Returns "" or one line naming what is missing.
+std::string linkPositionFromUrdf(const std::string& urdf_xml, const std::string& link, double& x, double& y);
+
 }  // namespace sowing_robot
