@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <fstream>
+#include <iomanip>
 #include <limits>
 
 namespace sowing_robot {
@@ -114,6 +116,20 @@ std::string metricsTable(const std::vector<std::string>& names,
       s += "\n";
     }
   return s;
+}
+
+bool writeMetricsYaml(const std::string& path, const std::string& label,
+                      const std::array<AxisMetrics, AXIS_COUNT>& m) {
+  std::ofstream f(path);
+  if (!f) return false;
+  f << std::setprecision(17) << label << ":\n";
+  const char* axes[] = {"x", "y", "theta"};
+  for (int a = 0; a < AXIS_COUNT; ++a) {
+    f << "  " << axes[a] << ": {ise: " << m[a].ise << ", itse: " << m[a].itse << ", iae: " << m[a].iae
+      << ", itae: " << m[a].itae << ", rise_time: " << m[a].rise_time << ", settling_time: " << m[a].settling_time
+      << ", overshoot: " << m[a].overshoot << "}\n";
+  }
+  return static_cast<bool>(f);
 }
 
 }  // namespace core

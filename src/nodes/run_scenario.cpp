@@ -1,6 +1,6 @@
 // run_scenario: the thesis closed loop in-process (no ROS), for quick comparisons and benchmarks.
 //   run_scenario [--tsmc] [--atsmc] [--disturbance] [--mismatch S] [--noise STD] [--duration T] [--rate HZ]
-//                [--switching NAME --width W] [--repeat N]
+//                [--switching NAME --width W] [--repeat N] [--yaml FILE (metrics of the last mode)]
 // Prints the Table 5.5/5.6 metrics as Markdown and the wall time per run.
 #include <chrono>
 #include <cstdio>
@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
   std::vector<bool> modes;
   Scenario sc;
   int repeat = 1;
+  std::string yaml;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto value = [&](const char* what) {
@@ -35,6 +36,7 @@ int main(int argc, char** argv) {
     else if (a == "--rate") sc.control_period_ns = static_cast<std::int64_t>(1e9 / value("--rate") + 0.5);
     else if (a == "--width") sc.sliding.switching.width = value("--width");
     else if (a == "--repeat") repeat = static_cast<int>(value("--repeat"));
+    else if (a == "--yaml" && i + 1 < argc) yaml = argv[++i];
     else if (a == "--switching" && i + 1 < argc) {
       if (!SwitchFunction::parse(argv[++i], sc.sliding.switching.type)) {
         std::fprintf(stderr, "run_scenario: unknown switching '%s'\n", argv[i]);
@@ -65,8 +67,12 @@ int main(int argc, char** argv) {
                 adaptive ? "ATSMC" : "TSMC", 1e3 * s, sc.duration, (sc.steps() + 1) / s / 1e6, r.final_state[X],
                 r.final_state[Y], r.final_state[THETA], static_cast<long>(r.saturated_steps),
                 r.diverged ? ", DIVERGED" : "");
-    names.push_back(adaptive ? "ATSMC" : "TSMC");
+    names.push_back(adaptive ? "atsmc" : "tsmc");
     results.push_back(r.metrics);
+    if (!yaml.empty() && !writeMetricsYaml(yaml, names.back(), r.metrics)) {
+      std::fprintf(stderr, "run_scenario: cannot write %s\n", yaml.c_str());
+      return 2;
+    }
   }
   std::printf("\n%s", metricsTable(names, results).c_str());
   return 0;

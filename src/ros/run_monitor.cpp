@@ -1,8 +1,6 @@
 #include "sowing_robot/ros/run_monitor.h"
 
 #include <cstdio>
-#include <fstream>
-#include <iomanip>
 
 #include "sowing_robot/core/validation.h"
 #include "sowing_robot/ros/component_params.h"
@@ -39,23 +37,9 @@ void RunMonitor::finish() {
   ROS_INFO("run_monitor: %zu samples up to t = %.3f s\n%s", metrics_.samples(), last_.toSec(), table.c_str());
   std::printf("%s", table.c_str());
   std::fflush(stdout);
-  if (!output_.empty() && !writeMetricsYaml(output_, label_, m))
+  if (!output_.empty() && !core::writeMetricsYaml(output_, label_, m))
     ROS_ERROR("run_monitor: could not write %s", output_.c_str());
   if (exit_at_end_) ros::shutdown();
-}
-
-bool writeMetricsYaml(const std::string& path, const std::string& label,
-                      const std::array<core::AxisMetrics, core::AXIS_COUNT>& m) {
-  std::ofstream f(path);
-  if (!f) return false;
-  f << std::setprecision(17) << label << ":\n";
-  const char* axes[] = {"x", "y", "theta"};
-  for (int a = 0; a < core::AXIS_COUNT; ++a) {
-    f << "  " << axes[a] << ": {ise: " << m[a].ise << ", itse: " << m[a].itse << ", iae: " << m[a].iae
-      << ", itae: " << m[a].itae << ", rise_time: " << m[a].rise_time << ", settling_time: " << m[a].settling_time
-      << ", overshoot: " << m[a].overshoot << "}\n";
-  }
-  return static_cast<bool>(f);
 }
 
 }  // namespace sowing_robot

@@ -27,8 +27,5 @@ class RunMonitor {
   ros::Subscriber sub_;
 };
 
-/// Writes metrics as YAML: {label: {x: {ise: .., ...}, y: {...}, theta: {...}}}.
-bool writeMetricsYaml(const std::string& path, const std::string& label,
-                      const std::array<core::AxisMetrics, core::AXIS_COUNT>& m);
 
 }  // namespace sowing_robot
