@@ -235,17 +235,25 @@ std::string fromModel(const urdf::ModelInterface& model, core::RobotParams& p) {
 
 }  // namespace
 
-std::string robotParamsFromUrdf(const std::string& urdf_xml, core::RobotParams& out) {
-  urdf::ModelInterfaceSharedPtr model;
+namespace {
+/// Parses the URDF; "" or one line saying why it could not be parsed.
+std::string parse(const std::string& urdf_xml, urdf::ModelInterfaceSharedPtr& model) {
   try {
     model = urdf::parseURDF(urdf_xml);
   } catch (const std::exception& e) {
     return std::string("URDF could not be parsed: ") + e.what();
   }
-  if (!model) return "URDF could not be parsed (malformed XML or invalid URDF)";
+  return model ? "" : "URDF could not be parsed (malformed XML or invalid URDF)";
+}
+}  // namespace
+
+std::string robotParamsFromUrdf(const std::string& urdf_xml, core::RobotParams& out) {
+  urdf::ModelInterfaceSharedPtr model;
+  std::string err = parse(urdf_xml, model);
+  if (!err.empty()) return err;
 
   core::RobotParams p;
-  std::string err = fromModel(*model, p);
+  err = fromModel(*model, p);
   if (!err.empty()) return "URDF " + quoted(model->getName()) + ": " + err;
   err = p.validate();
   if (!err.empty()) return "URDF " + quoted(model->getName()) + " gives an invalid parameter: " + err;
@@ -259,14 +267,10 @@ namespace sowing_robot {
 
 std::string linkPositionFromUrdf(const std::string& urdf_xml, const std::string& link, double& x, double& y) {
   urdf::ModelInterfaceSharedPtr model;
-  try {
-    model = urdf::parseURDF(urdf_xml);
-  } catch (const std::exception& e) {
-    return std::string("URDF could not be parsed: ") + e.what();
-  }
-  if (!model) return "URDF could not be parsed (malformed XML or invalid URDF)";
+  std::string err = parse(urdf_xml, model);
+  if (!err.empty()) return err;
   Eigen::Isometry3d pose;
-  const std::string err = frameInBase(*model, link, false, pose);
+  err = frameInBase(*model, link, false, pose);
   if (!err.empty()) return "URDF " + quoted(model->getName()) + ": " + err;
   x = pose.translation().x();
   y = pose.translation().y();

@@ -177,3 +177,12 @@ TEST_F(UrdfParams, MalformedXml) {
   errorFor("");
   errorFor("<robot name=\"x\"><link name=\"base_link\"></robot>");
 }
+
+TEST_F(UrdfParams, ToolLinkIsTheSeedDropPointBehindTheAxle) {
+  double x = 1.0, y = 1.0;
+  ASSERT_EQ(sowing_robot::linkPositionFromUrdf(xml, "tool_link", x, y), "");
+  EXPECT_NEAR(x, -0.45, 1e-12);  // on the ground behind the furrow-opener disc
+  EXPECT_NEAR(y, 0.0, 1e-12);
+  EXPECT_NE(sowing_robot::linkPositionFromUrdf(xml, "no_such_link", x, y).find("no_such_link"), std::string::npos);
+  EXPECT_NE(sowing_robot::linkPositionFromUrdf("<robot", "tool_link", x, y).find("could not be parsed"), std::string::npos);
+}
