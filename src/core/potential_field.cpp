@@ -113,6 +113,17 @@ std::unique_ptr<ReferenceSource> PotentialField::clone() const {
   return c;
 }
 
+void PotentialField::setGains(double alpha, double beta, double gain, double tangential_ratio) {
+  PotentialFieldParams p = params_;
+  p.alpha = alpha;
+  p.beta = beta;
+  p.gain = gain;
+  p.tangential_ratio = tangential_ratio;
+  const std::string error = p.validate();
+  if (!error.empty()) throw std::invalid_argument(error);
+  params_ = p;
+}
+
 void PotentialField::setObstacles(std::vector<Obstacle> obstacles) {
   validateObstacles(obstacles);
   obstacles_ = std::move(obstacles);

@@ -66,6 +66,11 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
       ROS_INFO("reference_generator: obstacle %zu at (%.3f, %.3f), radius %.3f m", i, obstacles_[i].x, obstacles_[i].y,
                obstacles_[i].radius);
   }
+  if (field_) {
+    reconfigure_ = std::make_unique<dynamic_reconfigure::Server<ReferenceGeneratorConfig>>(
+        ros::NodeHandle(pnh, "potential"));
+    reconfigure_->setCallback([this](ReferenceGeneratorConfig& c, uint32_t level) { reconfigure(c, level); });
+  }
   ref_pub_ = nh.advertise<ReferenceState>("reference", kLockstepQueue);
   path_pub_ = nh.advertise<nav_msgs::Path>("reference_path", 1, true);
   path_.header.frame_id = "odom";
@@ -166,6 +171,23 @@ void ReferenceGenerator::publishMarkers() {
   }
   out.markers.push_back(rows);
   marker_pub_.publish(out);
+}
+
+void ReferenceGenerator::reconfigure(ReferenceGeneratorConfig& config, uint32_t) {
+  const core::PotentialFieldParams old = field_->potentialField().params();
+  try {
+    field_->setGains(config.alpha, config.beta, config.gain, config.tangential_ratio);
+  } catch (const std::invalid_argument& e) {
+    ROS_WARN("reference_generator: rejected gain change: %s; keeping alpha %g, beta %g, gain %g, tangential_ratio %g",
+             e.what(), old.alpha, old.beta, old.gain, old.tangential_ratio);
+    config.alpha = old.alpha;  // the server then reports (and stores) the values really in force
+    config.beta = old.beta;
+    config.gain = old.gain;
+    config.tangential_ratio = old.tangential_ratio;
+    return;
+  }
+  ROS_INFO("reference_generator: potential gains now alpha %g, beta %g, gain %g, tangential_ratio %g", config.alpha,
+           config.beta, config.gain, config.tangential_ratio);
 }
 
 void ReferenceGenerator::odomCallback(const nav_msgs::Odometry::ConstPtr& msg) {

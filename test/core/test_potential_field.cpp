@@ -372,3 +372,19 @@ TEST(PotentialField, AReferenceStartingInsideAnObstacleIsPushedOut) {
   });
   EXPECT_GT(pf.minObstacleClearance({r.pose.x, r.pose.y}), 0.0);
 }
+
+TEST(PotentialField, GainsChangeLiveAndInvalidOnesAreRefused) {
+  PotentialField pf(PotentialFieldParams{}, sowing_robot::core::RowLine{}, {});
+  pf.setGains(6.0, 5.0, 2.0, 0.5);
+  EXPECT_EQ(pf.params().alpha, 6.0);
+  EXPECT_EQ(pf.params().beta, 5.0);
+  EXPECT_EQ(pf.params().gain, 2.0);
+  EXPECT_EQ(pf.params().tangential_ratio, 0.5);
+  EXPECT_THROW(pf.setGains(-1.0, 5.0, 2.0, 0.5), std::invalid_argument);
+  EXPECT_THROW(pf.setGains(6.0, std::nan(""), 2.0, 0.5), std::invalid_argument);
+  EXPECT_EQ(pf.params().alpha, 6.0);  // a refused change keeps the gains in force
+  EXPECT_EQ(pf.params().beta, 5.0);
+  // The reference keeps running from its state (no reset): still the line without obstacles.
+  const Reference r = pf.next(1.0);
+  EXPECT_NEAR(r.pose.y, 3.0, 1e-12);
+}

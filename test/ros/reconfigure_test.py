@@ -47,6 +47,13 @@ class Reconfigure(unittest.TestCase):
         self.assertTrue(self.warned("kinematic_controller", "rejected gain change: ky"))
         self.assertEqual(c.update_configuration({"ktheta": float("nan")})["ktheta"], 2.2)
 
+    def test_reference_generator(self):
+        c = Client("/reference_generator/potential", timeout=30)
+        self.assertEqual(c.update_configuration({"alpha": 6.0})["alpha"], 6.0)
+        self.assertEqual(c.update_configuration({"beta": -1.0})["beta"], 4.0)  # clamped to 0, then refused
+        self.assertTrue(self.warned("reference_generator", "rejected gain change"))
+        self.assertEqual(c.update_configuration({"gain": float("nan")})["gain"], 5.0)
+
 
 if __name__ == "__main__":
     rostest.rosrun("sowing_robot", "reconfigure_test", Reconfigure)

@@ -138,6 +138,10 @@ class FieldReference : public ReferenceSource {
   double duration() const { return duration_; }  ///< [s]
 
   void setObstacles(std::vector<Obstacle> obstacles) { field_.setObstacles(std::move(obstacles)); }
+  /// See PotentialField::setGains.
+  void setGains(double alpha, double beta, double gain, double tangential_ratio) {
+    field_.setGains(alpha, beta, gain, tangential_ratio);
+  }
   const PotentialField& potentialField() const { return field_; }
   const FieldPath& path() const { return static_cast<const FieldPath&>(field_.target()); }
   const FieldParams& params() const { return params_; }

@@ -149,6 +149,9 @@ class PotentialField : public ReferenceSource {
   double minObstacleClearance(const Eigen::Vector2d& p) const;
 
   const PotentialFieldParams& params() const { return params_; }
+  /// Change the live-tunable gains alpha, beta, k (gain) and tangential_ratio; the state and the
+  /// geometry are kept. Throws std::invalid_argument (and keeps the old gains) if they do not validate.
+  void setGains(double alpha, double beta, double gain, double tangential_ratio);
   const TargetTrajectory& target() const { return *target_; }
   /// Reference position [m], velocity [m/s] and acceleration [m/s^2] of the last next() call.
   const Eigen::Vector2d& position() const { return out_p_; }

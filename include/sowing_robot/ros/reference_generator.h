@@ -6,6 +6,7 @@
 //               run time, and `field_markers` (latched) shows obstacles, influence zones and rows.
 #pragma once
 
+#include <dynamic_reconfigure/server.h>
 #include <nav_msgs/Odometry.h>
 #include <nav_msgs/Path.h>
 #include <ros/ros.h>
@@ -14,6 +15,7 @@
 #include <memory>
 #include <vector>
 
+#include "sowing_robot/ReferenceGeneratorConfig.h"
 #include "sowing_robot/ReferenceState.h"
 #include "sowing_robot/core/field.h"
 #include "sowing_robot/core/reference.h"
@@ -31,6 +33,8 @@ class ReferenceGenerator {
   void obstaclesCallback(const visualization_msgs::MarkerArray::ConstPtr& msg);
   /// type field: obstacles, influence zones and row lines on field_markers.
   void publishMarkers();
+  /// type field: live avoidance gains, validated like the start-up values (a rejected change keeps them).
+  void reconfigure(ReferenceGeneratorConfig& config, uint32_t level);
 
   std::unique_ptr<core::ReferenceSource> source_;
   core::FieldReference* field_ = nullptr;  ///< source_ when type is field, else null
@@ -41,6 +45,7 @@ class ReferenceGenerator {
   nav_msgs::Path path_;
   bool any_ = false;
   double path_spacing_ = 0.1;  // [m] between stored reference path points
+  std::unique_ptr<dynamic_reconfigure::Server<ReferenceGeneratorConfig>> reconfigure_;  // type field only
 };
 
 }  // namespace sowing_robot
