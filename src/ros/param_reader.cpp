@@ -22,7 +22,16 @@ T ParamReader::read(const std::string& key, const T& def, const char* type_name)
 }
 
 double ParamReader::get(const std::string& key, double def) { return read<double>(key, def, "double"); }
-int ParamReader::get(const std::string& key, int def) { return read<int>(key, def, "int"); }
+int ParamReader::get(const std::string& key, int def) {
+  // roscpp's getParam(int&) truncates a double (2.5 -> 2) without a word: refuse anything but an int.
+  XmlRpc::XmlRpcValue v;
+  if (nh_.getParam(key, v) && v.getType() != XmlRpc::XmlRpcValue::TypeInt) {
+    read_.insert(nh_.resolveName(key));
+    if (error_.empty()) error_ = "parameter " + nh_.resolveName(key) + " must be of type int";
+    return def;
+  }
+  return read<int>(key, def, "int");
+}
 bool ParamReader::get(const std::string& key, bool def) { return read<bool>(key, def, "bool"); }
 std::string ParamReader::get(const std::string& key, const std::string& def) {
   return read<std::string>(key, def, "string");

@@ -20,6 +20,7 @@ CASES = [
     ("plant_sim", {"mismatch/mass_scale": 0.0}, "mass_scale"),
     ("plant_sim", {"torque_timout": 0.2}, "torque_timout"),  # typo: unknown key
     ("plant_sim", {"control_rate": "fast"}, "control_rate"),  # wrong type
+    ("plant_sim", {"min_subscribers": 2.5}, "min_subscribers"),  # not an integer (roscpp would truncate)
     ("plant_sim", {"robot_description": "ZERO_RADIUS"}, "radius"),
     ("plant_sim", {"robot_description": "<robot name='x'>"}, "robot_description"),
     ("torque_controller", {"p": 4}, "p/q"),
