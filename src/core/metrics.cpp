@@ -45,8 +45,12 @@ void MetricsAccumulator::add(double t, double ex, double ey, double etheta) {
 
 std::array<AxisMetrics, AXIS_COUNT> MetricsAccumulator::result() const {
   auto r = acc_;
-  if (keep_ && !t_.empty())
+  if (keep_ && !t_.empty()) {
     for (int a = 0; a < AXIS_COUNT; ++a) timeDomainMetrics(t_, e_[a], r[a]);
+  } else {
+    const double nan = std::numeric_limits<double>::quiet_NaN();  // not computed, not zero
+    for (auto& m : r) m.rise_time = m.settling_time = m.overshoot = m.peak = nan;
+  }
   return r;
 }
 

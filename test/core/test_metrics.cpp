@@ -74,3 +74,12 @@ TEST(Metrics, TableHasOneColumnPerRun) {
   EXPECT_NE(s.find("| metric | axis | A | B |"), std::string::npos);
   EXPECT_NE(s.find("| ISE | x | 1 | 4 |"), std::string::npos);
 }
+
+TEST(Metrics, WithoutSamplesTheTimeDomainFiguresAreNaNNotZero) {
+  MetricsAccumulator m(false);
+  for (int i = 0; i <= 100; ++i) m.add(i * 0.01, 1.0, 1.0, 1.0);
+  const auto r = m.result();
+  EXPECT_NEAR(r[AXIS_X].ise, 1.0, 1e-12);  // the integrals are still there
+  EXPECT_TRUE(std::isnan(r[AXIS_X].settling_time));
+  EXPECT_TRUE(std::isnan(r[AXIS_Y].overshoot));
+}
