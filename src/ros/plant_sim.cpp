@@ -85,7 +85,6 @@ PlantSim::PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh) {
   joint_msg_.name = {"right_wheel_joint", "left_wheel_joint"};
   joint_msg_.position.resize(2);
   joint_msg_.velocity.resize(2);
-  path_msg_.header.frame_id = "odom";
 }
 
 void PlantSim::torqueCallback(const WheelTorque::ConstPtr& msg) {
@@ -149,32 +148,20 @@ void PlantSim::publishState(const ros::Time& stamp, bool visuals) {
   joint_msg_.velocity[1] = ds[core::PHI_L];
   joint_pub_.publish(joint_msg_);
 
-  // The travelled path keeps a point every 5 cm and goes out at 1/10 of the visual rate: it is the
-  // largest message here and grows with the run, so it must not be re-sent at 50 Hz.
-  const bool moved = path_msg_.poses.empty() ||
-                     std::hypot(s[core::X] - path_msg_.poses.back().pose.position.x,
-                                s[core::Y] - path_msg_.poses.back().pose.position.y) >= 0.05;
-  if (moved) {
-    geometry_msgs::PoseStamped pose;
-    pose.header = odom_msg_.header;
-    pose.pose = odom_msg_.pose.pose;
-    if (path_msg_.poses.size() >= 20000)
-      path_msg_.poses.erase(path_msg_.poses.begin(), path_msg_.poses.begin() + 10000);
-    path_msg_.poses.push_back(pose);
-  }
-  if (++visual_count_ % 10 == 1) {
-    path_msg_.header.stamp = stamp;
-    path_pub_.publish(path_msg_);
-  }
+  geometry_msgs::PoseStamped pose;
+  pose.header = odom_msg_.header;
+  pose.pose = odom_msg_.pose.pose;
+  if (path_.add(pose)) path_pub_.publish(path_.path());
 }
 
-bool PlantSim::healthy() {
+void PlantSim::requireHealthy() {
   const core::State& s = plant_->state();
-  if (std::isfinite(s.sum()) && std::fabs(s[core::V]) <= cfg_.max_speed) return true;
+  if (std::isfinite(s.sum()) && std::fabs(s[core::V]) <= cfg_.max_speed) return;
   ROS_FATAL("plant_sim: state diverged at t=%.6f s (x %g, y %g, theta %g, v %g, omega %g; max_speed %g m/s): "
             "stopping the run instead of publishing garbage",
             plant_->time(), s[core::X], s[core::Y], s[core::THETA], s[core::V], s[core::OMEGA], cfg_.max_speed);
-  return false;
+  ros::shutdown();
+  std::exit(2);
 }
 
 void PlantSim::runLockstep() {
@@ -225,10 +212,7 @@ void PlantSim::runLockstep() {
     }
     if (!running() || k == n) break;
     plant_->step(u.right, u.left, dt);
-    if (!healthy()) {
-      ros::shutdown();
-      std::exit(2);
-    }
+    requireHealthy();
   }
   const double wall = (ros::WallTime::now() - wall_start).toSec();
   ROS_INFO("plant_sim: lockstep scenario finished: %.3f s simulated in %.3f s wall (real-time factor %.2f); "
@@ -240,7 +224,7 @@ void PlantSim::runLockstep() {
 void PlantSim::runRealtime() {
   const double dt = core::secondsFromNanos(cfg_.period_ns);
   const ros::WallTime wall_start = ros::WallTime::now();
-  std::int64_t zero_hold = 0, slipped = 0;
+  std::int64_t slipped = 0;
   for (std::int64_t k = 0; running(); ++k) {
     const ros::Time stamp = stampOf(k, cfg_.period_ns);
     step_ = k;
@@ -262,16 +246,12 @@ void PlantSim::runRealtime() {
       const bool fresh = torque_valid_ && (stamp - torque_stamp_).toSec() <= cfg_.torque_timeout;
       if (fresh) u = torque_;
       if (!fresh && torque_valid_) {
-        ++zero_hold;
         ROS_WARN_THROTTLE(2.0, "plant_sim: no wheel_torque for %.3f s (timeout %.3f s): applying zero torque",
                           (stamp - torque_stamp_).toSec(), cfg_.torque_timeout);
       }
     }
     plant_->step(u.right, u.left, dt);
-    if (!healthy()) {
-      ros::shutdown();
-      std::exit(2);
-    }
+    requireHealthy();
   }
 }
 

@@ -73,7 +73,7 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
   }
   ref_pub_ = nh.advertise<ReferenceState>("reference", kLockstepQueue);
   path_pub_ = nh.advertise<nav_msgs::Path>("reference_path", 1, true);
-  path_.header.frame_id = "odom";
+  path_ = std::make_unique<PathBuffer>("odom", path_spacing_, 10);  // re-sent every 10th point
   if (field_) {
     marker_pub_ = nh.advertise<visualization_msgs::MarkerArray>("field_markers", 1, true);
     publishMarkers();
@@ -210,20 +210,13 @@ void ReferenceGenerator::odomCallback(const nav_msgs::Odometry::ConstPtr& msg) {
   publishShared(ref_pub_, ref_);
   any_ = true;
 
-  const bool far = path_.poses.empty() || std::hypot(r.pose.x - path_.poses.back().pose.position.x,
-                                                     r.pose.y - path_.poses.back().pose.position.y) >= path_spacing_;
-  if (far) {
-    geometry_msgs::PoseStamped p;
-    p.header = ref_.header;
-    p.pose.position.x = r.pose.x;
-    p.pose.position.y = r.pose.y;
-    p.pose.orientation.z = std::sin(0.5 * r.pose.theta);
-    p.pose.orientation.w = std::cos(0.5 * r.pose.theta);
-    if (path_.poses.size() >= 20000) path_.poses.erase(path_.poses.begin(), path_.poses.begin() + 10000);
-    path_.poses.push_back(p);
-    path_.header.stamp = stamp;
-    path_pub_.publish(path_);
-  }
+  geometry_msgs::PoseStamped p;
+  p.header = ref_.header;
+  p.pose.position.x = r.pose.x;
+  p.pose.position.y = r.pose.y;
+  p.pose.orientation.z = std::sin(0.5 * r.pose.theta);
+  p.pose.orientation.w = std::cos(0.5 * r.pose.theta);
+  if (path_->add(p)) path_pub_.publish(path_->path());
 }
 
 }  // namespace sowing_robot

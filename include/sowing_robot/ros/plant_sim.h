@@ -20,6 +20,7 @@
 #include "sowing_robot/WheelTorque.h"
 #include "sowing_robot/core/plant.h"
 #include "sowing_robot/core/types.h"
+#include "sowing_robot/ros/path_buffer.h"
 
 namespace sowing_robot {
 
@@ -57,7 +58,8 @@ class PlantSim {
 
   void torqueCallback(const WheelTorque::ConstPtr& msg);
   void publishState(const ros::Time& stamp, bool visuals);
-  bool healthy();
+  /// Stops the process (exit 2, FATAL line) when the state is non-finite or faster than max_speed.
+  void requireHealthy();
   bool running() const { return ros::ok() && !stop_; }
   void runLockstep();
   void runRealtime();
@@ -72,11 +74,10 @@ class PlantSim {
   tf2_ros::TransformBroadcaster tf_;
   nav_msgs::Odometry odom_msg_;
   sensor_msgs::JointState joint_msg_;
-  nav_msgs::Path path_msg_;
+  PathBuffer path_{"odom", 0.05, 10};  // a point every 5 cm, re-sent every 10th point
   std::int64_t visual_every_ = 20;  // publish visuals every n steps
   std::int64_t clock_every_ = 1;    // publish /clock every n steps
   std::int64_t step_ = 0;           // index of the state being published
-  std::int64_t visual_count_ = 0;   // visual publications so far
 
   std::mutex torque_mutex_;
   core::WheelTorques torque_;       // last accepted torque

@@ -19,6 +19,7 @@
 #include "sowing_robot/ReferenceState.h"
 #include "sowing_robot/core/field.h"
 #include "sowing_robot/core/reference.h"
+#include "sowing_robot/ros/path_buffer.h"
 
 namespace sowing_robot {
 
@@ -42,7 +43,7 @@ class ReferenceGenerator {
   ros::Subscriber odom_sub_, obstacles_sub_;
   ros::Publisher ref_pub_, path_pub_, marker_pub_;
   ReferenceState ref_;
-  nav_msgs::Path path_;
+  std::unique_ptr<PathBuffer> path_;  // reference_path (spacing from the parameters)
   bool any_ = false;
   double path_spacing_ = 0.1;  // [m] between stored reference path points
   std::unique_ptr<dynamic_reconfigure::Server<ReferenceGeneratorConfig>> reconfigure_;  // type field only
