@@ -1,11 +1,35 @@
 #include "sowing_robot/core/plant.h"
 
 #include <cmath>
+#include <limits>
 
 #include "sowing_robot/core/validation.h"
 
 namespace sowing_robot {
 namespace core {
+namespace {
+
+// cos and sin of (theta + delta) from cos0 = cos(theta), sin0 = sin(theta) by the angle-sum identity.
+// RK4's heading increments are small (delta = h w / 2 or h w: 1e-3 rad at 1 kHz and 2 rad/s), where the
+// Taylor series below are exact to double rounding (first dropped terms delta^9/9! and delta^10/10!,
+// under 1e-16 of the kept ones for |delta| <= 0.05); larger increments fall back to the library.
+void rotateHeading(double cos0, double sin0, double delta, double& cos_out, double& sin_out) {
+  double cd, sd;
+  if (std::fabs(delta) <= 0.05) {
+    const double d2 = delta * delta;
+    constexpr double k6 = 1.0 / 6.0, k20 = 1.0 / 20.0, k42 = 1.0 / 42.0;  // 3!, 5!/3!, 7!/5!
+    constexpr double k12 = 1.0 / 12.0, k30 = 1.0 / 30.0, k56 = 1.0 / 56.0;  // 4!/2!, 6!/4!, 8!/6!
+    sd = delta * (1.0 - d2 * k6 * (1.0 - d2 * k20 * (1.0 - d2 * k42)));
+    cd = 1.0 - 0.5 * d2 * (1.0 - d2 * k12 * (1.0 - d2 * k30 * (1.0 - d2 * k56)));
+  } else {
+    cd = std::cos(delta);
+    sd = std::sin(delta);
+  }
+  cos_out = cos0 * cd - sin0 * sd;
+  sin_out = sin0 * cd + cos0 * sd;
+}
+
+}  // namespace
 
 std::string PlantDisturbance::validate() const {
   return firstError({checkNonNegative("disturbance.amplitude", amplitude, "N·m"),
@@ -28,6 +52,7 @@ void Plant::reset(const State& initial, double t) {
   time_ = t;
   rng_.seed(disturbance_.seed);
   noise_.reset();
+  cached_disturbance_time_ = std::numeric_limits<double>::quiet_NaN();
 }
 
 void Plant::sinusoidalDisturbance(double t, double& right, double& left) const {
@@ -35,17 +60,27 @@ void Plant::sinusoidalDisturbance(double t, double& right, double& left) const {
     right = left = 0.0;
     return;
   }
-  right = disturbance_.amplitude * std::sin(disturbance_.frequency * t);
-  left = disturbance_.amplitude * std::cos(disturbance_.frequency * t);
+  // One angle held in a local: writing through right could alias disturbance_, which would make the
+  // compiler recompute the product and miss fusing sin and cos into one sincos call.
+  const double angle = disturbance_.frequency * t, amplitude = disturbance_.amplitude;
+  right = amplitude * std::sin(angle);
+  left = amplitude * std::cos(angle);
 }
 
 State Plant::derivative(const State& s, double applied_right, double applied_left) const {
-  const double v = s[V], w = s[OMEGA], th = s[THETA];
+  return derivativeWithHeading(s, std::cos(s[THETA]), std::sin(s[THETA]), applied_right, applied_left);
+}
+
+// Inline body of derivative() with cos/sin of the heading supplied, so that step() can evaluate the
+// four RK4 stages without a call through the shared library's PLT per stage.
+inline State Plant::derivativeWithHeading(const State& s, double cos_th, double sin_th, double applied_right,
+                                          double applied_left) const {
+  const double v = s[V], w = s[OMEGA];
   const double u1 = applied_right + applied_left, u2 = applied_right - applied_left;
   State ds;
   // eq 3.13: unicycle kinematics of the axle midpoint
-  ds[X] = v * std::cos(th);
-  ds[Y] = v * std::sin(th);
+  ds[X] = v * cos_th;
+  ds[Y] = v * sin_th;
   ds[THETA] = w;
   // eq 3.54: m0 v' - mc d w^2 = u1 / R ;  I0 w' + mc d w v = L u2 / R
   ds[V] = (mcd_ * w * w + u1 / nominal_.R) / m0_;
@@ -56,6 +91,17 @@ State Plant::derivative(const State& s, double applied_right, double applied_lef
   return ds;
 }
 
+void Plant::disturbanceAt(double t, double& right, double& left) {
+  // RK4 asks for three times per step (t, t + h/2 twice, t + h) and the next step starts where this one
+  // ended: remembering the last time evaluated halves the sin/cos calls, with bit-identical values.
+  if (t != cached_disturbance_time_) {
+    sinusoidalDisturbance(t, cached_disturbance_right_, cached_disturbance_left_);
+    cached_disturbance_time_ = t;
+  }
+  right = cached_disturbance_right_;
+  left = cached_disturbance_left_;
+}
+
 void Plant::step(double tau_right, double tau_left, double dt) {
   double noise_r = 0.0, noise_l = 0.0;
   if (disturbance_.noise_std > 0.0) {
@@ -63,16 +109,21 @@ void Plant::step(double tau_right, double tau_left, double dt) {
     noise_l = disturbance_.noise_std * noise_(rng_);
   }
   // The sinusoid is evaluated at each RK4 stage time; command and noise are held over the step.
-  auto f = [&](const State& s, double t) {
-    double dr, dl;
-    sinusoidalDisturbance(t, dr, dl);
-    return derivative(s, tau_right + noise_r + dr, tau_left + noise_l + dl);
+  // Stages 2 and 3 share t + h/2, and stage 4's t + h is the next step's stage 1.
+  // The heading's cos/sin come from one sincos at the start of the step, turned by each stage's small
+  // heading increment (rotateHeading), instead of a sincos per stage.
+  const double cos0 = std::cos(state_[THETA]), sin0 = std::sin(state_[THETA]);
+  auto f = [&](const State& s, double t, double heading_increment) {
+    double dr, dl, c, sn;
+    disturbanceAt(t, dr, dl);
+    rotateHeading(cos0, sin0, heading_increment, c, sn);
+    return derivativeWithHeading(s, c, sn, tau_right + noise_r + dr, tau_left + noise_l + dl);
   };
   const double t = time_, h = dt;
-  const State k1 = f(state_, t);
-  const State k2 = f(state_ + 0.5 * h * k1, t + 0.5 * h);
-  const State k3 = f(state_ + 0.5 * h * k2, t + 0.5 * h);
-  const State k4 = f(state_ + h * k3, t + h);
+  const State k1 = f(state_, t, 0.0);
+  const State k2 = f(state_ + 0.5 * h * k1, t + 0.5 * h, 0.5 * h * k1[THETA]);
+  const State k3 = f(state_ + 0.5 * h * k2, t + 0.5 * h, 0.5 * h * k2[THETA]);
+  const State k4 = f(state_ + h * k3, t + h, h * k3[THETA]);
   state_ += (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
   time_ += dt;
 }

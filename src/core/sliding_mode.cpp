@@ -8,17 +8,20 @@
 namespace sowing_robot {
 namespace core {
 
+namespace {
+// root^num with the sign a real odd root of a negative number keeps (even numerators are non-negative).
+double powerOfRoot(double root, int num, bool negative) {
+  double mag = 1.0;
+  for (int i = 0; i < num; ++i) mag *= root;
+  return (num % 2 == 0 || !negative) ? mag : -mag;
+}
+}  // namespace
+
 double realPower(double x, int num, int den) {
-  double mag;
-  if (den == 3) {  // the thesis's 5/3 and 2/3: a cube root and integer multiplications beat pow ~4x
-    const double c = std::cbrt(std::fabs(x));
-    mag = 1.0;
-    for (int i = 0; i < num; ++i) mag *= c;
-  } else {
-    mag = std::pow(std::fabs(x), static_cast<double>(num) / den);
-  }
-  if (num % 2 == 0 || x >= 0.0) return mag;  // even numerator: the real root squared is non-negative
-  return -mag;
+  // the thesis's 5/3 and 2/3: a cube root and integer multiplications beat pow ~4x
+  if (den == 3) return powerOfRoot(std::cbrt(std::fabs(x)), num, x < 0.0);
+  const double mag = std::pow(std::fabs(x), static_cast<double>(num) / den);
+  return (num % 2 == 0 || x >= 0.0) ? mag : -mag;
 }
 
 std::string SlidingModeParams::validate() const {
@@ -73,9 +76,17 @@ void SlidingModeController::surface(Channel& c, double e, double xd_dot, double 
   // S = e + beta (int e)^(p/q)  (eq 4.7).  The derivative term uses (int e)^(p/q - 1): for 1 < p/q < 2
   // its exponent (p-q)/q lies in (0, 1), so it is finite and equals 0 at int e = 0 (no division, no
   // singularity); only its own derivative would be unbounded there, and that never enters the law.
-  s = e + beta * realPower(c.integral, params_.p, params_.q);
-  phi = xd_dot + beta * (static_cast<double>(params_.p) / params_.q) * e *
-                     realPower(c.integral, params_.p - params_.q, params_.q);
+  double power_p, power_p_minus_q;  // (int e)^(p/q) and (int e)^((p-q)/q)
+  if (params_.q == 3) {              // one cube root serves both powers (same values as realPower)
+    const double root = std::cbrt(std::fabs(c.integral));
+    power_p = powerOfRoot(root, params_.p, c.integral < 0.0);
+    power_p_minus_q = powerOfRoot(root, params_.p - params_.q, c.integral < 0.0);
+  } else {
+    power_p = realPower(c.integral, params_.p, params_.q);
+    power_p_minus_q = realPower(c.integral, params_.p - params_.q, params_.q);
+  }
+  s = e + beta * power_p;
+  phi = xd_dot + beta * (static_cast<double>(params_.p) / params_.q) * e * power_p_minus_q;
 }
 
 SlidingModeOutput SlidingModeController::update(const VelocityCommand& desired, double v, double omega, double dt) {

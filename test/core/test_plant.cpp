@@ -114,6 +114,37 @@ TEST(Plant, Rk4ConvergesAtFourthOrder) {
   EXPECT_LT(order, 4.3);
 }
 
+// step() shares the disturbance between RK4 stages and turns one sincos of the heading by each stage's
+// increment; it must agree with the textbook RK4 of derivative() (std::sin/cos per stage) to rounding,
+// both on the small-increment series (1 kHz) and on the library fallback (large steps, fast turn).
+TEST(Plant, StepMatchesTextbookRk4OfDerivative) {
+  PlantDisturbance d;
+  d.sinusoidal = true;
+  RobotParams p;
+  for (const double dt : {1e-3, 0.05}) {
+    Plant plant(p, d), reference(p, d);
+    State x = State::Zero();
+    plant.reset(x);
+    const double tr = 3.0, tl = -1.0;  // turning: heading increments are not zero
+    const int n = static_cast<int>(std::llround(4.0 / dt));
+    for (int i = 0; i < n; ++i) {
+      const double t = i * dt;
+      auto f = [&](const State& s, double ts) {
+        double dr, dl;
+        reference.sinusoidalDisturbance(ts, dr, dl);
+        return reference.derivative(s, tr + dr, tl + dl);
+      };
+      const State k1 = f(x, t), k2 = f(x + 0.5 * dt * k1, t + 0.5 * dt), k3 = f(x + 0.5 * dt * k2, t + 0.5 * dt),
+                  k4 = f(x + dt * k3, t + dt);
+      x += (dt / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+      plant.step(tr, tl, dt);
+    }
+    EXPECT_GT(std::fabs(x[THETA]), 1.0) << "dt " << dt;  // the robot really turned
+    for (int i = 0; i < STATE_SIZE; ++i)
+      EXPECT_NEAR(plant.state()[i], x[i], 1e-11 * (1.0 + std::fabs(x[i]))) << "dt " << dt << " index " << i;
+  }
+}
+
 TEST(Plant, SinusoidalDisturbanceMatchesFigure59) {
   PlantDisturbance d;
   d.sinusoidal = true;

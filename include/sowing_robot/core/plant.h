@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <limits>
 #include <random>
 #include <string>
 
@@ -59,11 +60,18 @@ class Plant {
  private:
   RobotParams nominal_;
   PlantDisturbance disturbance_;
+  State derivativeWithHeading(const State& s, double cos_th, double sin_th, double applied_right,
+                              double applied_left) const;
+  void disturbanceAt(double t, double& right, double& left);  // sinusoidalDisturbance, memoised
+
   double m0_, i0_, mcd_;  // true effective inertias and the coupling mc·d
   State state_ = State::Zero();
   double time_ = 0.0;
   std::mt19937_64 rng_;
   std::normal_distribution<double> noise_{0.0, 1.0};
+  // Last disturbance evaluated (NaN time: none yet). Never compares equal to NaN, so reset() clears it.
+  double cached_disturbance_time_ = std::numeric_limits<double>::quiet_NaN();
+  double cached_disturbance_right_ = 0.0, cached_disturbance_left_ = 0.0;
 };
 
 }  // namespace core

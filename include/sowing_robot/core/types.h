@@ -35,6 +35,7 @@ struct WheelTorques {
 
 /// Wrap an angle to (-pi, pi].
 inline double wrapAngle(double a) {
+  if (a > -M_PI && a <= M_PI) return a;  // what remainder() returns here anyway, without its cost
   a = std::remainder(a, 2.0 * M_PI);
   return a <= -M_PI ? a + 2.0 * M_PI : a;
 }
