@@ -351,8 +351,6 @@ std::unique_ptr<TargetTrajectory> makePath(const FieldParams& p) { return std::m
 FieldReference::FieldReference(const FieldParams& params, std::vector<Obstacle> obstacles)
     : params_(params), field_(params.potential, makePath(params), std::move(obstacles)), duration_(path().duration()) {}
 
-Reference FieldReference::next(double t) { return field_.next(t); }
-
 std::unique_ptr<ReferenceSource> FieldReference::clone() const {
   auto c = std::make_unique<FieldReference>(*this);
   c->reset();

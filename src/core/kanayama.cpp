@@ -1,6 +1,7 @@
 #include "sowing_robot/core/kanayama.h"
 
 #include <cmath>
+#include <stdexcept>
 
 #include "sowing_robot/core/validation.h"
 
@@ -12,6 +13,14 @@ std::string KanayamaGains::validate() const {
                      checkPositive("ktheta", ktheta, "1/m")});
 }
 
+Kanayama::Kanayama(const KanayamaGains& gains) { setGains(gains); }
+
+void Kanayama::setGains(const KanayamaGains& g) {
+  const std::string error = g.validate();
+  if (!error.empty()) throw std::invalid_argument(error);
+  gains_ = g;
+}
+
 PostureError Kanayama::postureError(const Pose2D& r, const Pose2D& a) {
   const double c = std::cos(a.theta), s = std::sin(a.theta);
   const double dx = r.x - a.x, dy = r.y - a.y;
@@ -19,6 +28,9 @@ PostureError Kanayama::postureError(const Pose2D& r, const Pose2D& a) {
 }
 
 VelocityCommand Kanayama::compute(const Reference& ref, const Pose2D& actual, double v, double omega) const {
+  if (!allFinite(ref.pose.x, ref.pose.y, ref.pose.theta, ref.v, ref.omega, ref.v_dot, ref.omega_dot, actual.x,
+                 actual.y, actual.theta, v, omega))
+    return VelocityCommand{};
   const PostureError e = postureError(ref.pose, actual);
   const double c = std::cos(e.thetae), s = std::sin(e.thetae);
   VelocityCommand out;

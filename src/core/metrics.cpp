@@ -1,5 +1,7 @@
 #include "sowing_robot/core/metrics.h"
 
+#include "sowing_robot/core/types.h"
+
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -16,13 +18,17 @@ void MetricsAccumulator::reserve(std::size_t n) {
 }
 
 void MetricsAccumulator::reset() {
-  count_ = 0;
+  count_ = rejected_ = 0;
   acc_ = {};
   t_.clear();
   for (auto& v : e_) v.clear();
 }
 
-void MetricsAccumulator::add(double t, double ex, double ey, double etheta) {
+bool MetricsAccumulator::add(double t, double ex, double ey, double etheta) {
+  if (!allFinite(t, ex, ey, etheta)) {
+    ++rejected_;
+    return false;
+  }
   const std::array<double, AXIS_COUNT> e{ex, ey, etheta};
   if (count_ > 0) {
     const double h = t - last_t_;
@@ -41,6 +47,7 @@ void MetricsAccumulator::add(double t, double ex, double ey, double etheta) {
     t_.push_back(t);
     for (int a = 0; a < AXIS_COUNT; ++a) e_[a].push_back(e[a]);
   }
+  return true;
 }
 
 std::array<AxisMetrics, AXIS_COUNT> MetricsAccumulator::result() const {

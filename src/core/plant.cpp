@@ -2,7 +2,9 @@
 
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
+#include "sowing_robot/core/types.h"
 #include "sowing_robot/core/validation.h"
 
 namespace sowing_robot {
@@ -45,9 +47,13 @@ Plant::Plant(const RobotParams& nominal, const PlantDisturbance& disturbance)
       m0_(nominal.m0() * disturbance.mass_scale),
       i0_(nominal.I0() * disturbance.inertia_scale),
       mcd_(nominal.mc * nominal.d * disturbance.mass_scale),
-      rng_(disturbance.seed) {}
+      rng_(disturbance.seed) {
+  const std::string error = firstError({nominal.validate(), disturbance.validate()});
+  if (!error.empty()) throw std::invalid_argument(error);
+}
 
 void Plant::reset(const State& initial, double t) {
+  if (!initial.allFinite() || !std::isfinite(t)) throw std::invalid_argument("plant reset: non-finite state or time");
   state_ = initial;
   time_ = t;
   rng_.seed(disturbance_.seed);
@@ -102,7 +108,8 @@ void Plant::disturbanceAt(double t, double& right, double& left) {
   left = cached_disturbance_left_;
 }
 
-void Plant::step(double tau_right, double tau_left, double dt) {
+bool Plant::step(double tau_right, double tau_left, double dt) {
+  if (!allFinite(tau_right, tau_left, dt) || !(dt > 0.0)) return false;
   double noise_r = 0.0, noise_l = 0.0;
   if (disturbance_.noise_std > 0.0) {
     noise_r = disturbance_.noise_std * noise_(rng_);
@@ -126,6 +133,7 @@ void Plant::step(double tau_right, double tau_left, double dt) {
   const State k4 = f(state_ + h * k3, t + h, h * k3[THETA]);
   state_ += (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
   time_ += dt;
+  return true;
 }
 
 Eigen::Vector2d Plant::centreOfMass() const {

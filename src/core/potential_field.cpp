@@ -95,7 +95,7 @@ PotentialField& PotentialField::operator=(const PotentialField& o) {
   return *this;
 }
 
-void PotentialField::reset() {
+void PotentialField::restart() {
   state_ = ErrorState{};
   steps_ = 0;
   const TargetState t0 = target_->at(0.0);
@@ -275,9 +275,9 @@ PotentialField::ErrorState PotentialField::rk4(const ErrorState& s, double t, do
   return out;
 }
 
-Reference PotentialField::next(double t) {
+Reference PotentialField::evaluate(double t) {
   const double h = params_.step;
-  if (!(t > 0.0)) t = 0.0;  // also maps NaN to 0
+  if (t < 0.0) t = 0.0;  // (non-finite t never gets here: ReferenceSource::next refuses it)
   while (static_cast<double>(steps_ + 1) * h <= t + kGridSlack) {
     state_ = rk4(state_, static_cast<double>(steps_) * h, h);
     ++steps_;

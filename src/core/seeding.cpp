@@ -68,6 +68,10 @@ void SeedDrill::score(SeedStats& s, double& sum_sq, std::size_t& over, double e)
 }
 
 bool SeedDrill::update(const Eigen::Vector2d& p, bool tool_down, Eigen::Vector2d& seed) {
+  if (!p.allFinite()) {
+    ++rejected_;
+    return false;
+  }
   const bool first = !has_last_;
   const Eigen::Vector2d last = last_;
   has_last_ = true;

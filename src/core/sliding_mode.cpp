@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include "sowing_robot/core/validation.h"
 
@@ -49,11 +50,14 @@ SlidingModeController::SlidingModeController(const SlidingModeParams& params, co
       L_(nominal.L),
       m0_initial_(params.m0_initial > 0.0 ? params.m0_initial : nominal.m0()),
       i0_initial_(params.i0_initial > 0.0 ? params.i0_initial : nominal.I0()) {
+  const std::string error = firstError({params.validate(), nominal.validate()});
+  if (!error.empty()) throw std::invalid_argument(error);
   reset();
 }
 
 void SlidingModeController::reset() {
   linear_ = angular_ = Channel{};
+  last_output_ = SlidingModeOutput{};
   m0_hat_ = m0_initial_;
   i0_hat_ = i0_initial_;
   if (params_.adaptive) {
@@ -63,6 +67,8 @@ void SlidingModeController::reset() {
 }
 
 void SlidingModeController::setParams(const SlidingModeParams& params) {
+  const std::string error = params.validate();
+  if (!error.empty()) throw std::invalid_argument(error);
   params_ = params;
   if (params_.adaptive) {
     m0_hat_ = std::clamp(m0_hat_, params_.m0_min, params_.m0_max);
@@ -90,6 +96,11 @@ void SlidingModeController::surface(Channel& c, double e, double xd_dot, double 
 }
 
 SlidingModeOutput SlidingModeController::update(const VelocityCommand& desired, double v, double omega, double dt) {
+  if (!allFinite(desired.v, desired.omega, desired.v_dot, desired.omega_dot, v, omega, dt) || !(dt > 0.0)) {
+    SlidingModeOutput held = last_output_;
+    held.rejected = true;
+    return held;
+  }
   SlidingModeOutput out;
   out.e_v = desired.v - v;  // e = X_d - X: the sign eq 4.9 onwards uses (eq 4.5 prints X - X_d)
   out.e_omega = desired.omega - omega;
@@ -114,6 +125,7 @@ SlidingModeOutput SlidingModeController::update(const VelocityCommand& desired, 
   out.torques.right = std::clamp(right, -params_.max_torque, params_.max_torque);
   out.torques.left = std::clamp(left, -params_.max_torque, params_.max_torque);
   out.saturated = out.torques.right != right || out.torques.left != left;
+  last_output_ = out;
   return out;
 }
 

@@ -25,12 +25,11 @@ RunMonitor::RunMonitor(ros::NodeHandle nh, ros::NodeHandle pnh) {
 void RunMonitor::errorCallback(const TrackingError::ConstPtr& msg) {
   if (done_) return;
   if (metrics_.samples() > 0 && msg->header.stamp <= last_) return;  // repeats answer a retried state
-  if (!core::allFinite(msg->x, msg->y, msg->theta)) {
+  if (!metrics_.add(msg->header.stamp.toSec(), msg->x, msg->y, msg->theta)) {  // refuses non-finite errors
     ROS_WARN_THROTTLE(1.0, "run_monitor: non-finite tracking error ignored");
     return;
   }
   last_ = msg->header.stamp;
-  metrics_.add(msg->header.stamp.toSec(), msg->x, msg->y, msg->theta);
   if (msg->header.stamp.toSec() >= duration_ - 1e-9) finish();
 }
 

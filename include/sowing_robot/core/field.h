@@ -128,9 +128,6 @@ class FieldReference : public ReferenceSource {
   /// Throws std::invalid_argument on invalid parameters or obstacles.
   explicit FieldReference(const FieldParams& params, std::vector<Obstacle> obstacles = {});
 
-  void reset() override { field_.reset(); }
-  /// Reference at t; tool_down = true on rows, false on turns and once finished.
-  Reference next(double t) override;
   std::unique_ptr<ReferenceSource> clone() const override;
 
   /// True once the path has ended (t >= duration()); the reference then stops at the last row's end.
@@ -145,6 +142,11 @@ class FieldReference : public ReferenceSource {
   const PotentialField& potentialField() const { return field_; }
   const FieldPath& path() const { return static_cast<const FieldPath&>(field_.target()); }
   const FieldParams& params() const { return params_; }
+
+ protected:
+  void restart() override { field_.reset(); }
+  /// Reference at t; tool_down = true on rows, false on turns and once finished.
+  Reference evaluate(double t) override { return field_.next(t); }
 
  private:
   FieldParams params_;

@@ -22,21 +22,24 @@ struct PostureError {
 
 class Kanayama {
  public:
-  explicit Kanayama(const KanayamaGains& gains = {}) : gains_(gains) {}
+  /// Throws std::invalid_argument when the gains do not validate.
+  explicit Kanayama(const KanayamaGains& gains = {});
 
   /// eq 4.1: e_p = T(theta)^T (P_r - P_A), with theta_e wrapped to (-pi, pi].
   static PostureError postureError(const Pose2D& reference, const Pose2D& actual);
 
   /// eq 4.2 for the velocities. The accelerations are the exact time derivatives of eq 4.2 along the
   /// error dynamics (eq 4.15) evaluated with the measured velocities v, omega, so no numerical
-  /// differentiation (and no filter lag) enters the inner loop.
+  /// differentiation (and no filter lag) enters the inner loop. A non-finite input gives the stop
+  /// command (all zero), never a NaN: the safe output of a stateless controller.
   VelocityCommand compute(const Reference& ref, const Pose2D& actual, double v, double omega) const;
 
   /// eq 4.14: L0 = (xe^2 + ye^2)/2 + (1 - cos thetae)/ky.
   double lyapunov(const PostureError& e) const;
 
   const KanayamaGains& gains() const { return gains_; }
-  void setGains(const KanayamaGains& g) { gains_ = g; }
+  /// Throws std::invalid_argument (gains kept) when g does not validate.
+  void setGains(const KanayamaGains& g);
 
  private:
   KanayamaGains gains_;

@@ -31,15 +31,18 @@ class MetricsAccumulator {
   explicit MetricsAccumulator(bool keep_samples = true) : keep_(keep_samples) {}
   void reserve(std::size_t n);
   void reset();
-  /// One sample at time t [s] of the world-frame errors (x, y [m]; theta [rad]).
-  void add(double t, double ex, double ey, double etheta);
+  /// One sample at time t [s] of the world-frame errors (x, y [m]; theta [rad]). A sample with a
+  /// non-finite value is refused (returns false, counted by rejected()) so that one bad message cannot
+  /// turn every integral into NaN; a diverged run is the caller's to report (runClosedLoop: +inf).
+  bool add(double t, double ex, double ey, double etheta);
   /// Integrals so far and, when samples are kept, the time-domain figures.
   std::array<AxisMetrics, AXIS_COUNT> result() const;
   std::size_t samples() const { return count_; }
+  std::size_t rejected() const { return rejected_; }
 
  private:
   bool keep_;
-  std::size_t count_ = 0;
+  std::size_t count_ = 0, rejected_ = 0;
   double last_t_ = 0.0;
   std::array<double, AXIS_COUNT> last_e_{};
   std::array<AxisMetrics, AXIS_COUNT> acc_{};

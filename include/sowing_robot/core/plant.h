@@ -34,13 +34,17 @@ struct PlantDisturbance {
 /// (REP-105 base_link); the centre of mass sits d ahead of it.
 class Plant {
  public:
+  /// Throws std::invalid_argument when either does not validate.
   Plant(const RobotParams& nominal, const PlantDisturbance& disturbance);
 
-  /// Start again at time t with the given state (noise generator re-seeded).
+  /// Start again at time t with the given state (noise generator re-seeded). Throws
+  /// std::invalid_argument for a non-finite state or time.
   void reset(const State& initial, double t = 0.0);
 
-  /// Advance by dt [s] with the commanded wheel torques [N·m], held constant over the step.
-  void step(double tau_right, double tau_left, double dt);
+  /// Advance by dt [s] with the commanded wheel torques [N·m], held constant over the step. Returns
+  /// false, leaving the state, the time and the noise generator untouched, when a torque is not finite
+  /// or dt is not a finite positive number: bad input never reaches the integrator.
+  bool step(double tau_right, double tau_left, double dt);
 
   /// Time derivative of the state for the *applied* torques (commands + disturbance already added).
   State derivative(const State& s, double applied_right, double applied_left) const;

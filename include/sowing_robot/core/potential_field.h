@@ -126,10 +126,6 @@ class PotentialField : public ReferenceSource {
   PotentialField(PotentialField&&) = default;
   PotentialField& operator=(PotentialField&&) = default;
 
-  /// Reference back on the target at t = 0 (position p_d(0), velocity p_d'(0)).
-  void reset() override;
-  /// Reference at t [s], t non-decreasing after reset(). tool_down is the target's.
-  Reference next(double t) override;
   /// Same params, target and current obstacle list, in the reset state.
   std::unique_ptr<ReferenceSource> clone() const override;
 
@@ -157,6 +153,12 @@ class PotentialField : public ReferenceSource {
   const Eigen::Vector2d& position() const { return out_p_; }
   const Eigen::Vector2d& velocity() const { return out_v_; }
   const Eigen::Vector2d& acceleration() const { return out_a_; }
+
+ protected:
+  /// Reference back on the target at t = 0 (position p_d(0), velocity p_d'(0)).
+  void restart() override;
+  /// Reference at t [s], t non-decreasing after reset(). tool_down is the target's.
+  Reference evaluate(double t) override;
 
  private:
   struct ErrorState {

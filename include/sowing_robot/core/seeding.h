@@ -46,7 +46,8 @@ class SeedDrill {
             double influence);
 
   /// Advance the tool point to p; tool_down is the reference's request. Returns true (and the seed
-  /// position) when a seed falls here.
+  /// position) when a seed falls here. A non-finite p is refused (false, state untouched, counted by
+  /// rejected()), so it can neither drop a seed nor spoil the distance travelled.
   bool update(const Eigen::Vector2d& p, bool tool_down, Eigen::Vector2d& seed);
 
   /// Distance from p to the nearest row segment [m].
@@ -60,6 +61,7 @@ class SeedDrill {
   const SeedStats& onRows() const { return rows_stats_; }      ///< seeds away from obstacles
   const SeedStats& detours() const { return detour_stats_; }   ///< seeds in detour zones
   std::string report() const;
+  std::size_t rejected() const { return rejected_; }
 
  private:
   void score(SeedStats& s, double& sum_sq, std::size_t& over, double e);
@@ -68,6 +70,7 @@ class SeedDrill {
   std::vector<RowSegment> rows_;
   std::vector<Obstacle> obstacles_;
   double influence_;
+  std::size_t rejected_ = 0;
   bool has_last_ = false;
   bool lowered_ = false;  // tool physically down
   Eigen::Vector2d last_ = Eigen::Vector2d::Zero();

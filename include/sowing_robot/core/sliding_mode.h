@@ -37,25 +37,30 @@ struct SlidingModeOutput {
   double s_v = 0.0, s_omega = 0.0;  ///< sliding variables S1, S2
   double u1 = 0.0, u2 = 0.0;        ///< before saturation
   bool saturated = false;
+  bool rejected = false;  ///< the input was not finite: the previous output, held (see update())
 };
 
 class SlidingModeController {
  public:
-  /// `nominal` gives R, L and (where the params leave them <= 0) the initial m0, I0 estimates.
+  /// `nominal` gives R, L and (where the params leave them <= 0) the initial m0, I0 estimates. Throws
+  /// std::invalid_argument when either does not validate.
   SlidingModeController(const SlidingModeParams& params, const RobotParams& nominal);
 
-  /// Zero the integrals and return the estimates to their initial values.
+  /// Zero the integrals and return the estimates to their initial values (and the held output to zero).
   void reset();
   /// Zero only the sliding-surface integrals (estimates kept): a clean restart after an input gap.
   void resetSurfaces() { linear_ = angular_ = Channel{}; }
 
-  /// One control period of length dt [s]. Non-finite inputs must be rejected by the caller.
+  /// One control period of length dt [s]. A non-finite input (or dt not a finite positive number) is
+  /// rejected: integrals and adaptive estimates are untouched and the previous output is returned
+  /// again with rejected = true (zero torques before the first accepted period).
   SlidingModeOutput update(const VelocityCommand& desired, double v, double omega, double dt);
 
   double m0Hat() const { return m0_hat_; }
   double i0Hat() const { return i0_hat_; }
   const SlidingModeParams& params() const { return params_; }
-  /// Change gains live (integrals and estimates are kept; estimates clamped into new bounds).
+  /// Change gains live (integrals and estimates are kept; estimates clamped into new bounds). Throws
+  /// std::invalid_argument, keeping the old parameters, when params do not validate.
   void setParams(const SlidingModeParams& params);
 
  private:
@@ -70,6 +75,7 @@ class SlidingModeController {
   double m0_initial_, i0_initial_;
   double m0_hat_, i0_hat_;
   Channel linear_, angular_;
+  SlidingModeOutput last_output_;  ///< held on a rejected input
 };
 
 }  // namespace core
