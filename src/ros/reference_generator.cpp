@@ -15,6 +15,7 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
   const std::string type = p.get("type", "line");
   const double v_r = p.get("line/v_r", 1.0), row_y = p.get("line/y", 3.0), x0 = p.get("line/x0", 0.0);
   path_spacing_ = p.get("path_spacing", path_spacing_);
+  lookahead_ = p.get("lookahead", lookahead_);
   // The field keys are read whatever the type (so a field block left in a line run is not "unknown"),
   // but only the active type is validated.
   std::string field_error;
@@ -22,6 +23,7 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
   std::vector<core::Obstacle> obstacles;
   const std::string obstacle_error = loadObstacles(p, "obstacles", obstacles);
   std::string error = type == "line" || type == "field" ? "" : "type = '" + type + "' must be 'line' or 'field'";
+  period_ns_ = loadControlPeriod(p, error);
   if (error.empty() && type == "line")
     error = core::firstError({core::checkRange("line/v_r", v_r, 0.0, 10.0, "m/s"),
                               core::allFinite(row_y, x0) ? "" : "line/y and line/x0 must be finite",
@@ -190,32 +192,62 @@ void ReferenceGenerator::reconfigure(ReferenceGeneratorConfig& config, uint32_t)
            config.beta, config.gain, config.tangential_ratio);
 }
 
+void ReferenceGenerator::fill(ReferenceState& out, const ros::Time& stamp) {
+  const core::Reference r = source_->next(stamp.toSec());
+  out.header.stamp = stamp;
+  out.header.frame_id = "odom";
+  out.x = r.pose.x;
+  out.y = r.pose.y;
+  out.theta = r.pose.theta;
+  out.v = r.v;
+  out.omega = r.omega;
+  out.v_dot = r.v_dot;
+  out.omega_dot = r.omega_dot;
+  out.tool_down = r.tool_down;
+}
+
 void ReferenceGenerator::odomCallback(const nav_msgs::Odometry::ConstPtr& msg) {
   const ros::Time& stamp = msg->header.stamp;
   if (any_ && stamp <= ref_.header.stamp) {  // a repeat (or an old state): answer with what we said
     if (stamp == ref_.header.stamp) publishShared(ref_pub_, ref_);
     return;
   }
-  const core::Reference r = source_->next(stamp.toSec());
-  ref_.header.stamp = stamp;
-  ref_.header.frame_id = "odom";
-  ref_.x = r.pose.x;
-  ref_.y = r.pose.y;
-  ref_.theta = r.pose.theta;
-  ref_.v = r.v;
-  ref_.omega = r.omega;
-  ref_.v_dot = r.v_dot;
-  ref_.omega_dot = r.omega_dot;
-  ref_.tool_down = r.tool_down;
-  publishShared(ref_pub_, ref_);
+  if (ahead_valid_ && stamp == ahead_.header.stamp) {
+    ref_ = ahead_;  // published one period ago
+  } else {
+    if (ahead_valid_ && stamp < ahead_.header.stamp) {
+      // States come more often than control_rate says, and the source cannot go back to this time:
+      // answer once with the reference already computed (one step late) and stop looking ahead.
+      ROS_ERROR("reference_generator: state at t=%.6f s is before the reference already sent for t=%.6f s: "
+                "control_rate (%.3f Hz) does not match plant_sim's; lookahead switched off",
+                stamp.toSec(), ahead_.header.stamp.toSec(), 1e9 / period_ns_);
+      lookahead_ = false;
+      ahead_valid_ = false;
+      ref_ = ahead_;
+      ref_.header.stamp = stamp;
+    } else {
+      fill(ref_, stamp);
+    }
+    publishShared(ref_pub_, ref_);
+  }
   any_ = true;
+  if (lookahead_) {
+    // The reference depends on time (and the obstacle list) only: send the one for the next period now,
+    // so that the kinematic controller has it when that state arrives and this node is off the loop's
+    // critical path (one hop fewer per lockstep step).
+    ros::Time next;
+    next.fromNSec(stamp.toNSec() + static_cast<std::uint64_t>(period_ns_));
+    fill(ahead_, next);
+    publishShared(ref_pub_, ahead_);
+    ahead_valid_ = true;
+  }
 
   geometry_msgs::PoseStamped p;
   p.header = ref_.header;
-  p.pose.position.x = r.pose.x;
-  p.pose.position.y = r.pose.y;
-  p.pose.orientation.z = std::sin(0.5 * r.pose.theta);
-  p.pose.orientation.w = std::cos(0.5 * r.pose.theta);
+  p.pose.position.x = ref_.x;
+  p.pose.position.y = ref_.y;
+  p.pose.orientation.z = std::sin(0.5 * ref_.theta);
+  p.pose.orientation.w = std::cos(0.5 * ref_.theta);
   if (path_->add(p)) path_pub_.publish(path_->path());
 }
 

@@ -1,5 +1,7 @@
 // reference_generator: publishes the reference posture, velocities and accelerations for every state
-// the plant publishes (same stamp), plus the reference path for rviz.
+// the plant publishes (same stamp), plus the reference path for rviz. With `lookahead` (default) the
+// reference for t_k + 1/control_rate goes out together with the one for t_k: an obstacle or gain change
+// then takes effect one period later, and the loop does not wait for this node.
 //   type line:  core::LineReference (the thesis's sowing line).
 //   type field: core::FieldReference (rows + headland turns through the potential field) with the
 //               obstacles from the `obstacles` parameter; `obstacles` (MarkerArray) replaces them at
@@ -12,6 +14,7 @@
 #include <ros/ros.h>
 #include <visualization_msgs/MarkerArray.h>
 
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -29,6 +32,8 @@ class ReferenceGenerator {
 
  private:
   void odomCallback(const nav_msgs::Odometry::ConstPtr& msg);
+  /// The source's reference at stamp into out.
+  void fill(ReferenceState& out, const ros::Time& stamp);
   /// type field: every ADD CYLINDER marker is an obstacle (centre = pose.position, radius = scale.x / 2);
   /// the message replaces the whole list. A message with a non-finite or non-positive value is dropped.
   void obstaclesCallback(const visualization_msgs::MarkerArray::ConstPtr& msg);
@@ -42,7 +47,11 @@ class ReferenceGenerator {
   std::vector<core::Obstacle> obstacles_;  ///< the obstacles in force (type field)
   ros::Subscriber odom_sub_, obstacles_sub_;
   ros::Publisher ref_pub_, path_pub_, marker_pub_;
-  ReferenceState ref_;
+  ReferenceState ref_;    ///< reference for the newest state
+  ReferenceState ahead_;  ///< reference for one period after it (lookahead), already published
+  bool ahead_valid_ = false;
+  bool lookahead_ = true;
+  std::int64_t period_ns_ = 1000000;  ///< control period (control_rate) [ns]
   std::unique_ptr<PathBuffer> path_;  // reference_path (spacing from the parameters)
   bool any_ = false;
   double path_spacing_ = 0.1;  // [m] between stored reference path points
