@@ -7,7 +7,7 @@ int main(int argc, char** argv) {
   ros::init(argc, argv, "plant_sim");
   ros::NodeHandle nh, pnh("~");
   sowing_robot::PlantSim node(nh, pnh);
-  ros::AsyncSpinner spinner(1);  // callbacks; the simulation loop runs on this thread
+  ros::AsyncSpinner spinner(1);  // the global queue; run() serves the wheel_torque queue itself
   spinner.start();
   node.run();
   if (!node.exitAtEnd()) ros::waitForShutdown();

@@ -2,7 +2,6 @@
 
 #include <rosgraph_msgs/Clock.h>
 
-#include <chrono>
 #include <cmath>
 
 #include "sowing_robot/core/validation.h"
@@ -77,8 +76,11 @@ PlantSim::PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh) {
   odom_pub_ = nh_.advertise<nav_msgs::Odometry>("odom", kLockstepQueue);
   joint_pub_ = nh_.advertise<sensor_msgs::JointState>("joint_states", 10);
   path_pub_ = nh_.advertise<nav_msgs::Path>("travelled_path", 1, true);
-  torque_sub_ = nh_.subscribe("wheel_torque", 50, &PlantSim::torqueCallback, this,
-                              ros::TransportHints().tcpNoDelay());
+  ros::SubscribeOptions torque_options = ros::SubscribeOptions::create<WheelTorque>(
+      "wheel_torque", 50, [this](const WheelTorque::ConstPtr& m) { torqueCallback(m); }, ros::VoidPtr(),
+      &torque_queue_);
+  torque_options.transport_hints = ros::TransportHints().tcpNoDelay();
+  torque_sub_ = nh_.subscribe(torque_options);
 
   odom_msg_.header.frame_id = "odom";
   odom_msg_.child_frame_id = "base_link";
@@ -94,7 +96,6 @@ void PlantSim::torqueCallback(const WheelTorque::ConstPtr& msg) {
                       msg->right, msg->left, static_cast<long>(rejected_));
     return;
   }
-  std::lock_guard<std::mutex> lock(torque_mutex_);
   if (cfg_.lockstep) {
     if (msg->header.stamp != waiting_for_) {
       if (msg->header.stamp < waiting_for_) {
@@ -110,7 +111,19 @@ void PlantSim::torqueCallback(const WheelTorque::ConstPtr& msg) {
   torque_stamp_ = msg->header.stamp;
   torque_valid_ = true;
   got_torque_ = true;
-  torque_cv_.notify_one();
+}
+
+namespace {
+// An empty callback: queued by stop() to end run()'s wait on the torque queue at once.
+class WakeUp : public ros::CallbackInterface {
+ public:
+  CallResult call() override { return Success; }
+};
+}  // namespace
+
+void PlantSim::stop() {
+  stop_ = true;
+  torque_queue_.addCallback(boost::make_shared<WakeUp>());
 }
 
 void PlantSim::publishState(const ros::Time& stamp, bool visuals) {
@@ -165,8 +178,8 @@ void PlantSim::requireHealthy() {
 }
 
 void PlantSim::runLockstep() {
-  // Callbacks run on other threads (the node's AsyncSpinner or the nodelet manager): this thread only
-  // publishes, waits on the condition variable the torque callback signals, and integrates.
+  // This thread publishes the state, serves the torque queue until the torque for that state has come,
+  // and integrates: the torque callback runs here, so no other thread needs waking.
   ros::WallTime waited = ros::WallTime::now();
   while (running() && (static_cast<int>(odom_pub_.getNumSubscribers()) < cfg_.min_subscribers ||
                        torque_sub_.getNumPublishers() < 1)) {
@@ -181,35 +194,31 @@ void PlantSim::runLockstep() {
   const std::int64_t n = cfg_.duration > 0.0 ? std::llround(cfg_.duration * 1e9 / cfg_.period_ns) : -1;
   const double dt = core::secondsFromNanos(cfg_.period_ns);
   const ros::WallTime wall_start = ros::WallTime::now();
-  const auto retry = std::chrono::duration<double>(cfg_.lockstep_retry);
+  const ros::WallDuration retry(cfg_.lockstep_retry);
   for (std::int64_t k = 0; running() && (n < 0 || k <= n); ++k) {
     const ros::Time stamp = stampOf(k, cfg_.period_ns);
-    {
-      std::lock_guard<std::mutex> lock(torque_mutex_);
-      waiting_for_ = stamp;
-      got_torque_ = false;
-    }
+    waiting_for_ = stamp;
+    got_torque_ = false;
     step_ = k;
     publishState(stamp, k % visual_every_ == 0 || k == n);
-    ros::WallTime stalled_since = ros::WallTime::now();
-    core::WheelTorques u;
-    {
-      std::unique_lock<std::mutex> lock(torque_mutex_);
-      while (running() && !torque_cv_.wait_for(lock, retry, [this] { return got_torque_.load(); })) {
-        lock.unlock();
-        publishState(stamp, false);  // a connection that came late gets the state again
-        if ((ros::WallTime::now() - stalled_since).toSec() > cfg_.lockstep_timeout) {
-          ROS_ERROR("plant_sim: lockstep stalled at t=%.6f s: no wheel_torque stamped for it after %.1f s wall "
-                    "(%u publisher(s) on %s%s); waiting",
-                    stamp.toSec(), cfg_.lockstep_timeout, torque_sub_.getNumPublishers(),
-                    torque_sub_.getTopic().c_str(),
-                    torque_sub_.getNumPublishers() == 0 ? ": is torque_controller running?" : "");
-          stalled_since = ros::WallTime::now();
-        }
-        lock.lock();
+    ros::WallTime stalled_since = ros::WallTime::now(), sent = stalled_since;
+    while (running() && !got_torque_) {
+      torque_queue_.callAvailable(retry);  // returns after a callback (any stamp) or the retry time
+      if (got_torque_ || !running()) break;
+      const ros::WallTime now = ros::WallTime::now();
+      if (now - sent < retry) continue;
+      publishState(stamp, false);  // a connection that came late gets the state again
+      sent = now;
+      if ((now - stalled_since).toSec() > cfg_.lockstep_timeout) {
+        ROS_ERROR("plant_sim: lockstep stalled at t=%.6f s: no wheel_torque stamped for it after %.1f s wall "
+                  "(%u publisher(s) on %s%s); waiting",
+                  stamp.toSec(), cfg_.lockstep_timeout, torque_sub_.getNumPublishers(),
+                  torque_sub_.getTopic().c_str(),
+                  torque_sub_.getNumPublishers() == 0 ? ": is torque_controller running?" : "");
+        stalled_since = now;
       }
-      u = torque_;
     }
+    const core::WheelTorques u = torque_;
     if (!running() || k == n) break;
     plant_->step(u.right, u.left, dt);
     requireHealthy();
@@ -240,15 +249,13 @@ void PlantSim::runRealtime() {
                                                    cfg_.realtime_factor / dt);
       ROS_WARN_THROTTLE(10.0, "plant_sim: realtime fell behind the wall clock; slipping (machine overloaded?)");
     }
+    torque_queue_.callAvailable();  // every torque that came during the step; the newest is held
     core::WheelTorques u;
-    {
-      std::lock_guard<std::mutex> lock(torque_mutex_);
-      const bool fresh = torque_valid_ && (stamp - torque_stamp_).toSec() <= cfg_.torque_timeout;
-      if (fresh) u = torque_;
-      if (!fresh && torque_valid_) {
-        ROS_WARN_THROTTLE(2.0, "plant_sim: no wheel_torque for %.3f s (timeout %.3f s): applying zero torque",
-                          (stamp - torque_stamp_).toSec(), cfg_.torque_timeout);
-      }
+    const bool fresh = torque_valid_ && (stamp - torque_stamp_).toSec() <= cfg_.torque_timeout;
+    if (fresh) u = torque_;
+    if (!fresh && torque_valid_) {
+      ROS_WARN_THROTTLE(2.0, "plant_sim: no wheel_torque for %.3f s (timeout %.3f s): applying zero torque",
+                        (stamp - torque_stamp_).toSec(), cfg_.torque_timeout);
     }
     plant_->step(u.right, u.left, dt);
     requireHealthy();

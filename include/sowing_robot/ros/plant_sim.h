@@ -8,14 +8,13 @@
 
 #include <nav_msgs/Odometry.h>
 #include <nav_msgs/Path.h>
+#include <ros/callback_queue.h>
 #include <ros/ros.h>
 #include <sensor_msgs/JointState.h>
 #include <tf2_ros/transform_broadcaster.h>
 
 #include <atomic>
-#include <condition_variable>
 #include <memory>
-#include <mutex>
 
 #include "sowing_robot/WheelTorque.h"
 #include "sowing_robot/core/plant.h"
@@ -29,13 +28,11 @@ class PlantSim {
   /// Loads and validates all parameters; refuses to start (exit 1) on a bad one.
   PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh);
   /// Runs the simulation on the calling thread until shutdown, stop(), or the end of a lockstep
-  /// scenario. Callbacks must be served by other threads (an AsyncSpinner, or the nodelet manager).
+  /// scenario. The wheel_torque callback runs on this thread too (its own callback queue, served by
+  /// the loop): in lockstep the torque wakes the loop directly, with no hand-over between threads.
   void run();
-  /// Ask run() to return (nodelet unload).
-  void stop() {
-    stop_ = true;
-    torque_cv_.notify_all();
-  }
+  /// Ask run() to return (nodelet unload); safe from any thread.
+  void stop();
   /// exit_at_end: the process should end when run() returns after a lockstep scenario.
   bool exitAtEnd() const { return cfg_.lockstep && cfg_.exit_at_end; }
 
@@ -79,13 +76,13 @@ class PlantSim {
   std::int64_t clock_every_ = 1;    // publish /clock every n steps
   std::int64_t step_ = 0;           // index of the state being published
 
-  std::mutex torque_mutex_;
+  // Served only by run()'s thread, so the torque state below needs no lock.
+  ros::CallbackQueue torque_queue_;
   core::WheelTorques torque_;       // last accepted torque
   ros::Time torque_stamp_;          // its stamp
   bool torque_valid_ = false;
   ros::Time waiting_for_;           // lockstep: the stamp we need a torque for
-  std::atomic<bool> got_torque_{false};
-  std::condition_variable torque_cv_;
+  bool got_torque_ = false;
   std::atomic<bool> stop_{false};
   std::int64_t rejected_ = 0, late_ = 0;
 };
