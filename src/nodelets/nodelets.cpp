@@ -1,17 +1,20 @@
 // Every node as a nodelet: the same wrapper class, constructed in onInit() with the nodelet's handles,
 // so a manager can pass the lockstep messages as shared pointers without serialisation.
 //
-// Each nodelet serves its callbacks on a thread of its own rather than the manager's pool: the pool
-// hands every callback from a dispatcher thread to a worker (two wake-ups per message), a dedicated
-// thread takes it straight from the publisher (one). The lockstep loop is a chain of such hops, so this
-// roughly halves the thread hand-overs on its critical path. A nodelet's callbacks stay serialised, as
-// with getNodeHandle().
+// The callback-driven nodelets of one manager share one callback queue served by one thread, instead of
+// the manager's pool. The pool hands every callback from a dispatcher thread to a worker: two thread
+// wake-ups per message, and a lockstep step is a chain of messages (state -> kinematic -> torque, plus
+// the reference, seed drill and monitor). On one shared thread a message published from a callback is
+// queued behind it and taken by the same thread without any wake-up, so a step costs two hand-overs in
+// all (plant -> callbacks -> plant). None of these callbacks blocks, so sharing a thread cannot deadlock;
+// each nodelet's callbacks stay serialised, as with getNodeHandle().
 #include <nodelet/nodelet.h>
 #include <pluginlib/class_list_macros.hpp>
 #include <ros/callback_queue.h>
 #include <ros/spinner.h>
 
 #include <memory>
+#include <mutex>
 #include <thread>
 
 #include "sowing_robot/ros/kinematic_controller.h"
@@ -23,22 +26,43 @@
 
 namespace sowing_robot {
 
+/// The callback queue and thread shared by the nodelets of this library in one manager; it lives while
+/// any of them holds it.
+class SharedCallbackThread {
+ public:
+  static std::shared_ptr<SharedCallbackThread> acquire() {
+    static std::mutex mutex;
+    static std::weak_ptr<SharedCallbackThread> current;
+    std::lock_guard<std::mutex> lock(mutex);
+    std::shared_ptr<SharedCallbackThread> p = current.lock();
+    if (!p) {
+      p = std::shared_ptr<SharedCallbackThread>(new SharedCallbackThread);
+      current = p;
+    }
+    return p;
+  }
+  ros::CallbackQueue* queue() { return &queue_; }
+
+ private:
+  SharedCallbackThread() : spinner_(1, &queue_) { spinner_.start(); }
+  ros::CallbackQueue queue_;
+  ros::AsyncSpinner spinner_;  // after queue_: stopped (destroyed) before it
+};
+
 /// Callback-driven nodes: the wrapper lives as long as the nodelet.
 template <typename Wrapper>
 class WrapperNodelet : public nodelet::Nodelet {
  private:
   void onInit() override {
+    thread_ = SharedCallbackThread::acquire();
     ros::NodeHandle nh = getNodeHandle(), pnh = getPrivateNodeHandle();
-    nh.setCallbackQueue(&queue_);
-    pnh.setCallbackQueue(&queue_);
+    nh.setCallbackQueue(thread_->queue());
+    pnh.setCallbackQueue(thread_->queue());
     impl_ = std::make_unique<Wrapper>(nh, pnh);
-    spinner_ = std::make_unique<ros::AsyncSpinner>(1, &queue_);
-    spinner_->start();
   }
-  // Declared so that destruction stops the thread first, then drops the subscriptions, then the queue.
-  ros::CallbackQueue queue_;
+  // impl_ (its subscriptions) goes before the queue it uses.
+  std::shared_ptr<SharedCallbackThread> thread_;
   std::unique_ptr<Wrapper> impl_;
-  std::unique_ptr<ros::AsyncSpinner> spinner_;
 };
 
 using KinematicControllerNodelet = WrapperNodelet<KinematicController>;

@@ -1,12 +1,5 @@
 // Standalone reference_generator node: the wrapper class does the work.
-#include <ros/ros.h>
-
 #include "sowing_robot/ros/reference_generator.h"
+#include "sowing_robot/ros/node_main.h"
 
-int main(int argc, char** argv) {
-  ros::init(argc, argv, "reference_generator");
-  ros::NodeHandle nh, pnh("~");
-  sowing_robot::ReferenceGenerator node(nh, pnh);
-  ros::spin();
-  return 0;
-}
+int main(int argc, char** argv) { return sowing_robot::runCallbackNode<sowing_robot::ReferenceGenerator>(argc, argv, "reference_generator"); }

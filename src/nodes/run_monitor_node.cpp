@@ -1,12 +1,5 @@
 // Standalone run_monitor node: the wrapper class does the work.
-#include <ros/ros.h>
-
 #include "sowing_robot/ros/run_monitor.h"
+#include "sowing_robot/ros/node_main.h"
 
-int main(int argc, char** argv) {
-  ros::init(argc, argv, "run_monitor");
-  ros::NodeHandle nh, pnh("~");
-  sowing_robot::RunMonitor node(nh, pnh);
-  ros::spin();
-  return 0;
-}
+int main(int argc, char** argv) { return sowing_robot::runCallbackNode<sowing_robot::RunMonitor>(argc, argv, "run_monitor"); }

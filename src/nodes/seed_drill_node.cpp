@@ -1,12 +1,5 @@
 // Standalone seed_drill node: the wrapper class does the work.
-#include <ros/ros.h>
-
 #include "sowing_robot/ros/seed_drill.h"
+#include "sowing_robot/ros/node_main.h"
 
-int main(int argc, char** argv) {
-  ros::init(argc, argv, "seed_drill");
-  ros::NodeHandle nh, pnh("~");
-  sowing_robot::SeedDrillNode node(nh, pnh);
-  ros::spin();
-  return 0;
-}
+int main(int argc, char** argv) { return sowing_robot::runCallbackNode<sowing_robot::SeedDrillNode>(argc, argv, "seed_drill"); }

@@ -1,12 +1,5 @@
 // Standalone torque_controller node: the wrapper class does the work.
-#include <ros/ros.h>
-
 #include "sowing_robot/ros/torque_controller.h"
+#include "sowing_robot/ros/node_main.h"
 
-int main(int argc, char** argv) {
-  ros::init(argc, argv, "torque_controller");
-  ros::NodeHandle nh, pnh("~");
-  sowing_robot::TorqueController node(nh, pnh);
-  ros::spin();
-  return 0;
-}
+int main(int argc, char** argv) { return sowing_robot::runCallbackNode<sowing_robot::TorqueController>(argc, argv, "torque_controller"); }

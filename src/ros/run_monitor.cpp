@@ -42,7 +42,7 @@ void RunMonitor::finish() {
   std::fflush(stdout);
   if (!output_.empty() && !core::writeMetricsYaml(output_, label_, m))
     ROS_ERROR("run_monitor: could not write %s", output_.c_str());
-  if (exit_at_end_) ros::shutdown();
+  if (exit_at_end_) ros::requestShutdown();  // safe from any thread (as a nodelet: the shared callback thread)
 }
 
 }  // namespace sowing_robot

@@ -67,6 +67,7 @@ class PlantSim {
   core::Pose2D start_;
 
   ros::Publisher clock_pub_, odom_pub_, joint_pub_, path_pub_;
+  ros::CallbackQueue torque_queue_;  // before torque_sub_, which must be destroyed (unsubscribed) first
   ros::Subscriber torque_sub_;
   tf2_ros::TransformBroadcaster tf_;
   nav_msgs::Odometry odom_msg_;
@@ -77,7 +78,6 @@ class PlantSim {
   std::int64_t step_ = 0;           // index of the state being published
 
   // Served only by run()'s thread, so the torque state below needs no lock.
-  ros::CallbackQueue torque_queue_;
   core::WheelTorques torque_;       // last accepted torque
   ros::Time torque_stamp_;          // its stamp
   bool torque_valid_ = false;
