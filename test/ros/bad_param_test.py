@@ -2,13 +2,13 @@
 """rostest: start a node with one bad parameter at a time; it must refuse to start (exit 1) with a line
 naming the parameter, and never begin publishing."""
 import os
-import subprocess
 import unittest
 
-import roslib.packages
 import rospy
 import rostest
 import rospkg
+
+import node_process
 
 URDF = os.path.join(rospkg.RosPack().get_path("sowing_robot"), "urdf", "sowing_robot.urdf")
 
@@ -44,15 +44,10 @@ class BadParameters(unittest.TestCase):
     def test_each_bad_parameter_stops_the_node(self):
         rospy.init_node("bad_param_test")
         for i, (node, params, needle) in enumerate(CASES):
-            ns = "/bad_%d" % i
-            for key, value in params.items():
-                if value == "ZERO_RADIUS":
-                    value = zero_radius_urdf()
-                rospy.set_param("%s/%s" % (ns, key), value)
-            # roslib finds the binary through catkin (rosrun's find would crawl the .ws symlink loop)
-            cmd = [roslib.packages.find_node("sowing_robot", node)[0], "__name:=bad_%d" % i]
-            proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=60,
-                                  universal_newlines=True)
+            name = "bad_%d" % i
+            node_process.set_private_params(
+                "/" + name, {k: zero_radius_urdf() if v == "ZERO_RADIUS" else v for k, v in params.items()})
+            proc = node_process.run(node, name)
             out = proc.stdout
             self.assertEqual(proc.returncode, 1, "%s %s: exit %d\n%s" % (node, params, proc.returncode, out))
             self.assertIn("refusing to start", out, "%s %s:\n%s" % (node, params, out))

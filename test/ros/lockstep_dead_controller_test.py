@@ -1,0 +1,114 @@
+#!/usr/bin/env python3
+"""rostest (lockstep pipeline, lockstep_timeout 1.5 s wall): a torque controller that dies mid-run, or
+that never starts, must not leave plant_sim hanging silently. plant_sim does not exit: it waits, and
+every lockstep_timeout wall seconds it says what it is waiting for.
+
+- Killed mid-run: plant_sim stays at the stalled step, re-publishes that state every lockstep_retry, and
+  logs an ERROR naming the step's time and the torque topic with its publisher count (0); it resumes
+  when a torque controller is started again.
+- Never started (a second plant_sim alone in /lonely): it does not take step 0 and logs a WARN with the
+  number of wheel_torque publishers (0).
+
+Protections checked (PlantSim::runLockstep, src/ros/plant_sim.cpp): the "lockstep stalled" ROS_ERROR in
+the wait for a torque, the re-publication of the stalled state, and the "lockstep waiting for the loop"
+ROS_WARN before step 0.
+Verified to fail without them: with the ROS_ERROR removed test_killed_controller... fails waiting for
+the report; with the re-publication removed it fails on the repeat count (and the restarted controller
+never gets a state to answer, so the run does not resume); with the ROS_WARN removed
+test_missing_controller... fails waiting for the report."""
+import re
+import tempfile
+import time
+import unittest
+
+import rosnode
+import rospy
+import rostest
+from nav_msgs.msg import Odometry
+from rosgraph_msgs.msg import Log
+
+import node_process
+
+LOCKSTEP_TIMEOUT = 1.5  # [s wall] plant_sim/lockstep_timeout in lockstep_dead_controller.test
+WALL_LIMIT = 60.0       # [s wall] for anything that should take a few seconds on an idle machine
+
+
+class LockstepDeadController(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        rospy.init_node("lockstep_dead_controller_test")
+
+    def setUp(self):
+        self.logs = []  # (wall time received, Log)
+        self.odom_stamps = []
+        self.subs = [rospy.Subscriber("/rosout", Log, lambda m: self.logs.append((time.time(), m)), queue_size=1000),
+                     rospy.Subscriber("odom", Odometry, lambda m: self.odom_stamps.append(m.header.stamp.to_sec()),
+                                      queue_size=20000)]
+        self.children = []
+
+    def tearDown(self):
+        for proc in self.children:
+            node_process.stop(proc)
+        for sub in self.subs:
+            sub.unregister()
+
+    def wait_for(self, condition, what, limit=WALL_LIMIT):
+        deadline = time.time() + limit
+        while not condition():
+            if time.time() > deadline:
+                self.fail("no %s after %.0f s wall" % (what, limit))
+            time.sleep(0.05)
+
+    def reports(self, node, level, text):
+        """(wall time, message) of every log line of `node` at `level` holding `text`, in arrival order."""
+        return [(t, m.msg) for t, m in list(self.logs) if m.name == node and m.level == level and text in m.msg]
+
+    def last_odom(self):
+        return self.odom_stamps[-1] if self.odom_stamps else -1.0
+
+    def test_killed_controller_is_reported_and_replaced(self):
+        self.wait_for(lambda: self.last_odom() >= 0.5, "odom up to t = 0.5 s")
+        killed_at = time.time()
+        rosnode.kill_nodes(["/torque_controller"])
+
+        stall = lambda: self.reports("/plant_sim", Log.ERROR, "lockstep stalled")
+        self.wait_for(lambda: len(stall()) >= 2, "two stall reports from plant_sim",
+                      limit=2 * LOCKSTEP_TIMEOUT + WALL_LIMIT)
+        (first_at, first), (_, second) = stall()[:2]
+        stalled = self.last_odom()
+        # Not before lockstep_timeout: the stall cannot have begun before the kill.
+        self.assertGreaterEqual(first_at - killed_at, 0.9 * LOCKSTEP_TIMEOUT, first)
+        # It names the step it is stuck at (the last state published) and the missing input.
+        t = float(re.search(r"stalled at t=([0-9.]+) s", first).group(1))
+        self.assertAlmostEqual(t, stalled, places=5, msg="%s (last odom at t=%.6f)" % (first, stalled))
+        self.assertIn("0 publisher(s) on /wheel_torque: is torque_controller running?", first)
+        self.assertEqual(first, second, "a second report should be about the same step")
+        # Meanwhile the stalled state is re-published (lockstep_retry 0.5 s) for a late or new controller.
+        self.assertGreaterEqual(self.odom_stamps.count(stalled), 2, "stalled state not re-published")
+
+        self.children.append(node_process.start("torque_controller", "torque_controller"))
+        self.wait_for(lambda: self.last_odom() >= stalled + 0.5, "progress after the torque controller restarted")
+
+    def test_missing_controller_is_reported_before_the_start(self):
+        ns = "/lonely"  # its own topics: the pipeline's torque_controller must not count as its publisher
+        node_process.set_private_params(ns + "/plant_sim", {"mode": "lockstep", "min_subscribers": 0,
+                                                            "lockstep_timeout": LOCKSTEP_TIMEOUT})
+        lonely_odom = []
+        self.subs.append(rospy.Subscriber(ns + "/odom", Odometry, lonely_odom.append, queue_size=10))
+        with tempfile.TemporaryFile(mode="w+") as log:
+            started_at = time.time()
+            proc = node_process.start("plant_sim", "plant_sim", ns=ns, output=log)
+            self.children.append(proc)
+            waiting = lambda: self.reports(ns + "/plant_sim", Log.WARN, "lockstep waiting for the loop")
+            self.wait_for(lambda: len(waiting()) >= 2 or proc.poll() is not None, "waiting reports from plant_sim")
+            log.seek(0)
+            out = log.read()
+        self.assertIsNone(proc.poll(), "plant_sim exited (%s) instead of waiting\n%s" % (proc.returncode, out))
+        first_at, first = waiting()[0]
+        self.assertGreaterEqual(first_at - started_at, LOCKSTEP_TIMEOUT, first)
+        self.assertIn("0 wheel_torque publishers", first)
+        self.assertEqual(lonely_odom, [], "plant_sim published a state with no controller to answer it")
+
+
+if __name__ == "__main__":
+    rostest.rosrun("sowing_robot", "lockstep_dead_controller_test", LockstepDeadController)

@@ -1,0 +1,94 @@
+#!/usr/bin/env python3
+"""rostest: plant_sim (realtime, started here as a child process so its exit code can be checked) is
+driven to divergence by sustained wheel torques from this test. It must stop the run: a FATAL line
+saying the state diverged, exit code 2, and no diverged state ever published on odom.
+
+Protection checked: PlantSim::requireHealthy() (src/ros/plant_sim.cpp), the |v| > max_speed / non-finite
+check after every step. plant_sim does not clip incoming torques (max_torque is the torque controller's
+limit), so a finite torque can drive the state anywhere.
+Verified to fail without it: with requireHealthy() reduced to `return;` plant_sim runs on at any speed,
+the wait for its exit times out and both cases fail (and odom carries |v| > max_speed)."""
+import math
+import tempfile
+import time
+import unittest
+
+import rospy
+import rostest
+from nav_msgs.msg import Odometry
+from sowing_robot.msg import WheelTorque
+
+import node_process
+
+EXIT_LIMIT = 30.0  # [s wall] for start-up plus divergence; a healthy machine needs about 1 s
+
+CASES = [
+    # (namespace, plant_sim private params, torque on each wheel [N m], text the FATAL line must hold)
+    # 20 N m per wheel accelerates the (20 % heavier) robot at about 19 m/s^2: past 2 m/s in ~0.1 s.
+    ("/diverge_overspeed", {"max_speed": 2.0}, 20.0, "max_speed 2 m/s"),
+    # A finite but absurd torque: the sum of the two overflows to inf and the state turns NaN within a
+    # step (0 * inf in the Coriolis term); the run must stop on the NaN state (default max_speed).
+    ("/diverge_overflow", {}, 1e308, "nan"),
+]
+COMMON = {
+    "mode": "realtime",
+    "control_rate": 200.0,  # light on a busy 2-core machine; the check runs after every step at any rate
+    "torque_timeout": 1.0,  # [s sim] generous: our torques are stamped with the last odom we received
+    "disturbance/sinusoidal": False,  # the only cause of motion is the test's torque
+}
+
+
+class PlantDivergence(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        rospy.init_node("plant_divergence_test")
+
+    def run_case(self, ns, params, torque, needle):
+        node_process.set_private_params(ns + "/plant_sim", dict(COMMON, **params))
+        max_speed = params.get("max_speed", 20.0)
+        seen = {"stamp": None, "count": 0, "max_v": 0.0}
+
+        def on_odom(m):
+            seen["stamp"] = m.header.stamp
+            seen["count"] += 1
+            v = m.twist.twist.linear.x
+            seen["max_v"] = max(seen["max_v"], abs(v) if math.isfinite(v) else math.inf)
+
+        sub = rospy.Subscriber(ns + "/odom", Odometry, on_odom, queue_size=1000)
+        pub = rospy.Publisher(ns + "/wheel_torque", WheelTorque, queue_size=10)
+        with tempfile.TemporaryFile(mode="w+") as log:
+            proc = node_process.start("plant_sim", "plant_sim", ns=ns, output=log)
+            try:
+                deadline = time.time() + EXIT_LIMIT
+                while proc.poll() is None and time.time() < deadline:
+                    if seen["stamp"] is not None:  # stamped like a controller's answer, so it is fresh
+                        msg = WheelTorque()
+                        msg.header.stamp = seen["stamp"]
+                        msg.right = msg.left = torque
+                        pub.publish(msg)
+                    time.sleep(0.01)
+            finally:
+                code = node_process.stop(proc)  # no-op when it has exited by itself
+                sub.unregister()
+                pub.unregister()
+            log.seek(0)
+            out = log.read()
+        where = "%s (torque %g N m)" % (ns, torque)
+        self.assertGreater(seen["count"], 0, "%s: plant_sim never published odom\n%s" % (where, out))
+        self.assertEqual(code, 2, "%s: exit %s, expected 2 (stopped after %.0f s if it did not exit)\n%s"
+                         % (where, code, EXIT_LIMIT, out))
+        fatal = [line for line in out.splitlines() if "[FATAL]" in line]
+        self.assertEqual(len(fatal), 1, "%s: expected one FATAL line\n%s" % (where, out))
+        self.assertIn("state diverged", fatal[0], where)
+        self.assertIn(needle, fatal[0], where)
+        self.assertLessEqual(seen["max_v"], max_speed, "%s: a diverged state was published" % where)
+
+    def test_overspeed_stops_the_run(self):
+        self.run_case(*CASES[0])
+
+    def test_overflowing_state_stops_the_run(self):
+        self.run_case(*CASES[1])
+
+
+if __name__ == "__main__":
+    rostest.rosrun("sowing_robot", "plant_divergence_test", PlantDivergence)
