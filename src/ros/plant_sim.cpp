@@ -35,6 +35,7 @@ PlantSim::PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh) {
   cfg_.clock_rate = p.get("clock_rate", cfg_.clock_rate);
   cfg_.lockstep_retry = p.get("lockstep_retry", cfg_.lockstep_retry);
   cfg_.lockstep_timeout = p.get("lockstep_timeout", cfg_.lockstep_timeout);
+  cfg_.lockstep_give_up = p.get("lockstep_give_up", cfg_.lockstep_give_up);
   cfg_.min_subscribers = p.get("min_subscribers", cfg_.min_subscribers);
   cfg_.startup_delay = p.get("startup_delay", cfg_.startup_delay);
   cfg_.max_speed = p.get("max_speed", cfg_.max_speed);
@@ -50,6 +51,7 @@ PlantSim::PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh) {
          core::checkRange("clock_rate", cfg_.clock_rate, 0.0, 1e6, "Hz"),
          core::checkPositive("lockstep_retry", cfg_.lockstep_retry, "s"),
          core::checkPositive("lockstep_timeout", cfg_.lockstep_timeout, "s"),
+         core::checkNonNegative("lockstep_give_up", cfg_.lockstep_give_up, "s"),
          core::checkRange("min_subscribers", cfg_.min_subscribers, 0, 100),
          core::checkNonNegative("startup_delay", cfg_.startup_delay, "s"),
          core::checkPositive("max_speed", cfg_.max_speed, "m/s"),
@@ -177,18 +179,32 @@ void PlantSim::requireHealthy() {
   std::exit(2);
 }
 
+void PlantSim::giveUpAfter(const ros::WallTime& since, const char* what) {
+  if (cfg_.lockstep_give_up <= 0.0 || (ros::WallTime::now() - since).toSec() <= cfg_.lockstep_give_up) return;
+  ROS_FATAL("plant_sim: lockstep gave up at t=%.6f s after %.1f s wall (lockstep_give_up) waiting for %s; "
+            "%u publisher(s) on %s: is torque_controller running?",
+            waiting_for_.toSec(), cfg_.lockstep_give_up, what, torque_sub_.getNumPublishers(),
+            torque_sub_.getTopic().c_str());
+  ros::shutdown();
+  std::exit(3);
+}
+
 void PlantSim::runLockstep() {
   // This thread publishes the state, serves the torque queue until the torque for that state has come,
   // and integrates: the torque callback runs here, so no other thread needs waking.
-  ros::WallTime waited = ros::WallTime::now();
+  const ros::WallTime wait_start = ros::WallTime::now();
+  ros::WallTime waited = wait_start;
   while (running() && (static_cast<int>(odom_pub_.getNumSubscribers()) < cfg_.min_subscribers ||
                        torque_sub_.getNumPublishers() < 1)) {
     ros::WallDuration(0.01).sleep();
-    if ((ros::WallTime::now() - waited).toSec() > cfg_.lockstep_timeout) {
-      ROS_WARN("plant_sim: lockstep waiting for the loop: %u/%d odom subscribers, %u wheel_torque publishers",
-               odom_pub_.getNumSubscribers(), cfg_.min_subscribers, torque_sub_.getNumPublishers());
-      waited = ros::WallTime::now();
+    const ros::WallTime now = ros::WallTime::now();
+    if ((now - waited).toSec() > cfg_.lockstep_timeout) {
+      ROS_WARN("plant_sim: lockstep waiting for the loop for %.1f s wall: %u/%d odom subscribers, %u wheel_torque "
+               "publishers", (now - wait_start).toSec(), odom_pub_.getNumSubscribers(), cfg_.min_subscribers,
+               torque_sub_.getNumPublishers());
+      waited = now;
     }
+    giveUpAfter(wait_start, "the loop to connect (odom subscribers, a wheel_torque publisher)");
   }
   ros::WallDuration(cfg_.startup_delay).sleep();
   const std::int64_t n = cfg_.duration > 0.0 ? std::llround(cfg_.duration * 1e9 / cfg_.period_ns) : -1;
@@ -201,7 +217,8 @@ void PlantSim::runLockstep() {
     got_torque_ = false;
     step_ = k;
     publishState(stamp, k % visual_every_ == 0 || k == n);
-    ros::WallTime stalled_since = ros::WallTime::now(), sent = stalled_since;
+    const ros::WallTime stall_start = ros::WallTime::now();
+    ros::WallTime stalled_since = stall_start, sent = stall_start;
     while (running() && !got_torque_) {
       torque_queue_.callAvailable(retry);  // returns after a callback (any stamp) or the retry time
       if (got_torque_ || !running()) break;
@@ -212,11 +229,12 @@ void PlantSim::runLockstep() {
       if ((now - stalled_since).toSec() > cfg_.lockstep_timeout) {
         ROS_ERROR("plant_sim: lockstep stalled at t=%.6f s: no wheel_torque stamped for it after %.1f s wall "
                   "(%u publisher(s) on %s%s); waiting",
-                  stamp.toSec(), cfg_.lockstep_timeout, torque_sub_.getNumPublishers(),
+                  stamp.toSec(), (now - stall_start).toSec(), torque_sub_.getNumPublishers(),
                   torque_sub_.getTopic().c_str(),
                   torque_sub_.getNumPublishers() == 0 ? ": is torque_controller running?" : "");
         stalled_since = now;
       }
+      giveUpAfter(stall_start, "a wheel_torque stamped for the current state");
     }
     const core::WheelTorques u = torque_;
     if (!running() || k == n) break;

@@ -7,11 +7,12 @@ every lockstep_timeout wall seconds it says what it is waiting for.
   logs an ERROR naming the step's time and the torque topic with its publisher count (0); it resumes
   when a torque controller is started again.
 - Never started (a second plant_sim alone in /lonely): it does not take step 0 and logs a WARN with the
-  number of wheel_torque publishers (0).
+  number of wheel_torque publishers (0); after lockstep_give_up wall seconds it exits 3 with a FATAL line
+  naming the missing input (a third plant_sim in /given_up, with a 3 s limit).
 
 Protections checked (PlantSim::runLockstep, src/ros/plant_sim.cpp): the "lockstep stalled" ROS_ERROR in
 the wait for a torque, the re-publication of the stalled state, and the "lockstep waiting for the loop"
-ROS_WARN before step 0.
+ROS_WARN before step 0, and giveUpAfter() (exit 3).
 Verified to fail without them: with the ROS_ERROR removed test_killed_controller... fails waiting for
 the report; with the re-publication removed it fails on the repeat count (and the restarted controller
 never gets a state to answer, so the run does not resume); with the ROS_WARN removed
@@ -82,7 +83,10 @@ class LockstepDeadController(unittest.TestCase):
         t = float(re.search(r"stalled at t=([0-9.]+) s", first).group(1))
         self.assertAlmostEqual(t, stalled, places=5, msg="%s (last odom at t=%.6f)" % (first, stalled))
         self.assertIn("0 publisher(s) on /wheel_torque: is torque_controller running?", first)
-        self.assertEqual(first, second, "a second report should be about the same step")
+        step = lambda m: re.search(r"stalled at t=([0-9.]+) s", m).group(1)
+        waited = lambda m: float(re.search(r"after ([0-9.]+) s wall", m).group(1))
+        self.assertEqual(step(first), step(second), "a second report should be about the same step")
+        self.assertGreater(waited(second), waited(first), "the report should say how long it has waited")
         # Meanwhile the stalled state is re-published (lockstep_retry 0.5 s) for a late or new controller.
         self.assertGreaterEqual(self.odom_stamps.count(stalled), 2, "stalled state not re-published")
 
@@ -108,6 +112,19 @@ class LockstepDeadController(unittest.TestCase):
         self.assertGreaterEqual(first_at - started_at, LOCKSTEP_TIMEOUT, first)
         self.assertIn("0 wheel_torque publishers", first)
         self.assertEqual(lonely_odom, [], "plant_sim published a state with no controller to answer it")
+
+    def test_missing_controller_ends_the_run_after_lockstep_give_up(self):
+        # A headless run whose controller never answers must end: exit 3 and one FATAL line naming what
+        # is missing, once lockstep_give_up wall seconds have passed (here 3 s; the default is 120 s).
+        ns = "/given_up"
+        node_process.set_private_params(ns + "/plant_sim", {"mode": "lockstep", "min_subscribers": 0,
+                                                            "lockstep_timeout": LOCKSTEP_TIMEOUT,
+                                                            "lockstep_give_up": 3.0})
+        started_at = time.time()
+        done = node_process.run("plant_sim", "plant_sim", ns=ns, timeout=60)
+        self.assertEqual(done.returncode, 3, done.stdout)
+        self.assertGreaterEqual(time.time() - started_at, 3.0)
+        self.assertRegex(done.stdout, r"lockstep gave up .*wheel_torque", done.stdout)
 
 
 if __name__ == "__main__":

@@ -47,6 +47,7 @@ class PlantSim {
     double clock_rate = 0.0;         // [Hz] sim, /clock; 0 = every step
     double lockstep_retry = 0.5;     // [s] wall: republish the state if no torque came
     double lockstep_timeout = 5.0;   // [s] wall: report the missing input
+    double lockstep_give_up = 120.0; // [s] wall: exit 3 when an input stays missing this long; 0 = wait forever
     int min_subscribers = 3;         // odom subscribers to wait for before step 0 (lockstep)
     double startup_delay = 0.5;      // [s] wall, lockstep: let every connection settle before step 0
     double max_speed = 20.0;         // [m/s]; beyond it (or NaN) the run is stopped as diverged
@@ -57,6 +58,9 @@ class PlantSim {
   void publishState(const ros::Time& stamp, bool visuals);
   /// Stops the process (exit 2, FATAL line) when the state is non-finite or faster than max_speed.
   void requireHealthy();
+  /// Lockstep: exit 3 with a FATAL line naming what is missing once it has been waited for since
+  /// `since` longer than lockstep_give_up (a headless run with a dead controller must end).
+  void giveUpAfter(const ros::WallTime& since, const char* what);
   bool running() const { return ros::ok() && !stop_; }
   void runLockstep();
   void runRealtime();
