@@ -4,7 +4,8 @@ kinematic_controller must command a stop (v = w = 0 and zero derivatives on desi
 reference is older than its input_timeout, keep commanding it, warn on /rosout, and compute again
 (non-zero command, tracking_error flowing) once references return.
 
-Protection checked: KinematicController::stopIfStale (src/ros/kinematic_controller.cpp).
+Protection checked: KinematicController::stopIfStale (src/ros/kinematic_controller.cpp), and the order
+of the two input_timeouts (kinematic 0.1 s < torque 0.2 s in fault_overlay.yaml, as in controllers.yaml).
 Verified to fail without it: with stopIfStale reduced to `return;` kinematic_controller publishes
 nothing while the reference is missing, and the wait for the stop command fails. With its age check
 removed (a stop on every odom that has no reference yet) it fails on the stop coming before
@@ -98,6 +99,10 @@ class SilentReference(unittest.TestCase):
         back_at = next(t for t in self.refs if t > stop_at + 1.0)
         during = [d for d in list(self.desired) if stop_at <= d.header.stamp.to_sec() < back_at]
         self.assertTrue(during and all(is_stop(d) for d in during), "not a steady stop during the outage")
+        # The torque controller's own timeout is longer, and the stop commands keep it fed: the outage is
+        # blamed on the reference generator, not on the kinematic controller.
+        blamed = [m.msg for m in list(self.logs) if m.name == "/torque_controller" and "no desired_velocity" in m.msg]
+        self.assertEqual(blamed, [], "torque_controller took the kinematic controller for dead")
 
         # Computing again: tracking errors at the new references, and commands that are not a stop.
         self.wait_for(lambda: min(self.latest(self.errors), self.latest_desired()) >= back_at + 0.5,
