@@ -71,7 +71,7 @@ using ReferenceGeneratorNodelet = WrapperNodelet<ReferenceGenerator>;
 using RunMonitorNodelet = WrapperNodelet<RunMonitor>;
 using SeedDrillNodelet = WrapperNodelet<SeedDrillNode>;
 
-/// The plant runs its simulation loop on a thread of its own; the manager serves its callbacks.
+/// The plant runs its simulation loop on a thread of its own, which also serves its wheel_torque queue.
 class PlantSimNodelet : public nodelet::Nodelet {
  public:
   ~PlantSimNodelet() override {
