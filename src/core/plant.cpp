@@ -14,7 +14,7 @@ namespace {
 // cos and sin of (theta + delta) from cos0 = cos(theta), sin0 = sin(theta) by the angle-sum identity.
 // RK4's heading increments are small (delta = h w / 2 or h w: 1e-3 rad at 1 kHz and 2 rad/s), where the
 // Taylor series below are exact to double rounding (first dropped terms delta^9/9! and delta^10/10!,
-// under 1e-16 of the kept ones for |delta| <= 0.05); larger increments fall back to the library.
+// about 1e-16 of the kept ones at |delta| = 0.05); larger increments fall back to the library.
 void rotateHeading(double cos0, double sin0, double delta, double& cos_out, double& sin_out) {
   double cd, sd;
   if (std::fabs(delta) <= 0.05) {
