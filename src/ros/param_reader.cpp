@@ -4,6 +4,7 @@
 #include <ros/param.h>
 #include <ros/this_node.h>
 
+#include <cstdio>
 #include <cstdlib>
 
 namespace sowing_robot {
@@ -54,8 +55,14 @@ std::string ParamReader::unknownKeys() const {
 
 void refuseToStart(const std::string& message) {
   ROS_FATAL("%s: refusing to start: %s", ros::this_node::getName().c_str(), message.c_str());
+  exitProcess(1);
+}
+
+void exitProcess(int code) {
   ros::shutdown();
-  std::exit(1);
+  std::fflush(stdout);
+  std::fflush(stderr);
+  std::_Exit(code);
 }
 
 }  // namespace sowing_robot

@@ -175,8 +175,7 @@ void PlantSim::requireHealthy() {
   ROS_FATAL("plant_sim: state diverged at t=%.6f s (x %g, y %g, theta %g, v %g, omega %g; max_speed %g m/s): "
             "stopping the run instead of publishing garbage",
             plant_->time(), s[core::X], s[core::Y], s[core::THETA], s[core::V], s[core::OMEGA], cfg_.max_speed);
-  ros::shutdown();
-  std::exit(2);
+  exitProcess(2);
 }
 
 void PlantSim::giveUpAfter(const ros::WallTime& since, const char* what) {
@@ -185,8 +184,7 @@ void PlantSim::giveUpAfter(const ros::WallTime& since, const char* what) {
             "%u publisher(s) on %s: is torque_controller running?",
             waiting_for_.toSec(), cfg_.lockstep_give_up, what, torque_sub_.getNumPublishers(),
             torque_sub_.getTopic().c_str());
-  ros::shutdown();
-  std::exit(3);
+  exitProcess(3);
 }
 
 void PlantSim::runLockstep() {

@@ -42,4 +42,9 @@ class ParamReader {
 /// Log `message` as FATAL with the node name and exit(1): the refusal to start that STYLE.md asks for.
 [[noreturn]] void refuseToStart(const std::string& message);
 
+/// Ends the process with `code` once a FATAL line has been logged: ros::shutdown(), flush stdout and
+/// stderr, then std::_Exit. Not std::exit: its static destructors raced roscpp's threads, which were
+/// still running, and now and then turned the exit code into an abort (seen in CI).
+[[noreturn]] void exitProcess(int code);
+
 }  // namespace sowing_robot
