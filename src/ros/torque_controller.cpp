@@ -36,30 +36,26 @@ TorqueController::TorqueController(ros::NodeHandle nh, ros::NodeHandle pnh) {
 }
 
 namespace {
-/// The live-tunable subset of SlidingModeParams <-> its dynamic_reconfigure config (one mapping each way).
+/// The live-tunable subset of SlidingModeParams and its dynamic_reconfigure fields, listed once:
+/// `each(param, config_field)` is called for every pair (P and C may be const, for the direction read).
+template <typename P, typename C, typename F>
+void forEachTunable(P& p, C& c, F each) {
+  each(p.beta_v, c.beta_v);
+  each(p.beta_omega, c.beta_omega);
+  each(p.k1, c.k1);
+  each(p.k2, c.k2);
+  each(p.eta1, c.eta1);
+  each(p.eta2, c.eta2);
+  each(p.rate_m, c.rate_m);
+  each(p.rate_i, c.rate_i);
+  each(p.max_torque, c.max_torque);
+  each(p.switching.width, c.switch_width);
+}
 void toParams(const TorqueControllerConfig& c, core::SlidingModeParams& p) {
-  p.beta_v = c.beta_v;
-  p.beta_omega = c.beta_omega;
-  p.k1 = c.k1;
-  p.k2 = c.k2;
-  p.eta1 = c.eta1;
-  p.eta2 = c.eta2;
-  p.rate_m = c.rate_m;
-  p.rate_i = c.rate_i;
-  p.max_torque = c.max_torque;
-  p.switching.width = c.switch_width;
+  forEachTunable(p, c, [](double& param, const double& field) { param = field; });
 }
 void toConfig(const core::SlidingModeParams& p, TorqueControllerConfig& c) {
-  c.beta_v = p.beta_v;
-  c.beta_omega = p.beta_omega;
-  c.k1 = p.k1;
-  c.k2 = p.k2;
-  c.eta1 = p.eta1;
-  c.eta2 = p.eta2;
-  c.rate_m = p.rate_m;
-  c.rate_i = p.rate_i;
-  c.max_torque = p.max_torque;
-  c.switch_width = p.switching.width;
+  forEachTunable(p, c, [](const double& param, double& field) { field = param; });
   c.switching = core::SwitchFunction::name(p.switching.type);
 }
 }  // namespace
