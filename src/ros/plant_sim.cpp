@@ -80,7 +80,7 @@ PlantSim::PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh) {
   path_pub_ = nh_.advertise<nav_msgs::Path>("travelled_path", 1, true);
   ros::SubscribeOptions torque_options = ros::SubscribeOptions::create<WheelTorque>(
       "wheel_torque", 50, [this](const WheelTorque::ConstPtr& m) { torqueCallback(m); }, ros::VoidPtr(),
-      &torque_queue_);
+      cfg_.lockstep ? static_cast<ros::CallbackQueueInterface*>(&inline_queue_) : &torque_queue_);
   torque_options.transport_hints = ros::TransportHints().tcpNoDelay();
   torque_sub_ = nh_.subscribe(torque_options);
 
@@ -107,12 +107,41 @@ void PlantSim::torqueCallback(const WheelTorque::ConstPtr& msg) {
       }
       return;
     }
-    if (got_torque_) return;  // a repeat of the same answer
+    // Before the first state, after the last, after a divergence, or a repeat of the same answer.
+    if (step_ < 0 || got_torque_ || finished_ || diverged_ || !running()) return;
   }
   torque_ = {msg->right, msg->left};
   torque_stamp_ = msg->header.stamp;
   torque_valid_ = true;
   got_torque_ = true;
+  if (cfg_.lockstep) advanceLockstep();
+}
+
+void PlantSim::advanceLockstep() {
+  if (last_step_ >= 0 && step_ >= last_step_) {  // the torque for the final state: the scenario is over
+    // Reported here, at once: a headless launch may end (run_monitor is done) before run() looks again.
+    const double wall = (ros::WallTime::now() - wall_start_).toSec();
+    ROS_INFO("plant_sim: lockstep scenario finished: %.3f s simulated in %.3f s wall (real-time factor %.2f); "
+             "%ld late and %ld non-finite torques ignored",
+             cfg_.duration, wall, wall > 0 ? cfg_.duration / wall : 0.0, static_cast<long>(late_),
+             static_cast<long>(rejected_));
+    finished_ = true;
+    return;
+  }
+  plant_->step(torque_.right, torque_.left, core::secondsFromNanos(cfg_.period_ns));
+  if (!healthy()) {
+    diverged_ = true;  // run() reports it and ends the process (not from inside roscpp's callback)
+    return;
+  }
+  publishLockstepState(step_ + 1);
+}
+
+void PlantSim::publishLockstepState(std::int64_t k) {
+  step_ = k;
+  waiting_for_ = stampOf(k, cfg_.period_ns);
+  got_torque_ = false;
+  progress_.store(k, std::memory_order_release);
+  publishState(waiting_for_, k % visual_every_ == 0 || k == last_step_);
 }
 
 namespace {
@@ -129,13 +158,6 @@ void PlantSim::stop() {
 }
 
 void PlantSim::publishState(const ros::Time& stamp, bool visuals) {
-  // Nothing in the control loop reads /clock (every node works on header stamps); it serves ROS time
-  // for logs, rosbag and rviz, so it may be published less often than every step (clock_rate).
-  if (step_ % clock_every_ == 0 || visuals) {
-    rosgraph_msgs::Clock clock;
-    clock.clock = stamp;
-    clock_pub_.publish(clock);
-  }
   const core::State& s = plant_->state();
   odom_msg_.header.stamp = stamp;
   odom_msg_.pose.pose.position.x = s[core::X];
@@ -145,6 +167,14 @@ void PlantSim::publishState(const ros::Time& stamp, bool visuals) {
   odom_msg_.twist.twist.linear.x = s[core::V];
   odom_msg_.twist.twist.angular.z = s[core::OMEGA];
   publishShared(odom_pub_, odom_msg_);
+  // Nothing in the control loop reads /clock (every node works on header stamps); it serves ROS time
+  // for logs, rosbag and rviz, so it may go out less often than every step (clock_rate), and after the
+  // state, off the loop's critical path (it has a link to every node).
+  if (step_ % clock_every_ == 0 || visuals) {
+    rosgraph_msgs::Clock clock;
+    clock.clock = stamp;
+    clock_pub_.publish(clock);
+  }
   if (!visuals) return;
 
   geometry_msgs::TransformStamped tf;
@@ -169,27 +199,29 @@ void PlantSim::publishState(const ros::Time& stamp, bool visuals) {
   if (path_.add(pose)) path_pub_.publish(path_.path());
 }
 
-void PlantSim::requireHealthy() {
+bool PlantSim::healthy() const {
   const core::State& s = plant_->state();
-  if (std::isfinite(s.sum()) && std::fabs(s[core::V]) <= cfg_.max_speed) return;
+  return std::isfinite(s.sum()) && std::fabs(s[core::V]) <= cfg_.max_speed;
+}
+
+void PlantSim::exitDiverged() {
+  const core::State& s = plant_->state();
   ROS_FATAL("plant_sim: state diverged at t=%.6f s (x %g, y %g, theta %g, v %g, omega %g; max_speed %g m/s): "
             "stopping the run instead of publishing garbage",
             plant_->time(), s[core::X], s[core::Y], s[core::THETA], s[core::V], s[core::OMEGA], cfg_.max_speed);
   exitProcess(2);
 }
 
-void PlantSim::giveUpAfter(const ros::WallTime& since, const char* what) {
+void PlantSim::giveUpAfter(const ros::WallTime& since, const ros::Time& stamp, const char* what) {
   if (cfg_.lockstep_give_up <= 0.0 || (ros::WallTime::now() - since).toSec() <= cfg_.lockstep_give_up) return;
   ROS_FATAL("plant_sim: lockstep gave up at t=%.6f s after %.1f s wall (lockstep_give_up) waiting for %s; "
             "%u publisher(s) on %s: is torque_controller running?",
-            waiting_for_.toSec(), cfg_.lockstep_give_up, what, torque_sub_.getNumPublishers(),
+            stamp.toSec(), cfg_.lockstep_give_up, what, torque_sub_.getNumPublishers(),
             torque_sub_.getTopic().c_str());
   exitProcess(3);
 }
 
 void PlantSim::runLockstep() {
-  // This thread publishes the state, serves the torque queue until the torque for that state has come,
-  // and integrates: the torque callback runs here, so no other thread needs waking.
   const ros::WallTime wait_start = ros::WallTime::now();
   ros::WallTime waited = wait_start;
   while (running() && (static_cast<int>(odom_pub_.getNumSubscribers()) < cfg_.min_subscribers ||
@@ -202,48 +234,49 @@ void PlantSim::runLockstep() {
                torque_sub_.getNumPublishers());
       waited = now;
     }
-    giveUpAfter(wait_start, "the loop to connect (odom subscribers, a wheel_torque publisher)");
+    giveUpAfter(wait_start, ros::Time(0), "the loop to connect (odom subscribers, a wheel_torque publisher)");
   }
   ros::WallDuration(cfg_.startup_delay).sleep();
-  const std::int64_t n = cfg_.duration > 0.0 ? std::llround(cfg_.duration * 1e9 / cfg_.period_ns) : -1;
-  const double dt = core::secondsFromNanos(cfg_.period_ns);
-  const ros::WallTime wall_start = ros::WallTime::now();
-  const ros::WallDuration retry(cfg_.lockstep_retry);
-  for (std::int64_t k = 0; running() && (n < 0 || k <= n); ++k) {
-    const ros::Time stamp = stampOf(k, cfg_.period_ns);
-    waiting_for_ = stamp;
-    got_torque_ = false;
-    step_ = k;
-    publishState(stamp, k % visual_every_ == 0 || k == n);
-    const ros::WallTime stall_start = ros::WallTime::now();
-    ros::WallTime stalled_since = stall_start, sent = stall_start;
-    while (running() && !got_torque_) {
-      torque_queue_.callAvailable(retry);  // returns after a callback (any stamp) or the retry time
-      if (got_torque_ || !running()) break;
-      const ros::WallTime now = ros::WallTime::now();
-      if (now - sent < retry) continue;
-      publishState(stamp, false);  // a connection that came late gets the state again
-      sent = now;
-      if ((now - stalled_since).toSec() > cfg_.lockstep_timeout) {
-        ROS_ERROR("plant_sim: lockstep stalled at t=%.6f s: no wheel_torque stamped for it after %.1f s wall "
-                  "(%u publisher(s) on %s%s); waiting",
-                  stamp.toSec(), (now - stall_start).toSec(), torque_sub_.getNumPublishers(),
-                  torque_sub_.getTopic().c_str(),
-                  torque_sub_.getNumPublishers() == 0 ? ": is torque_controller running?" : "");
-        stalled_since = now;
-      }
-      giveUpAfter(stall_start, "a wheel_torque stamped for the current state");
-    }
-    const core::WheelTorques u = torque_;
-    if (!running() || k == n) break;
-    plant_->step(u.right, u.left, dt);
-    requireHealthy();
+  if (!running()) return;
+  last_step_ = cfg_.duration > 0.0 ? std::llround(cfg_.duration * 1e9 / cfg_.period_ns) : -1;
+  {
+    std::lock_guard<std::recursive_mutex> lock(inline_queue_.mutex());
+    wall_start_ = ros::WallTime::now();
+    publishLockstepState(0);  // from here on the torque callback drives the steps
   }
-  const double wall = (ros::WallTime::now() - wall_start).toSec();
-  ROS_INFO("plant_sim: lockstep scenario finished: %.3f s simulated in %.3f s wall (real-time factor %.2f); "
-           "%ld late and %ld non-finite torques ignored",
-           cfg_.duration, wall, wall > 0 ? cfg_.duration / wall : 0.0, static_cast<long>(late_),
-           static_cast<long>(rejected_));
+  // Supervise: the loop needs this thread only when an answer is missing, so it looks every 10 ms.
+  const ros::WallDuration retry(cfg_.lockstep_retry), poll(std::min(0.01, cfg_.lockstep_retry));
+  std::int64_t seen = -1;
+  ros::WallTime stall_start, stalled_since, sent;
+  while (running() && !finished_) {
+    poll.sleep();
+    if (diverged_) exitDiverged();
+    const std::int64_t k = progress_.load(std::memory_order_acquire);
+    const ros::WallTime now = ros::WallTime::now();
+    if (k != seen) {
+      seen = k;
+      stall_start = stalled_since = sent = now;
+      continue;
+    }
+    if (now - sent < retry) continue;
+    ros::Time stamp;
+    {
+      std::lock_guard<std::recursive_mutex> lock(inline_queue_.mutex());
+      if (finished_ || diverged_ || step_ != seen) continue;
+      stamp = waiting_for_;
+      publishState(stamp, false);  // a connection that came late gets the state again
+    }
+    sent = now;
+    if ((now - stalled_since).toSec() > cfg_.lockstep_timeout) {
+      ROS_ERROR("plant_sim: lockstep stalled at t=%.6f s: no wheel_torque stamped for it after %.1f s wall "
+                "(%u publisher(s) on %s%s); waiting",
+                stamp.toSec(), (now - stall_start).toSec(), torque_sub_.getNumPublishers(),
+                torque_sub_.getTopic().c_str(),
+                torque_sub_.getNumPublishers() == 0 ? ": is torque_controller running?" : "");
+      stalled_since = now;
+    }
+    giveUpAfter(stall_start, stamp, "a wheel_torque stamped for the current state");
+  }
 }
 
 void PlantSim::runRealtime() {
@@ -274,7 +307,7 @@ void PlantSim::runRealtime() {
                         (stamp - torque_stamp_).toSec(), cfg_.torque_timeout);
     }
     plant_->step(u.right, u.left, dt);
-    requireHealthy();
+    if (!healthy()) exitDiverged();
   }
 }
 

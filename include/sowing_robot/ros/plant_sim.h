@@ -19,6 +19,7 @@
 #include "sowing_robot/WheelTorque.h"
 #include "sowing_robot/core/plant.h"
 #include "sowing_robot/core/types.h"
+#include "sowing_robot/ros/inline_callback_queue.h"
 #include "sowing_robot/ros/path_buffer.h"
 
 namespace sowing_robot {
@@ -27,9 +28,12 @@ class PlantSim {
  public:
   /// Loads and validates all parameters; refuses to start (exit 1) on a bad one.
   PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh);
-  /// Runs the simulation on the calling thread until shutdown, stop(), or the end of a lockstep
-  /// scenario. The wheel_torque callback runs on this thread too (its own callback queue, served by
-  /// the loop): in lockstep the torque wakes the loop directly, with no hand-over between threads.
+  /// Runs the simulation until shutdown, stop(), or the end of a lockstep scenario.
+  /// Realtime: this thread paces the steps and serves the wheel_torque queue itself.
+  /// Lockstep: the wheel_torque callback runs inline where the torque is received (roscpp's network
+  /// thread, or in a nodelet manager the thread that published it) and steps the plant and publishes the
+  /// next state there, with no hand-over between threads; this thread only supervises (republishes a
+  /// state nobody answered, reports a stall, gives up, reports the end).
   void run();
   /// Ask run() to return (nodelet unload); safe from any thread.
   void stop();
@@ -56,14 +60,21 @@ class PlantSim {
 
   void torqueCallback(const WheelTorque::ConstPtr& msg);
   void publishState(const ros::Time& stamp, bool visuals);
-  /// Stops the process (exit 2, FATAL line) when the state is non-finite or faster than max_speed.
-  void requireHealthy();
-  /// Lockstep: exit 3 with a FATAL line naming what is missing once it has been waited for since
-  /// `since` longer than lockstep_give_up (a headless run with a dead controller must end).
-  void giveUpAfter(const ros::WallTime& since, const char* what);
+  /// False when the state is non-finite or faster than max_speed.
+  bool healthy() const;
+  /// Ends the process with a FATAL line (exit 2): the state diverged.
+  [[noreturn]] void exitDiverged();
+  /// Lockstep: exit 3 with a FATAL line naming what is missing (for the state stamped `stamp`) once it
+  /// has been waited for since `since` longer than lockstep_give_up (a headless run with a dead
+  /// controller must end).
+  void giveUpAfter(const ros::WallTime& since, const ros::Time& stamp, const char* what);
   bool running() const { return ros::ok() && !stop_; }
   void runLockstep();
   void runRealtime();
+  /// Lockstep, under the queue mutex: the torque for the awaited stamp has come.
+  void advanceLockstep();
+  /// Lockstep: publish the state of step k (visuals at publish_rate and at the last step).
+  void publishLockstepState(std::int64_t k);
 
   ros::NodeHandle nh_;
   Config cfg_;
@@ -71,7 +82,10 @@ class PlantSim {
   core::Pose2D start_;
 
   ros::Publisher clock_pub_, odom_pub_, joint_pub_, path_pub_;
-  ros::CallbackQueue torque_queue_;  // before torque_sub_, which must be destroyed (unsubscribed) first
+  // Before torque_sub_, which must be destroyed (unsubscribed) first: realtime uses torque_queue_,
+  // lockstep inline_queue_ (whose mutex guards the plant and every member below in that mode).
+  ros::CallbackQueue torque_queue_;
+  InlineCallbackQueue inline_queue_;
   ros::Subscriber torque_sub_;
   tf2_ros::TransformBroadcaster tf_;
   nav_msgs::Odometry odom_msg_;
@@ -79,14 +93,19 @@ class PlantSim {
   PathBuffer path_{"odom", 0.05, 10};  // a point every 5 cm, re-sent every 10th point
   std::int64_t visual_every_ = 20;  // publish visuals every n steps
   std::int64_t clock_every_ = 1;    // publish /clock every n steps
-  std::int64_t step_ = 0;           // index of the state being published
+  std::int64_t step_ = -1;          // index of the state being published (-1: none yet)
 
-  // Served only by run()'s thread, so the torque state below needs no lock.
+  // Realtime: served only by run()'s thread. Lockstep: guarded by inline_queue_.mutex().
   core::WheelTorques torque_;       // last accepted torque
   ros::Time torque_stamp_;          // its stamp
   bool torque_valid_ = false;
   ros::Time waiting_for_;           // lockstep: the stamp we need a torque for
   bool got_torque_ = false;
+  std::int64_t last_step_ = -1;     // lockstep: index of the final state (-1: run forever)
+  std::atomic<std::int64_t> progress_{0};  // lockstep: steps taken, read by the supervising thread
+  std::atomic<bool> finished_{false};      // lockstep: the torque for the final state has come
+  std::atomic<bool> diverged_{false};      // lockstep: the state went bad; run() ends the process
+  ros::WallTime wall_start_;         // lockstep: when step 0 was published
   std::atomic<bool> stop_{false};
   std::int64_t rejected_ = 0, late_ = 0;
 };
