@@ -19,8 +19,8 @@ KinematicController::KinematicController(ros::NodeHandle nh, ros::NodeHandle pnh
   desired_pub_ = nh.advertise<DesiredVelocity>("desired_velocity", kLockstepQueue);
   error_pub_ = nh.advertise<TrackingError>("tracking_error", kLockstepQueue);
   const auto hints = ros::TransportHints().tcpNoDelay();
-  odom_sub_ = nh.subscribe("odom", 50, &KinematicController::odomCallback, this, hints);
-  ref_sub_ = nh.subscribe("reference", 50, &KinematicController::referenceCallback, this, hints);
+  odom_sub_ = nh.subscribe("odom", kLockstepQueue, &KinematicController::odomCallback, this, hints);
+  ref_sub_ = nh.subscribe("reference", kLockstepQueue, &KinematicController::referenceCallback, this, hints);
 }
 
 void KinematicController::reconfigure(KinematicControllerConfig& config, uint32_t) {
@@ -49,10 +49,14 @@ void KinematicController::odomCallback(const nav_msgs::Odometry::ConstPtr& msg) 
     publishShared(desired_pub_, desired_);
     return;
   }
-  if (inputs_.setFirst(*msg))
+  if (inputs_.setFirst(*msg)) {
     compute();
-  else
-    stopIfStale(*msg);
+    return;
+  }
+  if (inputs_.secondsPassed(msg->header.stamp))
+    ROS_ERROR_THROTTLE(5.0, "kinematic_controller: no reference stamped t=%.9f s, but newer ones: the reference "
+                       "generator's control_rate does not match plant_sim's", msg->header.stamp.toSec());
+  stopIfStale(*msg);
 }
 
 void KinematicController::stopIfStale(const nav_msgs::Odometry& odom) {

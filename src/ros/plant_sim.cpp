@@ -157,7 +157,7 @@ void PlantSim::stop() {
   torque_queue_.addCallback(boost::make_shared<WakeUp>());
 }
 
-void PlantSim::publishState(const ros::Time& stamp, bool visuals) {
+void PlantSim::publishState(const ros::Time& stamp, bool visuals, bool clock) {
   const core::State& s = plant_->state();
   odom_msg_.header.stamp = stamp;
   odom_msg_.pose.pose.position.x = s[core::X];
@@ -170,10 +170,10 @@ void PlantSim::publishState(const ros::Time& stamp, bool visuals) {
   // Nothing in the control loop reads /clock (every node works on header stamps); it serves ROS time
   // for logs, rosbag and rviz, so it may go out less often than every step (clock_rate), and after the
   // state, off the loop's critical path (it has a link to every node).
-  if (step_ % clock_every_ == 0 || visuals) {
-    rosgraph_msgs::Clock clock;
-    clock.clock = stamp;
-    clock_pub_.publish(clock);
+  if (clock || visuals || step_ % clock_every_ == 0) {
+    rosgraph_msgs::Clock c;
+    c.clock = stamp;
+    clock_pub_.publish(c);
   }
   if (!visuals) return;
 
@@ -264,7 +264,9 @@ void PlantSim::runLockstep() {
       std::lock_guard<std::recursive_mutex> lock(inline_queue_.mutex());
       if (finished_ || diverged_ || step_ != seen) continue;
       stamp = waiting_for_;
-      publishState(stamp, false);  // a connection that came late gets the state again
+      // A connection that came late gets the state again, and /clock with it: the reference generator,
+      // paced by /clock, may be what the loop waits for (a reference generator that started late).
+      publishState(stamp, false, true);
     }
     sent = now;
     if ((now - stalled_since).toSec() > cfg_.lockstep_timeout) {

@@ -1,5 +1,6 @@
 #include "sowing_robot/ros/reference_generator.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -35,7 +36,9 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
     const std::string fe = error.empty() ? field.validate() : "";
     if (!fe.empty()) error = "field/" + fe;
   }
+  if (error.empty()) error = core::checkRange("lookahead", lookahead_, 1e-6, 10.0, "s");
   requireValid(p, error);
+  window_ns_ = std::llround(lookahead_ * 1e9);
   if (type == "line") {
     source_ = std::make_unique<core::LineReference>(v_r, row_y, x0);
     ROS_INFO("reference_generator: line x = %.3f + %.3f t, y = %.3f", x0, v_r, row_y);
@@ -73,7 +76,11 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
         ros::NodeHandle(pnh, "potential"));
     reconfigure_->setCallback([this](ReferenceGeneratorConfig& c, uint32_t level) { reconfigure(c, level); });
   }
-  ref_pub_ = nh.advertise<ReferenceState>("reference", kLockstepQueue);
+  // A subscriber that connects late (a restarted controller) is sent the references already out for
+  // the times still ahead: the loop may be waiting for one of them.
+  ref_pub_ = nh.advertise<ReferenceState>(
+      "reference", kLockstepQueue, [this](const ros::SingleSubscriberPublisher& sub) { replayTo(sub); },
+      ros::SubscriberStatusCallback());
   path_pub_ = nh.advertise<nav_msgs::Path>("reference_path", 1, true);
   path_ = std::make_unique<PathBuffer>("odom", path_spacing_, 10);  // re-sent every 10th point
   if (field_) {
@@ -81,7 +88,9 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
     publishMarkers();
     obstacles_sub_ = nh.subscribe("obstacles", 10, &ReferenceGenerator::obstaclesCallback, this);
   }
-  odom_sub_ = nh.subscribe("odom", 50, &ReferenceGenerator::odomCallback, this, ros::TransportHints().tcpNoDelay());
+  clock_sub_ = nh.subscribe("/clock", 10, &ReferenceGenerator::clockCallback, this, ros::TransportHints().tcpNoDelay());
+  ROS_INFO("reference_generator: references on a %.6f s grid (control_rate), sent %.3f s ahead of /clock "
+           "(lookahead)", core::secondsFromNanos(period_ns_), lookahead_);
 }
 
 void ReferenceGenerator::obstaclesCallback(const visualization_msgs::MarkerArray::ConstPtr& msg) {
@@ -206,49 +215,53 @@ void ReferenceGenerator::fill(ReferenceState& out, const ros::Time& stamp) {
   out.tool_down = r.tool_down;
 }
 
-void ReferenceGenerator::odomCallback(const nav_msgs::Odometry::ConstPtr& msg) {
-  const ros::Time& stamp = msg->header.stamp;
-  if (any_ && stamp <= ref_.header.stamp) {  // a repeat (or an old state): answer with what we said
-    if (stamp == ref_.header.stamp) publishShared(ref_pub_, ref_);
+void ReferenceGenerator::clockCallback(const rosgraph_msgs::Clock::ConstPtr& msg) {
+  const std::int64_t now = static_cast<std::int64_t>(msg->clock.toNSec());
+  if (clock_seen_ && now < last_clock_ns_) {
+    ROS_ERROR("reference_generator: simulated time went back from %.6f s to %.6f s: references already sent are "
+              "not sent again (the potential field integrates forward); restart this node with the plant",
+              1e-9 * last_clock_ns_, 1e-9 * now);
+    last_clock_ns_ = now;
     return;
   }
-  if (ahead_valid_ && stamp == ahead_.header.stamp) {
-    ref_ = ahead_;  // published one period ago
-  } else {
-    if (ahead_valid_ && stamp < ahead_.header.stamp) {
-      // States come more often than control_rate says, and the source cannot go back to this time:
-      // answer once with the reference already computed (one step late) and stop looking ahead.
-      ROS_ERROR("reference_generator: state at t=%.6f s is before the reference already sent for t=%.6f s: "
-                "control_rate (%.3f Hz) does not match plant_sim's; lookahead switched off",
-                stamp.toSec(), ahead_.header.stamp.toSec(), 1e9 / period_ns_);
-      lookahead_ = false;
-      ahead_valid_ = false;
-      ref_ = ahead_;
-      ref_.header.stamp = stamp;
-    } else {
-      fill(ref_, stamp);
-    }
-    publishShared(ref_pub_, ref_);
+  if (now % period_ns_ != 0 && !grid_warned_) {
+    grid_warned_ = true;
+    ROS_ERROR("reference_generator: /clock at t=%.9f s is not on the %.6f s grid of control_rate (%.3f Hz): it "
+              "must equal plant_sim's, or the controllers wait for references stamped at times never sent",
+              msg->clock.toSec(), core::secondsFromNanos(period_ns_), 1e9 / period_ns_);
   }
-  any_ = true;
-  if (lookahead_) {
-    // The reference depends on time (and the obstacle list) only: send the one for the next period now,
-    // so that the kinematic controller has it when that state arrives and this node is off the loop's
-    // critical path (one hop fewer per lockstep step).
-    ros::Time next;
-    next.fromNSec(stamp.toNSec() + static_cast<std::uint64_t>(period_ns_));
-    fill(ahead_, next);
-    publishShared(ref_pub_, ahead_);
-    ahead_valid_ = true;
+  // The window must outlast the gap to the next /clock, or the loop would wait for a reference that only
+  // that /clock (which needs the loop to advance) would release: at least twice the largest gap seen.
+  // (Should a gap still exceed it, plant_sim re-sends /clock with the state it is stuck at.)
+  if (clock_seen_ && now > last_clock_ns_ && 2 * (now - last_clock_ns_) > window_ns_) {
+    window_ns_ = 2 * (now - last_clock_ns_);
+    ROS_WARN("reference_generator: /clock comes every %.3f s of simulated time: references now sent %.3f s ahead "
+             "(lookahead %.3f s)", 1e-9 * (now - last_clock_ns_), 1e-9 * window_ns_, lookahead_);
   }
+  clock_seen_ = true;
+  last_clock_ns_ = now;
+  // Forget what is behind simulated time (a late subscriber needs only the references still ahead).
+  while (!sent_.empty() && static_cast<std::int64_t>(sent_.front().header.stamp.toNSec()) < now) sent_.pop_front();
+  if (next_ns_ < 0 || next_ns_ < now - now % period_ns_) next_ns_ = now - now % period_ns_;  // start or jump
+  for (const std::int64_t end = now + window_ns_; next_ns_ <= end; next_ns_ += period_ns_) {
+    ros::Time stamp;
+    stamp.fromNSec(static_cast<std::uint64_t>(next_ns_));
+    sent_.emplace_back();
+    ReferenceState& r = sent_.back();
+    fill(r, stamp);
+    publishShared(ref_pub_, r);
+    geometry_msgs::PoseStamped p;
+    p.header = r.header;
+    p.pose.position.x = r.x;
+    p.pose.position.y = r.y;
+    p.pose.orientation.z = std::sin(0.5 * r.theta);
+    p.pose.orientation.w = std::cos(0.5 * r.theta);
+    if (path_->add(p)) path_pub_.publish(path_->path());
+  }
+}
 
-  geometry_msgs::PoseStamped p;
-  p.header = ref_.header;
-  p.pose.position.x = ref_.x;
-  p.pose.position.y = ref_.y;
-  p.pose.orientation.z = std::sin(0.5 * ref_.theta);
-  p.pose.orientation.w = std::cos(0.5 * ref_.theta);
-  if (path_->add(p)) path_pub_.publish(path_->path());
+void ReferenceGenerator::replayTo(const ros::SingleSubscriberPublisher& sub) {
+  for (const ReferenceState& r : sent_) sub.publish(r);
 }
 
 }  // namespace sowing_robot

@@ -4,6 +4,7 @@
 
 #include "sowing_robot/core/validation.h"
 #include "sowing_robot/ros/component_params.h"
+#include "sowing_robot/ros/msg_checks.h"
 
 namespace sowing_robot {
 
@@ -19,7 +20,7 @@ RunMonitor::RunMonitor(ros::NodeHandle nh, ros::NodeHandle pnh) {
   requireValid(p, core::checkPositive("duration", duration_, "s"));
   metrics_ = core::MetricsAccumulator(time_domain);
   metrics_.reserve(static_cast<std::size_t>(duration_ * 1000.0) + 2);
-  sub_ = nh.subscribe("tracking_error", 1000, &RunMonitor::errorCallback, this, ros::TransportHints().tcpNoDelay());
+  sub_ = nh.subscribe("tracking_error", kLockstepQueue, &RunMonitor::errorCallback, this, ros::TransportHints().tcpNoDelay());
 }
 
 void RunMonitor::errorCallback(const TrackingError::ConstPtr& msg) {

@@ -83,11 +83,19 @@ SeedDrillNode::~SeedDrillNode() {
 
 void SeedDrillNode::odomCallback(const nav_msgs::Odometry::ConstPtr& msg) {
   if (!odomIsFinite(*msg)) return;
-  const core::Pose2D pose = poseOf(*msg);
+  if (inputs_.setFirst(*msg)) update(inputs_.first(), inputs_.second().tool_down);
+}
+
+void SeedDrillNode::referenceCallback(const ReferenceState::ConstPtr& msg) {
+  if (inputs_.setSecond(*msg)) update(inputs_.first(), inputs_.second().tool_down);
+}
+
+void SeedDrillNode::update(const nav_msgs::Odometry& odom, bool tool_down) {
+  const core::Pose2D pose = poseOf(odom);
   const double c = std::cos(pose.theta), s = std::sin(pose.theta);
   const Eigen::Vector2d tool(pose.x + c * tool_x_ - s * tool_y_, pose.y + s * tool_x_ + c * tool_y_);
   Eigen::Vector2d seed;
-  if (!drill_->update(tool, tool_down_, seed)) return;
+  if (!drill_->update(tool, tool_down, seed)) return;
   if (chunk_.points.size() >= kChunk) {
     chunk_.points.clear();
     ++chunk_id_;
@@ -97,7 +105,7 @@ void SeedDrillNode::odomCallback(const nav_msgs::Odometry::ConstPtr& msg) {
   pt.y = seed.y();
   chunk_.points.push_back(pt);
   chunk_.id = chunk_id_;
-  chunk_.header.stamp = msg->header.stamp;
+  chunk_.header.stamp = odom.header.stamp;
   visualization_msgs::MarkerArray out;
   out.markers.push_back(chunk_);
   seeds_pub_.publish(out);

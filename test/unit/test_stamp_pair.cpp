@@ -1,5 +1,5 @@
-// StampPair: the pairing by stamp that makes lockstep exact, including a reference that arrives one
-// period ahead of the state (the reference generator's lookahead).
+// StampPair: the pairing by stamp that makes lockstep exact, including references that arrive up to
+// the reference generator's lookahead ahead of the state.
 #include <gtest/gtest.h>
 
 #include "sowing_robot/ros/stamp_pair.h"
@@ -67,4 +67,38 @@ TEST(StampPair, PairsTheNewestCommonStamp) {
   EXPECT_EQ(p.first().tag, 2);
   EXPECT_EQ(p.second().tag, 4);
   EXPECT_FALSE(p.setSecond(at(1.0, 5)));  // 1.0 is older than the pair handed out
+}
+
+TEST(StampPair, HoldsAWholeLookaheadWindowAndPairsEveryStateInTurn) {
+  // The generator sends references in bursts, up to 60 periods ahead of the state: every state must
+  // find its own reference, and the references it has passed must not pile up.
+  StampPair<Msg, Msg> p;
+  int next_ref = 0;
+  for (int k = 0; k < 1000; ++k) {
+    if (k % 10 == 0)
+      for (; next_ref <= k + 60; ++next_ref) EXPECT_FALSE(p.setSecond(at(0.001 * next_ref, next_ref)));
+    ASSERT_TRUE(p.setFirst(at(0.001 * k, -k))) << k;
+    EXPECT_EQ(p.first().tag, -k);
+    EXPECT_EQ(p.second().tag, k);
+    EXPECT_LE(p.heldSeconds(), 62u);
+  }
+}
+
+TEST(StampPair, CapsEachStreamDroppingTheOldest) {
+  // No reference ever comes (generator dead): states are kept only up to the first stream's cap.
+  StampPair<Msg, Msg, 4, 16> p;
+  for (int k = 0; k < 100; ++k) EXPECT_FALSE(p.setFirst(at(0.001 * k, k)));
+  EXPECT_EQ(p.heldFirsts(), 4u);
+  EXPECT_TRUE(p.setSecond(at(0.099, 1)));  // the newest state is still there
+  EXPECT_FALSE(p.setSecond(at(0.050, 2)));  // an old one is not
+  for (int k = 0; k < 100; ++k) p.setSecond(at(1.0 + 0.001 * k, k));
+  EXPECT_EQ(p.heldSeconds(), 16u);
+}
+
+TEST(StampPair, TellsAGridMismatchFromAReferenceOnItsWay) {
+  StampPair<Msg, Msg> p;
+  p.setSecond(at(0.002));
+  EXPECT_FALSE(p.setFirst(at(0.001)));
+  EXPECT_TRUE(p.secondsPassed(ros::Time(0.001)));   // a newer reference, none for 0.001: off grid
+  EXPECT_FALSE(p.secondsPassed(ros::Time(0.002)));  // nothing newer: still on its way
 }

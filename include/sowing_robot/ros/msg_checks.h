@@ -26,8 +26,10 @@ inline bool odomIsFinite(const nav_msgs::Odometry& o) {
 }  // namespace sowing_robot
 
 namespace sowing_robot {
-/// Publisher queue of every per-period topic: a recorder that falls behind in lockstep (which does not
-/// wait for it) must not lose messages, so the queue holds several seconds of a 1 kHz run.
+/// Publisher and subscriber queue of every per-period topic: a recorder that falls behind in lockstep
+/// (which does not wait for it) must not lose messages, so the queue holds several seconds of a 1 kHz
+/// run; and a subscriber in a nodelet manager gets the reference generator's lookahead in one burst
+/// (50 references at the defaults), which a short queue would cut (dropping the oldest, the one due).
 constexpr std::uint32_t kLockstepQueue = 20000;
 }  // namespace sowing_robot
 

@@ -59,7 +59,9 @@ class PlantSim {
   };
 
   void torqueCallback(const WheelTorque::ConstPtr& msg);
-  void publishState(const ros::Time& stamp, bool visuals);
+  /// The state at `stamp`; tf, joint_states and the path too with `visuals`; /clock at clock_rate, with
+  /// visuals, or when `clock` is set.
+  void publishState(const ros::Time& stamp, bool visuals, bool clock = false);
   /// False when the state is non-finite or faster than max_speed.
   bool healthy() const;
   /// Ends the process with a FATAL line (exit 2): the state diverged.

@@ -1,7 +1,9 @@
-// reference_generator: publishes the reference posture, velocities and accelerations for every state
-// the plant publishes (same stamp), plus the reference path for rviz. With `lookahead` (default) the
-// reference for t_k + 1/control_rate goes out together with the one for t_k: an obstacle or gain change
-// then takes effect one period later, and the loop does not wait for this node.
+// reference_generator: publishes the reference posture, velocities and accelerations on the control
+// grid (t_k = k / control_rate, the stamps of the plant's states), plus the reference path for rviz.
+// The reference depends on time (and the obstacle list) only, so it is sent ahead: paced by /clock,
+// every reference up to `lookahead` seconds after it. The loop then never waits for this node, which
+// gets no message per step (/clock comes at plant_sim's clock_rate); an obstacle or gain change takes
+// effect on references not yet sent, i.e. `lookahead` later.
 //   type line:  core::LineReference (the thesis's sowing line).
 //   type field: core::FieldReference (rows + headland turns through the potential field) with the
 //               obstacles from the `obstacles` parameter; `obstacles` (MarkerArray) replaces them at
@@ -9,12 +11,13 @@
 #pragma once
 
 #include <dynamic_reconfigure/server.h>
-#include <nav_msgs/Odometry.h>
 #include <nav_msgs/Path.h>
 #include <ros/ros.h>
+#include <rosgraph_msgs/Clock.h>
 #include <visualization_msgs/MarkerArray.h>
 
 #include <cstdint>
+#include <deque>
 #include <memory>
 #include <vector>
 
@@ -31,7 +34,10 @@ class ReferenceGenerator {
   ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh);
 
  private:
-  void odomCallback(const nav_msgs::Odometry::ConstPtr& msg);
+  /// Sends every reference up to the new simulated time + the window.
+  void clockCallback(const rosgraph_msgs::Clock::ConstPtr& msg);
+  /// A late subscriber gets the references already sent for times still ahead.
+  void replayTo(const ros::SingleSubscriberPublisher& sub);
   /// The source's reference at stamp into out.
   void fill(ReferenceState& out, const ros::Time& stamp);
   /// type field: every ADD CYLINDER marker is an obstacle (centre = pose.position, radius = scale.x / 2);
@@ -45,15 +51,16 @@ class ReferenceGenerator {
   std::unique_ptr<core::ReferenceSource> source_;
   core::FieldReference* field_ = nullptr;  ///< source_ when type is field, else null
   std::vector<core::Obstacle> obstacles_;  ///< the obstacles in force (type field)
-  ros::Subscriber odom_sub_, obstacles_sub_;
+  ros::Subscriber clock_sub_, obstacles_sub_;
   ros::Publisher ref_pub_, path_pub_, marker_pub_;
-  ReferenceState ref_;    ///< reference for the newest state
-  ReferenceState ahead_;  ///< reference for one period after it (lookahead), already published
-  bool ahead_valid_ = false;
-  bool lookahead_ = true;
+  std::deque<ReferenceState> sent_;   ///< published, for times not yet passed (replayed to late subscribers)
+  double lookahead_ = 0.05;           ///< [s] send references this far ahead of /clock
+  std::int64_t window_ns_ = 50000000; ///< [ns] lookahead, or twice the largest /clock gap seen if longer
+  std::int64_t next_ns_ = -1;         ///< stamp of the next reference to send [ns]
+  std::int64_t last_clock_ns_ = 0;
+  bool clock_seen_ = false, grid_warned_ = false;
   std::int64_t period_ns_ = 1000000;  ///< control period (control_rate) [ns]
   std::unique_ptr<PathBuffer> path_;  // reference_path (spacing from the parameters)
-  bool any_ = false;
   double path_spacing_ = 0.1;  // [m] between stored reference path points
   std::unique_ptr<dynamic_reconfigure::Server<ReferenceGeneratorConfig>> reconfigure_;  // type field only
 };

@@ -1,5 +1,5 @@
 // seed_drill: the plant-side seed drill. Follows the tool point (URDF `tool_link`) on odom, drops a seed
-// every `spacing` metres while the tool is down, shows the seeds in rviz and reports the cross-track
+// every `spacing` metres while the tool is down (the reference's tool_down for the same stamp), shows the seeds in rviz and reports the cross-track
 // error of the sown line against the intended rows (away from obstacles and in detours apart).
 #pragma once
 
@@ -11,6 +11,7 @@
 
 #include "sowing_robot/ReferenceState.h"
 #include "sowing_robot/core/seeding.h"
+#include "sowing_robot/ros/stamp_pair.h"
 
 namespace sowing_robot {
 
@@ -21,12 +22,14 @@ class SeedDrillNode {
 
  private:
   void odomCallback(const nav_msgs::Odometry::ConstPtr& msg);
-  void referenceCallback(const ReferenceState::ConstPtr& msg) { tool_down_ = msg->tool_down; }
+  void referenceCallback(const ReferenceState::ConstPtr& msg);
+  /// The state and the reference for the same time: move the tool, maybe drop a seed.
+  void update(const nav_msgs::Odometry& odom, bool tool_down);
   void publishReport();
 
   std::unique_ptr<core::SeedDrill> drill_;
   double tool_x_ = 0.0, tool_y_ = 0.0;  // tool point in base_link [m]
-  bool tool_down_ = false;
+  StampPair<nav_msgs::Odometry, ReferenceState> inputs_;  // the reference is sent ahead of the state
   ros::Subscriber odom_sub_, ref_sub_;
   ros::Publisher seeds_pub_, report_pub_;
   visualization_msgs::Marker chunk_;  // the current SPHERE_LIST of up to kChunk seeds

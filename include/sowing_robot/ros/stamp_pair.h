@@ -4,27 +4,29 @@
 
 #include <ros/time.h>
 
-#include <array>
+#include <algorithm>
 #include <cstddef>
+#include <vector>
 
 namespace sowing_robot {
 
-template <typename A, typename B>
+/// Each stream keeps the messages newer than the last pair handed out, up to its cap (then the oldest
+/// goes): the second stream must hold every reference the generator sends ahead of the state
+/// (lookahead / control period of them, 50 at the defaults), the first only the newest few states.
+template <typename A, typename B, std::size_t kMaxFirsts = 8, std::size_t kMaxSeconds = 8192>
 class StampPair {
  public:
-  /// Messages kept per stream. Two, because the reference generator publishes the reference for
-  /// t_{k+1} as soon as it has the state for t_k: the kinematic controller may then hold the references
-  /// for t_k and t_{k+1} when the state for t_k arrives.
-  static constexpr std::size_t kDepth = 2;
 
-  /// Store a message (the oldest of its stream is dropped); returns true when a stamp present in both
-  /// streams is newer than the last pair handed out. first() and second() are then that pair.
+  /// Store a message; returns true when a stamp present in both streams is newer than the last pair
+  /// handed out. first() and second() are then that pair, valid until the next set call.
   bool setFirst(const A& a) {
-    firsts_.push(a);
+    prune();
+    firsts_.push(a, kMaxFirsts);
     return match();
   }
   bool setSecond(const B& b) {
-    seconds_.push(b);
+    prune();
+    seconds_.push(b, kMaxSeconds);
     return match();
   }
   const A& first() const { return firsts_.at(first_index_); }
@@ -34,32 +36,69 @@ class StampPair {
   bool any() const { return handed_out_; }
   /// Same stamp as the last pair handed out: the caller republishes its cached answer.
   bool isRepeat(const ros::Time& stamp) const { return handed_out_ && stamp == last_; }
+  /// Messages held (tests, diagnostics).
+  std::size_t heldFirsts() const { return firsts_.count; }
+  std::size_t heldSeconds() const { return seconds_.count; }
+  /// A second stamped after `stamp` is held: a first stamped `stamp` with no second means the two
+  /// streams are on different time grids (a control_rate mismatch), not a second still on its way.
+  bool secondsPassed(const ros::Time& stamp) const {
+    for (std::size_t i = 0; i < seconds_.count; ++i)
+      if (seconds_.at(i).header.stamp > stamp) return true;
+    return false;
+  }
 
  private:
+  /// A ring in arrival order that doubles (rarely: only while the lookahead fills it) up to `cap`.
   template <typename T>
   struct Ring {
-    std::array<T, kDepth> items{};
-    std::size_t count = 0, next = 0;
-    void push(const T& m) {
-      items[next] = m;
-      next = (next + 1) % kDepth;
-      if (count < kDepth) ++count;
+    std::vector<T> items = std::vector<T>(2);
+    std::size_t head = 0, count = 0;
+    const T& at(std::size_t i) const { return items[(head + i) % items.size()]; }
+    void push(const T& m, std::size_t cap) {
+      if (count == items.size()) {
+        if (items.size() < cap) {
+          std::vector<T> grown(std::min(cap, 2 * items.size()));
+          for (std::size_t i = 0; i < count; ++i) grown[i] = at(i);
+          items.swap(grown);
+          head = 0;
+        } else {
+          popFront();
+        }
+      }
+      items[(head + count) % items.size()] = m;
+      ++count;
     }
-    const T& at(std::size_t i) const { return items[i]; }
+    void popFront() {
+      head = (head + 1) % items.size();
+      --count;
+    }
+    /// Drops the oldest messages while they are not newer than `last` (they can never pair again).
+    void dropUpTo(const ros::Time& last) {
+      while (count > 0 && at(0).header.stamp <= last) popFront();
+    }
   };
+
+  /// Messages the last pair made useless (the pair included) go before a new one is stored, not at
+  /// once: first() and second() refer into the rings until then.
+  void prune() {
+    if (!handed_out_) return;
+    firsts_.dropUpTo(last_);
+    seconds_.dropUpTo(last_);
+  }
 
   bool match() {
     bool found = false;
     ros::Time best;
     for (std::size_t i = 0; i < firsts_.count; ++i) {
-      const ros::Time& stamp = firsts_.items[i].header.stamp;
+      const ros::Time& stamp = firsts_.at(i).header.stamp;
       if ((handed_out_ && stamp <= last_) || (found && stamp <= best)) continue;
       for (std::size_t j = 0; j < seconds_.count; ++j) {
-        if (seconds_.items[j].header.stamp != stamp) continue;
+        if (seconds_.at(j).header.stamp != stamp) continue;
         found = true;
         best = stamp;
         first_index_ = i;
         second_index_ = j;
+        break;
       }
     }
     if (!found) return false;
