@@ -153,6 +153,13 @@ std::string PsoParams::validate() const {
 }
 
 PsoResult psoMinimize(const PsoParams& p, const PsoFitness& fitness, const PsoProgressCallback& progress) {
+  if (!fitness) throw std::invalid_argument("psoMinimize: fitness is empty");
+  return psoMinimize(
+      p, PsoBoundedFitness([&fitness](const std::vector<double>& x, int t, double) { return fitness(x, t); }),
+      progress);
+}
+
+PsoResult psoMinimize(const PsoParams& p, const PsoBoundedFitness& fitness, const PsoProgressCallback& progress) {
   const std::string error = p.validate();
   if (!error.empty()) throw std::invalid_argument("PsoParams: " + error);
   if (!fitness) throw std::invalid_argument("psoMinimize: fitness is empty");
@@ -192,7 +199,8 @@ PsoResult psoMinimize(const PsoParams& p, const PsoFitness& fitness, const PsoPr
   result.evaluations = 0;
 
   EvaluationPool pool(threads, [&](int j, int thread_index) {
-    const double c = fitness(x[static_cast<std::size_t>(j)], thread_index);
+    // pbest_cost changes only between evaluation rounds, on the caller thread.
+    const double c = fitness(x[static_cast<std::size_t>(j)], thread_index, pbest_cost[static_cast<std::size_t>(j)]);
     cost[static_cast<std::size_t>(j)] = std::isfinite(c) ? c : INF;
   });
 

@@ -21,7 +21,7 @@ std::int64_t Scenario::steps() const {
 }
 
 RunResult runClosedLoop(const Scenario& sc, ReferenceSource& reference, bool keep_samples,
-                        const std::function<void(const LoopSample&)>& trace) {
+                        const std::function<void(const LoopSample&)>& trace, const RunStop& stop) {
   Plant plant(sc.robot, sc.disturbance);
   State x0 = State::Zero();
   x0[X] = sc.start.x;
@@ -54,6 +54,11 @@ RunResult runClosedLoop(const Scenario& sc, ReferenceSource& reference, bool kee
     const SlidingModeOutput u = smc.update(cmd, s[V], s[OMEGA], dt);
     if (u.saturated) ++result.saturated_steps;
     if (trace) trace({t, &s, &ref, &cmd, &u, smc.m0Hat(), smc.i0Hat(), ex, ey, eth});
+    result.periods = k;
+    if (stop && k % kStopCheckEvery == kStopCheckEvery - 1 && k < n && stop(metrics)) {
+      result.stopped = true;
+      break;
+    }
     if (k < n) plant.step(u.torques.right, u.torques.left, dt);
   }
   result.final_state = plant.state();

@@ -1,6 +1,7 @@
 #include "sowing_robot/core/tuning.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -153,7 +154,25 @@ Scenario TuningProblem::scenarioFor(const std::vector<double>& x) const {
   return sc;
 }
 
-TuningCost TuningProblem::evaluate(const std::vector<double>& x, int thread_index) const {
+void TuningProblem::total(const std::array<AxisMetrics, AXIS_COUNT>& metrics, double effort, double chattering,
+                          TuningCost& c) const {
+  c.tracking = 0.0;
+  for (const AxisMetrics& m : metrics) {
+    switch (objective_.cost) {
+      case CostType::ITAE: c.tracking += m.itae; break;
+      case CostType::ISE: c.tracking += m.ise; break;
+      case CostType::IAE: c.tracking += m.iae; break;
+      case CostType::ITSE: c.tracking += m.itse; break;
+    }
+  }
+  c.effort = effort;
+  c.chattering = chattering;
+  c.total = c.tracking;
+  if (objective_.torque_weight > 0.0) c.total += objective_.torque_weight * c.effort;
+  if (objective_.chattering_weight > 0.0) c.total += objective_.chattering_weight * c.chattering;
+}
+
+TuningCost TuningProblem::evaluate(const std::vector<double>& x, int thread_index, double bound) const {
   const Scenario sc = scenarioFor(x);
   ReferenceSource& ref = *references_.at(static_cast<std::size_t>(thread_index));
   TorqueTally tally;
@@ -163,23 +182,21 @@ TuningCost TuningProblem::evaluate(const std::vector<double>& x, int thread_inde
     TorqueTally* t = &tally;  // one pointer: fits std::function's small buffer, no allocation
     trace = [t](const LoopSample& s) { t->add(s); };
   }
-  const RunResult r = runClosedLoop(sc, ref, false, trace);
+  RunStop stop;
+  if (std::isfinite(bound)) {
+    stop = [this, &tally, bound](const MetricsAccumulator& m) {
+      TuningCost partial;
+      total(m.result(), tally.effort, tally.chattering, partial);
+      return partial.total >= bound;
+    };
+  }
+  const RunResult r = runClosedLoop(sc, ref, false, trace, stop);
 
   TuningCost c;
   c.diverged = r.diverged;
-  for (const AxisMetrics& m : r.metrics) {
-    switch (objective_.cost) {
-      case CostType::ITAE: c.tracking += m.itae; break;
-      case CostType::ISE: c.tracking += m.ise; break;
-      case CostType::IAE: c.tracking += m.iae; break;
-      case CostType::ITSE: c.tracking += m.itse; break;
-    }
-  }
-  c.effort = tally.effort;
-  c.chattering = tally.chattering;
-  c.total = c.tracking;
-  if (objective_.torque_weight > 0.0) c.total += objective_.torque_weight * c.effort;
-  if (objective_.chattering_weight > 0.0) c.total += objective_.chattering_weight * c.chattering;
+  c.bounded = r.stopped;
+  c.simulated = secondsFromNanos(r.periods * sc.control_period_ns);
+  total(r.metrics, tally.effort, tally.chattering, c);
   if (r.diverged || !std::isfinite(c.total)) c.total = INF;
   return c;
 }
@@ -206,9 +223,19 @@ TuningResult tuneGains(const Scenario& base, const ReferenceSource& reference, c
   out.threads = psoThreads(params);
   const TuningProblem problem(base, reference, gains, objective, out.threads);
   const auto t0 = std::chrono::steady_clock::now();
-  out.pso = psoMinimize(
-      params, [&problem](const std::vector<double>& x, int thread) { return problem.evaluate(x, thread).total; },
-      progress);
+  // Bounded: a particle's run stops once it cannot beat its personal best (same search, less work).
+  std::atomic<long> cut{0};
+  std::atomic<std::int64_t> simulated_ns{0};
+  out.pso = psoMinimize(params,
+                        PsoBoundedFitness([&](const std::vector<double>& x, int thread, double bound) {
+                          const TuningCost c = problem.evaluate(x, thread, bound);
+                          if (c.bounded) ++cut;
+                          simulated_ns += std::llround(c.simulated * 1e9);
+                          return c.total;
+                        }),
+                        progress);
+  out.evaluations_cut = cut;
+  out.simulated_s = 1e-9 * static_cast<double>(simulated_ns.load());
   out.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   out.best_gains = out.pso.best_position;
   out.best = problem.evaluate(out.best_gains, 0);

@@ -91,6 +91,13 @@ PlantSim::PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh) {
   joint_msg_.velocity.resize(2);
 }
 
+PlantSim::~PlantSim() {
+  // Returns only when no torque callback is running: roscpp holds the subscription's callback lock
+  // while a callback queued on inline_queue_ runs. Not under inline_queue_'s mutex (that order would
+  // be the reverse of roscpp's and could deadlock).
+  torque_sub_.shutdown();
+}
+
 void PlantSim::torqueCallback(const WheelTorque::ConstPtr& msg) {
   if (!core::allFinite(msg->right, msg->left)) {
     ++rejected_;

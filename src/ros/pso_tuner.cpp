@@ -284,8 +284,9 @@ int PsoTuner::run() {
   std::string best;
   for (std::size_t d = 0; d < gains_.size(); ++d)
     best += (d ? ", " : "") + gains_[d].name + " " + fmt("%.5g", r.best_gains[d]);
-  ROS_INFO("pso_tuner: done in %.2f s (%ld evaluations, %d thread(s)): cost %.6g -> %.6g; %s", r.wall_s,
-           r.pso.evaluations, r.threads, r.initial_best_cost, r.pso.best_cost, best.c_str());
+  ROS_INFO("pso_tuner: done in %.2f s (%ld evaluations, %ld of them stopped once they could not beat their "
+           "particle's best, %d thread(s)): cost %.6g -> %.6g; %s", r.wall_s, r.pso.evaluations, r.evaluations_cut,
+           r.threads, r.initial_best_cost, r.pso.best_cost, best.c_str());
   ROS_INFO("pso_tuner: wrote %s", output_.c_str());
   if (progress_pub_.getNumSubscribers() > 0) ros::WallDuration(0.3).sleep();  // let the last message go out
   return 0;

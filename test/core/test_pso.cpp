@@ -389,3 +389,49 @@ TEST(PsoMinimize, MoreThreadsThanParticlesIsFine) {
   EXPECT_EQ(psoMinimize(p, [](const std::vector<double>& x, int) { return sphere(x); }).best_position,
             r.best_position);
 }
+
+TEST(PsoMinimize, BoundedFitnessSearchesExactlyLikeTheExactOne) {
+  // A fitness that gives up as soon as it cannot beat the particle's personal best (and then returns
+  // some value >= bound, not its cost) must leave the whole search unchanged.
+  PsoParams p;
+  p.particles = 12;
+  p.iterations = 25;
+  p.lower = {-5.0, -5.0, -5.0};
+  p.upper = {5.0, 5.0, 5.0};
+  p.seed = 11;
+  p.threads = 2;
+  std::atomic<int> cut{0};
+  const PsoResult exact = psoMinimize(p, [](const std::vector<double>& x, int) { return rastrigin(x); });
+  const PsoResult bounded = psoMinimize(p, PsoBoundedFitness([&cut](const std::vector<double>& x, int, double bound) {
+                                          const double c = rastrigin(x);
+                                          if (c < bound) return c;
+                                          ++cut;
+                                          return bound + 1.0;  // "at least the bound"
+                                        }));
+  EXPECT_GT(cut.load(), 0);
+  EXPECT_EQ(bounded.best_position, exact.best_position);
+  EXPECT_EQ(bounded.best_cost, exact.best_cost);
+  EXPECT_EQ(bounded.best_cost_per_iteration, exact.best_cost_per_iteration);
+}
+
+TEST(PsoMinimize, BoundIsThePersonalBest) {
+  PsoParams p;
+  p.particles = 1;
+  p.iterations = 3;
+  p.lower = {-1.0};
+  p.upper = {1.0};
+  p.threads = 1;
+  std::vector<double> bounds, costs;
+  psoMinimize(p, PsoBoundedFitness([&](const std::vector<double>& x, int, double bound) {
+                bounds.push_back(bound);
+                costs.push_back(sphere(x));
+                return costs.back();
+              }));
+  ASSERT_EQ(bounds.size(), 4u);
+  EXPECT_TRUE(std::isinf(bounds[0]));  // no personal best before the first evaluation
+  double best = costs[0];
+  for (std::size_t i = 1; i < bounds.size(); ++i) {
+    EXPECT_EQ(bounds[i], best) << i;
+    best = std::min(best, costs[i]);
+  }
+}

@@ -78,3 +78,22 @@ TEST(Runner, ScenarioValidation) {
   sc.duration = -1;
   EXPECT_NE(sc.validate().find("duration"), std::string::npos);
 }
+
+TEST(Runner, StopEndsTheRunWithTheIntegralsSoFar) {
+  Scenario sc;
+  sc.duration = 5.0;
+  LineReference ref;
+  const RunResult whole = runClosedLoop(sc, ref, false);
+  int asked = 0;
+  const RunResult part = runClosedLoop(sc, ref, false, {}, [&asked](const MetricsAccumulator& m) {
+    ++asked;
+    return m.samples() >= 1000;
+  });
+  EXPECT_FALSE(whole.stopped);
+  EXPECT_TRUE(part.stopped);
+  EXPECT_EQ(asked, 4);  // asked every kStopCheckEvery (256) periods: after 256, 512, 768, 1024 samples
+  for (int a = 0; a < AXIS_COUNT; ++a) {
+    EXPECT_GT(part.metrics[a].itae, 0.0) << a;
+    EXPECT_LE(part.metrics[a].itae, whole.metrics[a].itae) << a;  // a lower bound of the whole run's
+  }
+}

@@ -6,6 +6,9 @@ every lockstep_timeout wall seconds it says what it is waiting for.
 - Killed mid-run: plant_sim stays at the stalled step, re-publishes that state every lockstep_retry, and
   logs an ERROR naming the step's time and the torque topic with its publisher count (0); it resumes
   when a torque controller is started again.
+- Kinematic controller killed mid-run and restarted: the reference generator, which sends references
+  ahead of the state, replays the ones still ahead to the new subscriber, so the new controller answers
+  the stalled state with a real command, not the stop it gives when it has no reference.
 - Never started (a second plant_sim alone in /lonely): it does not take step 0 and logs a WARN with the
   number of wheel_torque publishers (0); after lockstep_give_up wall seconds it exits 3 with a FATAL line
   naming the missing input (a third plant_sim in /given_up, with a 3 s limit).
@@ -13,10 +16,12 @@ every lockstep_timeout wall seconds it says what it is waiting for.
 Protections checked (PlantSim::runLockstep, src/ros/plant_sim.cpp): the "lockstep stalled" ROS_ERROR in
 the wait for a torque, the re-publication of the stalled state, and the "lockstep waiting for the loop"
 ROS_WARN before step 0, and giveUpAfter() (exit 3).
+And ReferenceGenerator::replayTo (src/ros/reference_generator.cpp).
 Verified to fail without them: with the ROS_ERROR removed test_killed_controller... fails waiting for
 the report; with the re-publication removed it fails on the repeat count (and the restarted controller
 never gets a state to answer, so the run does not resume); with the ROS_WARN removed
-test_missing_controller... fails waiting for the report."""
+test_missing_controller... fails waiting for the report; with replayTo emptied test_restarted_kinematic...
+fails on the stop commands."""
 import re
 import tempfile
 import time
@@ -27,6 +32,7 @@ import rospy
 import rostest
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Log
+from sowing_robot.msg import DesiredVelocity
 
 import node_process
 
@@ -92,6 +98,25 @@ class LockstepDeadController(unittest.TestCase):
 
         self.children.append(node_process.start("torque_controller", "torque_controller"))
         self.wait_for(lambda: self.last_odom() >= stalled + 0.5, "progress after the torque controller restarted")
+
+    def test_restarted_kinematic_controller_gets_the_references_already_sent(self):
+        if "/torque_controller" not in rosnode.get_node_names():  # another test may have replaced it
+            self.children.append(node_process.start("torque_controller", "torque_controller"))
+        self.wait_for(lambda: self.last_odom() >= 0.5, "odom up to t = 0.5 s")
+        rosnode.kill_nodes(["/kinematic_controller"])
+        self.wait_for(lambda: self.odom_stamps.count(self.last_odom()) >= 2, "the stalled state re-published")
+        stalled = self.last_odom()
+        desired = []
+        self.subs.append(rospy.Subscriber("desired_velocity", DesiredVelocity, desired.append, queue_size=20000))
+        self.children.append(node_process.start("kinematic_controller", "kinematic_controller"))
+        self.wait_for(lambda: self.last_odom() >= stalled + 0.5, "progress after the kinematic controller restarted")
+        after = [m for m in list(desired) if m.header.stamp.to_sec() >= stalled - 1e-9]
+        self.assertTrue(after and abs(after[0].header.stamp.to_sec() - stalled) < 1e-9,
+                        "no command for the stalled state t=%.6f" % stalled)
+        # Without its reference the controller commands a stop (v = omega = 0 exactly) and warns.
+        stops = [m.header.stamp.to_sec() for m in after if m.v == 0.0 and m.omega == 0.0]
+        self.assertEqual(stops, [], "stop commands (no reference) after the restart at t = %s" % stops[:5])
+        self.assertEqual(self.reports("/kinematic_controller", Log.WARN, "no reference"), [])
 
     def test_missing_controller_is_reported_before_the_start(self):
         ns = "/lonely"  # its own topics: the pipeline's torque_controller must not count as its publisher

@@ -53,12 +53,19 @@ struct PsoResult {
 /// and no two concurrent calls share one, so callers can keep per-thread state (e.g. cloned references).
 /// Calls may run concurrently on different threads. Non-finite costs count as +inf (never become a best).
 using PsoFitness = std::function<double(const std::vector<double>&, int)>;
+/// The same with the particle's personal best cost as `bound` (+inf before it has one). A cost that is
+/// not below the bound changes nothing (no personal, hence no global, best), so the fitness may stop as
+/// soon as it knows its cost is at least the bound and return any value >= bound: the search, its
+/// random numbers and its result are exactly those of the exact fitness, only cheaper.
+using PsoBoundedFitness = std::function<double(const std::vector<double>&, int, double bound)>;
 using PsoProgressCallback = std::function<void(const PsoProgress&)>;
 
 /// Minimise `fitness` over the box [lower, upper]. Throws std::invalid_argument with params.validate()'s
 /// message if the parameters are bad. An exception thrown by fitness is rethrown on the caller thread
 /// (after the worker threads have stopped); so is one thrown by progress.
 PsoResult psoMinimize(const PsoParams& params, const PsoFitness& fitness, const PsoProgressCallback& progress = {});
+PsoResult psoMinimize(const PsoParams& params, const PsoBoundedFitness& fitness,
+                      const PsoProgressCallback& progress = {});
 
 }  // namespace core
 }  // namespace sowing_robot

@@ -46,13 +46,21 @@ struct RunResult {
   std::array<AxisMetrics, AXIS_COUNT> metrics{};
   State final_state = State::Zero();
   bool diverged = false;  ///< state became non-finite; metrics are then +inf
+  bool stopped = false;   ///< ended early by the caller's stop(): the integrals so far (a lower bound)
+  std::int64_t periods = 0;  ///< control periods simulated
   std::int64_t saturated_steps = 0;
 };
+
+/// Asked every kStopCheckEvery periods with the metrics so far; true ends the run there. Every integral
+/// only grows with time, so a caller that only needs to know whether a run beats a bound can stop once
+/// the partial cost has reached it (the PSO tuner does).
+using RunStop = std::function<bool(const MetricsAccumulator&)>;
+constexpr std::int64_t kStopCheckEvery = 256;
 
 /// Run the scenario with the given reference. trace (optional) sees every period; keep_samples turns
 /// on the time-domain figures (rise/settling/overshoot).
 RunResult runClosedLoop(const Scenario& scenario, ReferenceSource& reference, bool keep_samples = true,
-                        const std::function<void(const LoopSample&)>& trace = {});
+                        const std::function<void(const LoopSample&)>& trace = {}, const RunStop& stop = {});
 
 /// World-frame errors (reference minus actual, theta wrapped).
 inline void worldErrors(const Reference& r, const Pose2D& a, double& ex, double& ey, double& eth) {

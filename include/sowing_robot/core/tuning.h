@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -63,6 +64,8 @@ struct TuningCost {
   double effort = 0.0;    ///< int (tau_R^2 + tau_L^2) dt
   double chattering = 0.0;
   bool diverged = false;
+  bool bounded = false;   ///< the run was stopped once total reached the bound: total is a lower bound
+  double simulated = 0.0; ///< simulated time actually run [s]
 };
 
 /// Scores gain vectors (in the order of `gains`) on a base scenario. evaluate() may be called from
@@ -75,8 +78,11 @@ class TuningProblem {
 
   /// The base scenario with the given gains applied.
   Scenario scenarioFor(const std::vector<double>& position) const;
-  /// A diverged run or any non-finite term gives total = +inf.
-  TuningCost evaluate(const std::vector<double>& position, int thread_index) const;
+  /// A diverged run or any non-finite term gives total = +inf. With a finite `bound` the run stops as
+  /// soon as the cost so far (every term only grows with time) has reached it; total is then that
+  /// partial cost, >= bound, and `bounded` is set (what psoMinimize's bounded fitness may do).
+  TuningCost evaluate(const std::vector<double>& position, int thread_index,
+                      double bound = std::numeric_limits<double>::infinity()) const;
 
   const std::vector<GainBounds>& gains() const { return gains_; }
   const Scenario& base() const { return base_; }
@@ -87,6 +93,12 @@ class TuningProblem {
   std::vector<GainBounds> gains_;
   TuningObjective objective_;
   std::vector<std::unique_ptr<ReferenceSource>> references_;
+
+  /// The weighted total of the terms, added in one fixed order: the same formula for a partial and a
+  /// whole run, so a partial total is never above the whole run's (floating-point sums of non-negative
+  /// terms only grow).
+  void total(const std::array<AxisMetrics, AXIS_COUNT>& metrics, double effort, double chattering,
+             TuningCost& c) const;
 };
 
 struct TuningResult {
@@ -96,6 +108,8 @@ struct TuningResult {
   double initial_best_cost = 0.0;  ///< best of iteration 0 (the random initial swarm)
   int threads = 1;                 ///< evaluation threads actually used
   double wall_s = 0.0;
+  long evaluations_cut = 0;        ///< evaluations stopped early by their particle's bound
+  double simulated_s = 0.0;        ///< simulated time run over all evaluations [s]
 };
 
 /// Resolved number of evaluation threads psoMinimize will use for these parameters.

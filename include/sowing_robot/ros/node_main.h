@@ -24,8 +24,7 @@ int runCallbackNode(int argc, char** argv, const char* name) {
     std::lock_guard<std::recursive_mutex> lock(queue.mutex());
     node = std::make_unique<Wrapper>(nh, pnh);
   }
-  ros::waitForShutdown();
-  std::lock_guard<std::recursive_mutex> lock(queue.mutex());
+  ros::waitForShutdown();  // returns once roscpp's threads have ended: no callback can be running
   node.reset();
   return 0;
 }

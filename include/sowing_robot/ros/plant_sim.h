@@ -28,6 +28,9 @@ class PlantSim {
  public:
   /// Loads and validates all parameters; refuses to start (exit 1) on a bad one.
   PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh);
+  /// Unsubscribes first: the lockstep torque callback runs on roscpp's (or a manager's) thread and uses
+  /// members declared after the subscriber, which would otherwise go before it.
+  ~PlantSim();
   /// Runs the simulation until shutdown, stop(), or the end of a lockstep scenario.
   /// Realtime: this thread paces the steps and serves the wheel_torque queue itself.
   /// Lockstep: the wheel_torque callback runs inline where the torque is received (roscpp's network
