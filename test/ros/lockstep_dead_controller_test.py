@@ -100,9 +100,13 @@ class LockstepDeadController(unittest.TestCase):
         self.wait_for(lambda: self.last_odom() >= stalled + 0.5, "progress after the torque controller restarted")
 
     def test_restarted_kinematic_controller_gets_the_references_already_sent(self):
-        if "/torque_controller" not in rosnode.get_node_names():  # another test may have replaced it
+        if "/torque_controller" not in rosnode.get_node_names():  # another test may have stopped it
             self.children.append(node_process.start("torque_controller", "torque_controller"))
-        self.wait_for(lambda: self.last_odom() >= 0.5, "odom up to t = 0.5 s")
+        # The loop must be running with both controllers (a torque controller that has never had a desired
+        # velocity answers with zero torque instead of waiting, and the loop would not stall).
+        self.wait_for(lambda: self.odom_stamps, "a state")
+        start = self.last_odom()
+        self.wait_for(lambda: self.last_odom() >= start + 0.5, "the loop running")
         rosnode.kill_nodes(["/kinematic_controller"])
         self.wait_for(lambda: self.odom_stamps.count(self.last_odom()) >= 2, "the stalled state re-published")
         stalled = self.last_odom()
