@@ -53,9 +53,12 @@ void KinematicController::odomCallback(const nav_msgs::Odometry::ConstPtr& msg) 
     compute();
     return;
   }
-  if (inputs_.secondsPassed(msg->header.stamp))
-    ROS_ERROR_THROTTLE(5.0, "kinematic_controller: no reference stamped t=%.9f s, but newer ones: the reference "
-                       "generator's control_rate does not match plant_sim's", msg->header.stamp.toSec());
+  if (!grid_reported_ && inputs_.secondsPassed(msg->header.stamp)) {
+    // Once, not throttled: a throttle runs on simulated time, which a stalled lockstep loop never advances.
+    grid_reported_ = true;
+    ROS_ERROR("kinematic_controller: no reference stamped t=%.9f s, but newer ones: the reference generator's "
+              "control_rate does not match plant_sim's", msg->header.stamp.toSec());
+  }
   stopIfStale(*msg);
 }
 

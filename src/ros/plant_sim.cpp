@@ -221,10 +221,11 @@ void PlantSim::exitDiverged() {
 
 void PlantSim::giveUpAfter(const ros::WallTime& since, const ros::Time& stamp, const char* what) {
   if (cfg_.lockstep_give_up <= 0.0 || (ros::WallTime::now() - since).toSec() <= cfg_.lockstep_give_up) return;
+  const unsigned publishers = torque_sub_.getNumPublishers();
   ROS_FATAL("plant_sim: lockstep gave up at t=%.6f s after %.1f s wall (lockstep_give_up) waiting for %s; "
-            "%u publisher(s) on %s: is torque_controller running?",
-            stamp.toSec(), cfg_.lockstep_give_up, what, torque_sub_.getNumPublishers(),
-            torque_sub_.getTopic().c_str());
+            "%u publisher(s) on %s%s",
+            stamp.toSec(), cfg_.lockstep_give_up, what, publishers, torque_sub_.getTopic().c_str(),
+            publishers == 0 ? ": is torque_controller running?" : "");
   exitProcess(3);
 }
 

@@ -33,6 +33,7 @@ class KinematicController {
   core::Kanayama kanayama_;
   ros::Subscriber odom_sub_, ref_sub_;
   ros::Publisher desired_pub_, error_pub_;
+  bool grid_reported_ = false;  // a control_rate mismatch is reported once
   StampPair<nav_msgs::Odometry, ReferenceState> inputs_;
   DesiredVelocity desired_;
   TrackingError error_;
