@@ -5,9 +5,10 @@
 // the manager's pool. The pool hands every callback from a dispatcher thread to a worker: two thread
 // wake-ups per message, and a lockstep step is a chain of messages (state -> kinematic -> torque, plus
 // the reference, seed drill and monitor). On one shared thread a message published from a callback is
-// queued behind it and taken by the same thread without any wake-up, so a step costs two hand-overs in
-// all (plant -> callbacks -> plant). None of these callbacks blocks, so sharing a thread cannot deadlock;
-// each nodelet's callbacks stay serialised, as with getNodeHandle().
+// queued behind it and taken by the same thread without any wake-up; the plant's lockstep torque
+// callback runs inline where the torque is published (on that thread too), so a whole step runs on one
+// thread with no hand-over. None of these callbacks blocks, so sharing a thread cannot deadlock; each
+// nodelet's callbacks stay serialised, as with getNodeHandle().
 #include <nodelet/nodelet.h>
 #include <pluginlib/class_list_macros.hpp>
 #include <ros/callback_queue.h>
@@ -71,7 +72,8 @@ using ReferenceGeneratorNodelet = WrapperNodelet<ReferenceGenerator>;
 using RunMonitorNodelet = WrapperNodelet<RunMonitor>;
 using SeedDrillNodelet = WrapperNodelet<SeedDrillNode>;
 
-/// The plant runs its simulation loop on a thread of its own, which also serves its wheel_torque queue.
+/// The plant's run() on a thread of its own: in lockstep it only supervises (the torque callback steps);
+/// in realtime it paces the steps and serves the wheel_torque queue.
 class PlantSimNodelet : public nodelet::Nodelet {
  public:
   ~PlantSimNodelet() override {
