@@ -169,8 +169,7 @@ void PlantSim::publishState(const ros::Time& stamp, bool visuals, bool clock) {
   odom_msg_.header.stamp = stamp;
   odom_msg_.pose.pose.position.x = s[core::X];
   odom_msg_.pose.pose.position.y = s[core::Y];
-  odom_msg_.pose.pose.orientation.z = std::sin(0.5 * s[core::THETA]);
-  odom_msg_.pose.pose.orientation.w = std::cos(0.5 * s[core::THETA]);
+  odom_msg_.pose.pose.orientation = yawQuaternion(s[core::THETA]);
   odom_msg_.twist.twist.linear.x = s[core::V];
   odom_msg_.twist.twist.angular.z = s[core::OMEGA];
   publishShared(odom_pub_, odom_msg_);
@@ -219,13 +218,16 @@ void PlantSim::exitDiverged() {
   exitProcess(2);
 }
 
+std::string PlantSim::torqueSources() const {
+  const unsigned publishers = torque_sub_.getNumPublishers();
+  return std::to_string(publishers) + " publisher(s) on " + torque_sub_.getTopic() +
+         (publishers == 0 ? ": is torque_controller running?" : "");
+}
+
 void PlantSim::giveUpAfter(const ros::WallTime& since, const ros::Time& stamp, const char* what) {
   if (cfg_.lockstep_give_up <= 0.0 || (ros::WallTime::now() - since).toSec() <= cfg_.lockstep_give_up) return;
-  const unsigned publishers = torque_sub_.getNumPublishers();
-  ROS_FATAL("plant_sim: lockstep gave up at t=%.6f s after %.1f s wall (lockstep_give_up) waiting for %s; "
-            "%u publisher(s) on %s%s",
-            stamp.toSec(), cfg_.lockstep_give_up, what, publishers, torque_sub_.getTopic().c_str(),
-            publishers == 0 ? ": is torque_controller running?" : "");
+  ROS_FATAL("plant_sim: lockstep gave up at t=%.6f s after %.1f s wall (lockstep_give_up) waiting for %s; %s",
+            stamp.toSec(), cfg_.lockstep_give_up, what, torqueSources().c_str());
   exitProcess(3);
 }
 
@@ -279,10 +281,8 @@ void PlantSim::runLockstep() {
     sent = now;
     if ((now - stalled_since).toSec() > cfg_.lockstep_timeout) {
       ROS_ERROR("plant_sim: lockstep stalled at t=%.6f s: no wheel_torque stamped for it after %.1f s wall "
-                "(%u publisher(s) on %s%s); waiting",
-                stamp.toSec(), (now - stall_start).toSec(), torque_sub_.getNumPublishers(),
-                torque_sub_.getTopic().c_str(),
-                torque_sub_.getNumPublishers() == 0 ? ": is torque_controller running?" : "");
+                "(%s); waiting",
+                stamp.toSec(), (now - stall_start).toSec(), torqueSources().c_str());
       stalled_since = now;
     }
     giveUpAfter(stall_start, stamp, "a wheel_torque stamped for the current state");

@@ -254,8 +254,7 @@ void ReferenceGenerator::clockCallback(const rosgraph_msgs::Clock::ConstPtr& msg
     p.header = r.header;
     p.pose.position.x = r.x;
     p.pose.position.y = r.y;
-    p.pose.orientation.z = std::sin(0.5 * r.theta);
-    p.pose.orientation.w = std::cos(0.5 * r.theta);
+    p.pose.orientation = yawQuaternion(r.theta);
     if (path_->add(p)) path_pub_.publish(path_->path());
   }
 }

@@ -1,8 +1,10 @@
 // Conversions and finiteness checks shared by the nodes.
 #pragma once
 
+#include <geometry_msgs/Quaternion.h>
 #include <nav_msgs/Odometry.h>
 
+#include <cmath>
 #include <cstdint>
 
 #include "sowing_robot/core/types.h"
@@ -14,6 +16,14 @@ namespace sowing_robot {
 inline core::Pose2D poseOf(const nav_msgs::Odometry& o) {
   const auto& q = o.pose.pose.orientation;
   return {o.pose.pose.position.x, o.pose.pose.position.y, std::atan2(2.0 * q.w * q.z, 1.0 - 2.0 * q.z * q.z)};
+}
+
+/// The quaternion of a yaw about z, as core::yawThroughQuaternion builds it (poseOf inverts it).
+inline geometry_msgs::Quaternion yawQuaternion(double theta) {
+  geometry_msgs::Quaternion q;
+  q.z = std::sin(0.5 * theta);
+  q.w = std::cos(0.5 * theta);
+  return q;
 }
 
 /// True when every field the controllers use is finite.

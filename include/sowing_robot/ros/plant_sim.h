@@ -15,6 +15,7 @@
 
 #include <atomic>
 #include <memory>
+#include <string>
 
 #include "sowing_robot/WheelTorque.h"
 #include "sowing_robot/core/plant.h"
@@ -69,6 +70,9 @@ class PlantSim {
   bool healthy() const;
   /// Ends the process with a FATAL line (exit 2): the state diverged.
   [[noreturn]] void exitDiverged();
+  /// "N publisher(s) on <wheel_torque topic>", asking whether torque_controller runs when N is 0: what
+  /// the stall and give-up reports say about the missing input.
+  std::string torqueSources() const;
   /// Lockstep: exit 3 with a FATAL line naming what is missing (for the state stamped `stamp`) once it
   /// has been waited for since `since` longer than lockstep_give_up (a headless run with a dead
   /// controller must end).

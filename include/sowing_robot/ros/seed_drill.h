@@ -1,6 +1,7 @@
 // seed_drill: the plant-side seed drill. Follows the tool point (URDF `tool_link`) on odom, drops a seed
-// every `spacing` metres while the tool is down (the reference's tool_down for the same stamp), shows the seeds in rviz and reports the cross-track
-// error of the sown line against the intended rows (away from obstacles and in detours apart).
+// every `spacing` metres while the tool is down (the reference's tool_down for the same stamp), shows
+// the seeds in rviz and reports the cross-track error of the sown line against the intended rows (away
+// from obstacles and in detours apart).
 #pragma once
 
 #include <nav_msgs/Odometry.h>
