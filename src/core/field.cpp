@@ -32,32 +32,57 @@ std::string formatNumber(double v) {
 
 }  // namespace
 
+const ParamTable<FieldParams>& fieldTable() {
+  using F = FieldParams;
+  static const ParamTable<F> table = [] {
+    ParamTable<F> t({
+        integer("field/rows", &F::rows, 1, Limits::atLeast(1), "", "number of rows N"),
+        number("field/row_length", &F::row_length, 100.0, Limits::positive(), "m", "length of each row"),
+        number("field/row_spacing", &F::row_spacing, 1.0, Limits::positive(), "m",
+               "distance between neighbouring rows"),
+        number("field/start_x", &F::start_x, 0.0, Limits::any(), "m", "start of the first row, x"),
+        number("field/start_y", &F::start_y, 3.0, Limits::any(), "m", "start of the first row, y"),
+        number("field/heading", &F::heading, 0.0, Limits::any(), "rad", "direction of the first row; odd rows run back"),
+        flag("field/rows_to_left", &F::rows_to_left, true, "the second row lies left of the first one's direction"),
+        number("field/row_speed", &F::row_speed, 1.0, Limits::positive(), "m/s", "v_r on the rows"),
+        number("field/turn_speed", &F::turn_speed, 0.5, Limits::positive(), "m/s",
+               "speed on the headland turns (above potential/heading_hold_speed, up to field/row_speed)"),
+        number("field/min_turn_radius", &F::min_turn_radius, 0.5, Limits::positive(), "m",
+               "the turns keep |curvature| <= 1/min_turn_radius; row_spacing below ~2 min_turn_radius gives bulb turns"),
+        number("field/max_accel", &F::max_accel, 0.5, Limits::positive(), "m/s^2",
+               "peak |v_dot| of the half-cosine speed ramps"),
+        number("field/max_curvature_rate", &F::max_curvature_rate, 10.0, Limits::positive(), "1/m^2",
+               "peak |dkappa/ds| in the turns (>= 1/(2 min_turn_radius^2))"),
+        flag("field/start_from_rest", &F::start_from_rest, false,
+             "true: the first row starts at rest and ramps up; false: at row_speed"),
+    });
+    return t.nest("potential/", &F::potential, potentialFieldTable());
+  }();
+  return table;
+}
+
+FieldParams::FieldParams() { fieldTable().applyDefaults(*this); }
+
 std::string FieldParams::validate() const {
-  if (rows < 1) return "rows = " + std::to_string(rows) + " must be >= 1";
-  if (!allFinite(start_x, start_y, heading))
-    return "start (" + formatNumber(start_x) + ", " + formatNumber(start_y) + ") and heading = " +
-           formatNumber(heading) + " must be finite";
-  std::string e = firstError(
-      {checkPositive("row_length", row_length, "m"), checkPositive("row_spacing", row_spacing, "m"),
-       checkPositive("row_speed", row_speed, "m/s"), checkPositive("turn_speed", turn_speed, "m/s"),
-       checkRange("turn_speed", turn_speed, 0.0, row_speed, "m/s (up to row_speed)"),
-       checkPositive("min_turn_radius", min_turn_radius, "m"), checkPositive("max_accel", max_accel, "m/s^2"),
-       checkPositive("max_curvature_rate", max_curvature_rate, "1/m^2"), potential.validate()});
+  std::string e = fieldTable().checkRanges(*this);
   if (!e.empty()) return e;
+  if (turn_speed > row_speed)
+    return "field/turn_speed = " + formatNumber(turn_speed) + " m/s must be <= field/row_speed = " +
+           formatNumber(row_speed) + " m/s";
   if (turn_speed <= potential.heading_hold_speed)
-    return "turn_speed = " + formatNumber(turn_speed) + " m/s must be above potential.heading_hold_speed = " +
+    return "field/turn_speed = " + formatNumber(turn_speed) + " m/s must be above potential/heading_hold_speed = " +
            formatNumber(potential.heading_hold_speed) + " m/s";
   const double rate_min = 0.5 / (min_turn_radius * min_turn_radius);
   if (max_curvature_rate < rate_min)
-    return "max_curvature_rate = " + formatNumber(max_curvature_rate) + " 1/m^2 must be >= 1/(2 min_turn_radius^2) = " +
-           formatNumber(rate_min) + " 1/m^2";
+    return "field/max_curvature_rate = " + formatNumber(max_curvature_rate) +
+           " 1/m^2 must be >= 1/(2 field/min_turn_radius^2) = " + formatNumber(rate_min) + " 1/m^2";
   // Rows in between go turn_speed -> turn_speed and always fit; the first and last may have to slow down.
   for (const int i : {0, rows - 1}) {
     double v_in, v_out;
     rowSpeeds(*this, i, v_in, v_out);
     const double need = rampDistance(v_in, v_out, max_accel);
     if (v_in > v_out && row_length < need * (1.0 - 1e-12))
-      return "row_length = " + formatNumber(row_length) + " m is too short to change speed from " +
+      return "field/row_length = " + formatNumber(row_length) + " m is too short to change speed from " +
              formatNumber(v_in) + " to " + formatNumber(v_out) + " m/s at max_accel (needs >= " + formatNumber(need) +
              " m)";
   }

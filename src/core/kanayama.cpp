@@ -8,10 +8,19 @@
 namespace sowing_robot {
 namespace core {
 
-std::string KanayamaGains::validate() const {
-  return firstError({checkPositive("kx", kx, "1/s"), checkPositive("ky", ky, "1/m^2"),
-                     checkPositive("ktheta", ktheta, "1/m")});
+const ParamTable<KanayamaGains>& kanayamaTable() {
+  using G = KanayamaGains;
+  static const ParamTable<G> table({
+      tunable(number("kx", &G::kx, 1.0, Limits::positive(), "1/s", "Kanayama gain on the along-track error xe")),
+      tunable(number("ky", &G::ky, 1.5, Limits::positive(), "1/m^2", "Kanayama gain on the cross-track error ye")),
+      tunable(number("ktheta", &G::ktheta, 2.2, Limits::positive(), "1/m", "Kanayama gain on sin(theta_e)")),
+  });
+  return table;
 }
+
+KanayamaGains::KanayamaGains() { kanayamaTable().applyDefaults(*this); }
+
+std::string KanayamaGains::validate() const { return kanayamaTable().checkRanges(*this); }
 
 Kanayama::Kanayama(const KanayamaGains& gains) { setGains(gains); }
 

@@ -33,13 +33,27 @@ void rotateHeading(double cos0, double sin0, double delta, double& cos_out, doub
 
 }  // namespace
 
-std::string PlantDisturbance::validate() const {
-  return firstError({checkNonNegative("disturbance.amplitude", amplitude, "N·m"),
-                     checkNonNegative("disturbance.frequency", frequency, "rad/s"),
-                     checkNonNegative("noise.std", noise_std, "N·m"),
-                     checkRange("mismatch.mass_scale", mass_scale, 0.1, 10.0),
-                     checkRange("mismatch.inertia_scale", inertia_scale, 0.1, 10.0)});
+const ParamTable<PlantDisturbance>& disturbanceTable() {
+  using D = PlantDisturbance;
+  static const ParamTable<D> table({
+      flag("disturbance/sinusoidal", &D::sinusoidal, false,
+           "add the wheel-torque disturbance of Fig 5.9: td_R = A sin(w t), td_L = A cos(w t)"),
+      number("disturbance/amplitude", &D::amplitude, 2.75, Limits::nonNegative(), "N·m", "A"),
+      number("disturbance/frequency", &D::frequency, 3.0, Limits::nonNegative(), "rad/s", "w"),
+      number("noise/std", &D::noise_std, 0.0, Limits::nonNegative(), "N·m",
+             "Gaussian wheel-torque noise, held per step; 0 = off"),
+      integer("noise/seed", &D::seed, 1, Limits::nonNegative(), "", "noise generator seed"),
+      number("mismatch/mass_scale", &D::mass_scale, 1.0, Limits::closed(0.1, 10.0), "",
+             "the plant's true m0 and mc·d = this × the URDF's (the controllers' model)"),
+      number("mismatch/inertia_scale", &D::inertia_scale, 1.0, Limits::closed(0.1, 10.0), "",
+             "the plant's true I0 = this × the URDF's"),
+  });
+  return table;
 }
+
+PlantDisturbance::PlantDisturbance() { disturbanceTable().applyDefaults(*this); }
+
+std::string PlantDisturbance::validate() const { return disturbanceTable().checkRanges(*this); }
 
 Plant::Plant(const RobotParams& nominal, const PlantDisturbance& disturbance)
     : nominal_(nominal),

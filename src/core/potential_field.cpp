@@ -35,14 +35,35 @@ std::string RowLine::validate() const {
   return checkPositive("speed", speed, "m/s");
 }
 
-std::string PotentialFieldParams::validate() const {
-  return firstError({checkPositive("alpha", alpha, "1/s^2"), checkPositive("beta", beta, "1/s"),
-                     checkPositive("influence_distance", influence_distance, "m"),
-                     checkNonNegative("gain", gain, "m^2/s^2"), checkNonNegative("tangential_ratio", tangential_ratio),
-                     checkRange("core_fraction", core_fraction, 1e-3, 0.9),
-                     checkNonNegative("side_band", side_band, "m"), checkRange("step", step, 1e-6, 1e-3, "s"),
-                     checkNonNegative("heading_hold_speed", heading_hold_speed, "m/s")});
+const ParamTable<PotentialFieldParams>& potentialFieldTable() {
+  using P = PotentialFieldParams;
+  static const ParamTable<P> table({
+      number("alpha", &P::alpha, 4.0, Limits::positive(), "1/s^2", "position gain alpha (thesis 4)"),
+      number("beta", &P::beta, 16.0, Limits::positive(), "1/s",
+             "damping of the velocity relative to the target (thesis 16; 2 sqrt(alpha) is critical, README)"),
+      number("influence_distance", &P::influence_distance, 0.5, Limits::positive(), "m",
+             "d: no repulsion beyond this clearance from the obstacle surface (thesis 0.5)"),
+      number("gain", &P::gain, 5.0, Limits::nonNegative(), "m^2/s^2",
+             "k: radial repulsion -k grad V_a; 0 disables avoidance (not given in the thesis)"),
+      number("tangential_ratio", &P::tangential_ratio, 1.0, Limits::nonNegative(), "", "|tangential| / |radial| repulsion"),
+      flag("nearest_side", &P::nearest_side, true,
+           "pass each obstacle on the side the reference is on when it enters the zone"),
+      choice("avoid_side", &P::avoid_side, AvoidSide::kLeft, {{"left", AvoidSide::kLeft}, {"right", AvoidSide::kRight}},
+             "forced side (nearest_side false) and tie-break on the line"),
+      number("side_band", &P::side_band, 0.05, Limits::nonNegative(), "m",
+             "half-width of the tie band around the obstacle centre"),
+      number("core_fraction", &P::core_fraction, 0.1, Limits::closed(1e-3, 0.9), "",
+             "below this fraction of d the potential continues linearly"),
+      number("step", &P::step, 1e-3, Limits::closed(1e-6, 1e-3), "s", "internal RK4 step"),
+      number("heading_hold_speed", &P::heading_hold_speed, 0.02, Limits::nonNegative(), "m/s",
+             "below this speed (reference and target) theta is held"),
+  });
+  return table;
 }
+
+PotentialFieldParams::PotentialFieldParams() { potentialFieldTable().applyDefaults(*this); }
+
+std::string PotentialFieldParams::validate() const { return potentialFieldTable().checkRanges(*this); }
 
 LineTarget::LineTarget(const RowLine& row) : row_(row), u_(std::cos(row.heading), std::sin(row.heading)) {}
 

@@ -20,15 +20,34 @@ std::vector<RowSegment> rowsOf(const FieldParams& field) {
   return rows;
 }
 
-std::string SeedingParams::validate() const {
-  return firstError({checkPositive("seeding/spacing", spacing, "m"), checkPositive("seeding/tolerance", tolerance, "m"),
-                     checkNonNegative("seeding/detour_margin", detour_margin, "m"),
-                     checkPositive("seeding/engage_distance", engage_distance, "m")});
+const ParamTable<SeedingParams>& seedingTable() {
+  using P = SeedingParams;
+  static const ParamTable<P> table({
+      number("spacing", &P::spacing, 0.1, Limits::positive(), "m", "distance between seeds along the tool's path"),
+      number("tolerance", &P::tolerance, 0.02, Limits::positive(), "m",
+             "cross-track error reported as \"off the line\" beyond this"),
+      number("detour_margin", &P::detour_margin, 4.0, Limits::nonNegative(), "m",
+             "seeds within radius + influence_distance + this of an obstacle are detour seeds, reported apart "
+             "(the reference rejoins the row about 3 m after leaving the influence zone at 1 m/s)"),
+      number("engage_distance", &P::engage_distance, 0.01, Limits::positive(), "m",
+             "the tool is lowered once the tool point is this close to a row"),
+  });
+  return table;
 }
+
+SeedingParams::SeedingParams() { seedingTable().applyDefaults(*this); }
+
+std::string SeedingParams::validate() const { return seedingTable().checkRanges(*this); }
 
 SeedDrill::SeedDrill(const SeedingParams& params, std::vector<RowSegment> rows, std::vector<Obstacle> obstacles,
                      double influence)
     : params_(params), rows_(std::move(rows)), obstacles_(std::move(obstacles)), influence_(influence) {}
+
+void SeedDrill::setPlan(std::vector<RowSegment> rows, std::vector<Obstacle> obstacles, double influence) {
+  rows_ = std::move(rows);
+  obstacles_ = std::move(obstacles);
+  influence_ = influence;
+}
 
 double SeedDrill::crossTrack(const Eigen::Vector2d& p) const {
   double best = std::numeric_limits<double>::infinity();

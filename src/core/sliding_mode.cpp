@@ -25,18 +25,49 @@ double realPower(double x, int num, int den) {
   return (num % 2 == 0 || x >= 0.0) ? mag : -mag;
 }
 
+const ParamTable<SlidingModeParams>& slidingModeTable() {
+  using P = SlidingModeParams;
+  static const ParamTable<P> table = [] {
+    ParamTable<P> t({
+        choice("mode", &P::adaptive, true, {{"atsmc", true}, {"tsmc", false}},
+               "atsmc: adaptive (eq 4.22 + projection); tsmc: fixed nominal m0, I0"),
+        integer("p", &P::p, 5, Limits::atLeast(1), "", "terminal exponent numerator, odd (1 < p/q < 2)"),
+        integer("q", &P::q, 3, Limits::atLeast(1), "", "terminal exponent denominator, odd"),
+        tunable(number("beta_v", &P::beta_v, 1.0, Limits::positive(), "",
+                       "surface gain beta, linear channel (not given in the thesis)")),
+        tunable(number("beta_omega", &P::beta_omega, 1.0, Limits::positive(), "", "surface gain beta, angular channel")),
+        tunable(number("k1", &P::k1, 1.0, Limits::positive(), "N·m·s/m", "feedback gain K1")),
+        tunable(number("k2", &P::k2, 150.0, Limits::positive(), "N·m·s/rad", "feedback gain K2")),
+        tunable(number("eta1", &P::eta1, 2.0, Limits::nonNegative(), "N·m", "switching gain eta1")),
+        tunable(number("eta2", &P::eta2, 2.0, Limits::nonNegative(), "N·m", "switching gain eta2")),
+        tunable(number("rate_m", &P::rate_m, 0.1, Limits::nonNegative(), "",
+                       "adaptation rate of m0_hat (Table 5.3 gamma1; applied to S·phi, README deviation 8)")),
+        tunable(number("rate_i", &P::rate_i, 0.1, Limits::nonNegative(), "", "adaptation rate of I0_hat (gamma2)")),
+        number("m0_min", &P::m0_min, 17.51, Limits::positive(), "kg", "projection bound: lowest m0_hat"),
+        number("m0_max", &P::m0_max, 37.51, Limits::positive(), "kg", "projection bound: highest m0_hat"),
+        number("i0_min", &P::i0_min, 0.57, Limits::positive(), "kg·m^2", "projection bound: lowest I0_hat"),
+        number("i0_max", &P::i0_max, 4.57, Limits::positive(), "kg·m^2", "projection bound: highest I0_hat"),
+        number("m0_initial", &P::m0_initial, 0.0, Limits::nonNegative(), "kg",
+               "initial m0_hat; 0 = the nominal m0 from the URDF (must lie in the bounds)"),
+        number("i0_initial", &P::i0_initial, 0.0, Limits::nonNegative(), "kg·m^2",
+               "initial I0_hat; 0 = the nominal I0 from the URDF"),
+        number("max_torque", &P::max_torque, 100.0, Limits::positive(), "N·m",
+               "per-wheel motor limit; clipping is reported"),
+    });
+    return t.nest("", &P::switching, switchingTable());
+  }();
+  return table;
+}
+
+SlidingModeParams::SlidingModeParams() { slidingModeTable().applyDefaults(*this); }
+
 std::string SlidingModeParams::validate() const {
-  std::string e;
-  if (p <= 0 || q <= 0 || p % 2 == 0 || q % 2 == 0 || !(p > q && p < 2 * q))
+  std::string e = slidingModeTable().checkRanges(*this);
+  if (!e.empty()) return e;
+  if (p % 2 == 0 || q % 2 == 0 || !(p > q && p < 2 * q))
     return "p/q = " + std::to_string(p) + "/" + std::to_string(q) +
            " must be a ratio of odd positive integers with 1 < p/q < 2";
-  e = firstError({checkPositive("beta_v", beta_v), checkPositive("beta_omega", beta_omega),
-                  checkPositive("k1", k1), checkPositive("k2", k2), checkNonNegative("eta1", eta1, "N·m"),
-                  checkNonNegative("eta2", eta2, "N·m"), checkNonNegative("rate_m", rate_m),
-                  checkNonNegative("rate_i", rate_i), checkPositive("m0_min", m0_min, "kg"),
-                  checkOrdered("m0_min", m0_min, "m0_max", m0_max), checkPositive("i0_min", i0_min, "kg·m^2"),
-                  checkOrdered("i0_min", i0_min, "i0_max", i0_max), checkPositive("max_torque", max_torque, "N·m"),
-                  switching.validate()});
+  e = firstError({checkOrdered("m0_min", m0_min, "m0_max", m0_max), checkOrdered("i0_min", i0_min, "i0_max", i0_max)});
   if (!e.empty()) return e;
   if (m0_initial > 0.0) e = checkRange("m0_initial", m0_initial, m0_min, m0_max, "kg (the projection bounds)");
   if (e.empty() && i0_initial > 0.0)

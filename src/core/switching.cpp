@@ -25,10 +25,25 @@ double SwitchFunction::operator()(double s) const {
   return 0.0;
 }
 
-std::string SwitchFunction::validate() const {
-  if (type == SwitchType::Sign) return "";
-  return checkPositive("switch_width", width);
+const ParamTable<SwitchFunction>& switchingTable() {
+  using F = SwitchFunction;
+  static const ParamTable<F> table({
+      choice("switching", &F::type, SwitchType::Sign,
+             {{"sign", SwitchType::Sign},
+              {"sat", SwitchType::Saturation},
+              {"relay", SwitchType::Relay},
+              {"atan", SwitchType::Atan},
+              {"tanh", SwitchType::Tanh}},
+             "switching function of the reaching law (eqs 4.46-4.48)"),
+      number("switch_width", &F::width, 0.01, Limits::positive(), "",
+             "boundary layer phi (sat, tanh) / relay delta / atan width; unused by sign"),
+  });
+  return table;
 }
+
+SwitchFunction::SwitchFunction() { switchingTable().applyDefaults(*this); }
+
+std::string SwitchFunction::validate() const { return switchingTable().checkRanges(*this); }
 
 bool SwitchFunction::parse(const std::string& n, SwitchType& t) {
   for (SwitchType c : {SwitchType::Sign, SwitchType::Saturation, SwitchType::Relay, SwitchType::Atan,

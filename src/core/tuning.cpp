@@ -19,19 +19,11 @@ namespace {
 
 constexpr double INF = std::numeric_limits<double>::infinity();
 
-double* gainSlot(Scenario& sc, const std::string& n) {
-  if (n == "kx") return &sc.kanayama.kx;
-  if (n == "ky") return &sc.kanayama.ky;
-  if (n == "ktheta") return &sc.kanayama.ktheta;
-  if (n == "k1") return &sc.sliding.k1;
-  if (n == "k2") return &sc.sliding.k2;
-  if (n == "eta1") return &sc.sliding.eta1;
-  if (n == "eta2") return &sc.sliding.eta2;
-  if (n == "beta_v") return &sc.sliding.beta_v;
-  if (n == "beta_omega") return &sc.sliding.beta_omega;
-  if (n == "rate_m") return &sc.sliding.rate_m;
-  if (n == "rate_i") return &sc.sliding.rate_i;
-  return nullptr;
+/// A tunable entry of the Kanayama or the sliding-mode table (the `tunable` mark in their tables).
+template <typename S>
+const ParamEntry<S>* tunableEntry(const ParamTable<S>& table, const std::string& name) {
+  const ParamEntry<S>* e = table.find(name);
+  return e && e->info.tunable ? e : nullptr;
 }
 
 std::string num(double v) {
@@ -81,27 +73,39 @@ const char* costTypeName(CostType type) {
 }
 
 const std::vector<std::string>& tunableGainNames() {
-  static const std::vector<std::string> names{"kx",   "ky",     "ktheta",     "k1",     "k2",    "eta1",
-                                              "eta2", "beta_v", "beta_omega", "rate_m", "rate_i"};
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> n;
+    for (const auto& e : kanayamaTable().entries())
+      if (e.info.tunable) n.push_back(e.info.key);
+    for (const auto& e : slidingModeTable().entries())
+      if (e.info.tunable) n.push_back(e.info.key);
+    return n;
+  }();
   return names;
 }
 
 std::string gainNode(const std::string& name) {
-  if (name == "kx" || name == "ky" || name == "ktheta") return "kinematic_controller";
-  const auto& n = tunableGainNames();
-  return std::find(n.begin(), n.end(), name) != n.end() ? "torque_controller" : "";
+  if (tunableEntry(kanayamaTable(), name)) return "kinematic_controller";
+  if (tunableEntry(slidingModeTable(), name)) return "torque_controller";
+  return "";
 }
 
 bool setGain(Scenario& sc, const std::string& name, double value) {
-  double* slot = gainSlot(sc, name);
-  if (!slot) return false;
-  *slot = value;
-  return true;
+  if (const auto* e = tunableEntry(kanayamaTable(), name)) {
+    e->set(sc.kanayama, value);
+    return true;
+  }
+  if (const auto* e = tunableEntry(slidingModeTable(), name)) {
+    e->set(sc.sliding, value);
+    return true;
+  }
+  return false;
 }
 
 double getGain(const Scenario& sc, const std::string& name) {
-  double* slot = gainSlot(const_cast<Scenario&>(sc), name);
-  return slot ? *slot : std::numeric_limits<double>::quiet_NaN();
+  if (const auto* e = tunableEntry(kanayamaTable(), name)) return std::get<double>(e->get(sc.kanayama));
+  if (const auto* e = tunableEntry(slidingModeTable(), name)) return std::get<double>(e->get(sc.sliding));
+  return std::numeric_limits<double>::quiet_NaN();
 }
 
 std::vector<GainBounds> defaultGainBounds() {

@@ -2,8 +2,10 @@
 
 #include <XmlRpcValue.h>
 
+#include <algorithm>
 #include <cmath>
 
+#include "sowing_robot/core/validation.h"
 #include "sowing_robot/ros/urdf_params.h"
 
 namespace sowing_robot {
@@ -16,108 +18,22 @@ std::string loadRobotParams(const ros::NodeHandle& nh, core::RobotParams& out) {
   return e.empty() ? "" : "robot_description: " + e;
 }
 
-std::int64_t loadControlPeriod(ParamReader& p, std::string& error) {
-  const double rate = p.get("control_rate", 1000.0);
-  if (!(std::isfinite(rate) && rate >= 1.0 && rate <= 100000.0)) {
-    error = "control_rate = " + std::to_string(rate) + " is outside the allowed range [1, 100000] Hz";
-    return 0;
+core::RunSettings loadRunSettings(const ros::NodeHandle& nh, ParamReader& own,
+                                  const std::vector<std::string>& own_keys) {
+  ParamReader run(ros::NodeHandle(nh, "run"));
+  core::RunSettings settings;
+  loadTable(run, core::RunSettings::table(), settings);
+  if (!run.error().empty()) own.fail(run.error());
+  for (const auto& e : core::RunSettings::table().entries()) {
+    if (!own.handle().hasParam(e.info.key)) continue;
+    if (std::find(own_keys.begin(), own_keys.end(), e.info.key) != own_keys.end()) continue;
+    const core::ParamValue mine = own.get(e.info.key, e.info.default_value), theirs = e.get(settings);
+    if (mine != theirs)
+      own.fail(own.handle().resolveName(e.info.key) + " = " + core::formatValue(mine) + " disagrees with " +
+               run.handle().resolveName(e.info.key) + " = " + core::formatValue(theirs) +
+               " (a run-wide setting: set it once, in run/)");
   }
-  return static_cast<std::int64_t>(std::llround(1e9 / rate));
-}
-
-core::PlantDisturbance loadDisturbance(ParamReader& p) {
-  core::PlantDisturbance d;
-  d.sinusoidal = p.get("disturbance/sinusoidal", d.sinusoidal);
-  d.amplitude = p.get("disturbance/amplitude", d.amplitude);
-  d.frequency = p.get("disturbance/frequency", d.frequency);
-  d.noise_std = p.get("noise/std", d.noise_std);
-  d.seed = static_cast<std::uint64_t>(p.get("noise/seed", 1));
-  d.mass_scale = p.get("mismatch/mass_scale", d.mass_scale);
-  d.inertia_scale = p.get("mismatch/inertia_scale", d.inertia_scale);
-  return d;
-}
-
-core::KanayamaGains loadKanayama(ParamReader& p) {
-  core::KanayamaGains g;
-  g.kx = p.get("kx", g.kx);
-  g.ky = p.get("ky", g.ky);
-  g.ktheta = p.get("ktheta", g.ktheta);
-  return g;
-}
-
-core::SlidingModeParams loadSlidingMode(ParamReader& p, std::string& error) {
-  core::SlidingModeParams s;
-  const std::string mode = p.get("mode", "atsmc");
-  if (mode != "atsmc" && mode != "tsmc") error = "mode = '" + mode + "' must be 'atsmc' or 'tsmc'";
-  s.adaptive = mode == "atsmc";
-  s.p = p.get("p", s.p);
-  s.q = p.get("q", s.q);
-  s.beta_v = p.get("beta_v", s.beta_v);
-  s.beta_omega = p.get("beta_omega", s.beta_omega);
-  s.k1 = p.get("k1", s.k1);
-  s.k2 = p.get("k2", s.k2);
-  s.eta1 = p.get("eta1", s.eta1);
-  s.eta2 = p.get("eta2", s.eta2);
-  s.rate_m = p.get("rate_m", s.rate_m);
-  s.rate_i = p.get("rate_i", s.rate_i);
-  s.m0_min = p.get("m0_min", s.m0_min);
-  s.m0_max = p.get("m0_max", s.m0_max);
-  s.i0_min = p.get("i0_min", s.i0_min);
-  s.i0_max = p.get("i0_max", s.i0_max);
-  s.m0_initial = p.get("m0_initial", s.m0_initial);
-  s.i0_initial = p.get("i0_initial", s.i0_initial);
-  s.max_torque = p.get("max_torque", s.max_torque);
-  const std::string sw = p.get("switching", "sign");
-  if (!core::SwitchFunction::parse(sw, s.switching.type) && error.empty())
-    error = "switching = '" + sw + "' must be one of sign, sat, relay, atan, tanh";
-  s.switching.width = p.get("switch_width", s.switching.width);
-  return s;
-}
-
-core::Pose2D loadStartPose(ParamReader& p) {
-  core::Pose2D s{-1.0, 0.0, 0.0};
-  s.x = p.get("start/x", s.x);
-  s.y = p.get("start/y", s.y);
-  s.theta = p.get("start/theta", s.theta);
-  return s;
-}
-
-core::PotentialFieldParams loadPotentialField(ParamReader& p, std::string& error) {
-  core::PotentialFieldParams f;
-  f.alpha = p.get("potential/alpha", f.alpha);
-  f.beta = p.get("potential/beta", f.beta);
-  f.influence_distance = p.get("potential/influence_distance", f.influence_distance);
-  f.gain = p.get("potential/gain", f.gain);
-  f.tangential_ratio = p.get("potential/tangential_ratio", f.tangential_ratio);
-  f.nearest_side = p.get("potential/nearest_side", f.nearest_side);
-  const std::string side = p.get("potential/avoid_side", "left");
-  if (side != "left" && side != "right" && error.empty())
-    error = "potential/avoid_side = '" + side + "' must be 'left' or 'right'";
-  f.avoid_side = side == "right" ? core::AvoidSide::kRight : core::AvoidSide::kLeft;
-  f.side_band = p.get("potential/side_band", f.side_band);
-  f.core_fraction = p.get("potential/core_fraction", f.core_fraction);
-  f.step = p.get("potential/step", f.step);
-  f.heading_hold_speed = p.get("potential/heading_hold_speed", f.heading_hold_speed);
-  return f;
-}
-
-core::FieldParams loadFieldParams(ParamReader& p, std::string& error) {
-  core::FieldParams f;
-  f.rows = p.get("field/rows", f.rows);
-  f.row_length = p.get("field/row_length", f.row_length);
-  f.row_spacing = p.get("field/row_spacing", f.row_spacing);
-  f.start_x = p.get("field/start_x", f.start_x);
-  f.start_y = p.get("field/start_y", f.start_y);
-  f.heading = p.get("field/heading", f.heading);
-  f.rows_to_left = p.get("field/rows_to_left", f.rows_to_left);
-  f.row_speed = p.get("field/row_speed", f.row_speed);
-  f.turn_speed = p.get("field/turn_speed", f.turn_speed);
-  f.min_turn_radius = p.get("field/min_turn_radius", f.min_turn_radius);
-  f.max_accel = p.get("field/max_accel", f.max_accel);
-  f.max_curvature_rate = p.get("field/max_curvature_rate", f.max_curvature_rate);
-  f.start_from_rest = p.get("field/start_from_rest", f.start_from_rest);
-  f.potential = loadPotentialField(p, error);
-  return f;
+  return settings;
 }
 
 namespace {
@@ -173,14 +89,22 @@ std::string loadPipelineScenario(core::Scenario& sc, double& duration) {
       torque(ros::NodeHandle("/torque_controller"));
   std::string e = loadRobotParams(ros::NodeHandle(), sc.robot);
   if (!e.empty()) return e;
-  sc.control_period_ns = loadControlPeriod(plant, e);
-  sc.disturbance = loadDisturbance(plant);
-  sc.start = loadStartPose(plant);
-  duration = plant.get("duration", 25.0);
-  sc.duration = duration;
-  sc.kanayama = loadKanayama(kin);
-  sc.sliding = loadSlidingMode(torque, e);
+  const core::RunSettings run = loadRunSettings(ros::NodeHandle(), plant);
+  core::PlantSimSettings plant_settings;
+  core::KinematicControllerSettings kin_settings;
+  core::TorqueControllerSettings torque_settings;
+  loadTable(plant, core::PlantSimSettings::table(), plant_settings);
+  loadTable(kin, core::KinematicControllerSettings::table(), kin_settings);
+  loadTable(torque, core::TorqueControllerSettings::table(), torque_settings);
+  e = core::firstError({plant.error(), kin.error(), torque.error()});
   if (!e.empty()) return e;
+  sc.control_period_ns = run.periodNs();
+  sc.disturbance = plant_settings.disturbance;
+  sc.start = plant_settings.start();
+  duration = run.duration;
+  sc.duration = duration;
+  sc.kanayama = kin_settings.gains;
+  sc.sliding = torque_settings.sliding;
   return sc.validate();
 }
 

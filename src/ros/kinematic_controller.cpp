@@ -4,17 +4,26 @@
 #include "sowing_robot/ros/component_params.h"
 #include "sowing_robot/core/validation.h"
 #include "sowing_robot/ros/msg_checks.h"
+#include "sowing_robot/ros/reconfigure_bridge.h"
 
 namespace sowing_robot {
 
 KinematicController::KinematicController(ros::NodeHandle nh, ros::NodeHandle pnh) {
   ParamReader p(pnh);
-  const core::KanayamaGains gains = loadKanayama(p);
-  input_timeout_ = p.get("input_timeout", input_timeout_);
-  requireValid(p, core::firstError({gains.validate(), core::checkPositive("input_timeout", input_timeout_, "s")}));
-  kanayama_.setGains(gains);
-  ROS_INFO("kinematic_controller: kx %.4g, ky %.4g, ktheta %.4g", gains.kx, gains.ky, gains.ktheta);
+  const core::RunSettings run = loadRunSettings(nh, p);
+  core::KinematicControllerSettings settings;
+  loadTable(p, core::KinematicControllerSettings::table(), settings);
+  requireValid(p, settings.validate());
+  input_timeout_ = settings.input_timeout;
+  kanayama_.setGains(settings.gains);
+  logSettings("kinematic_controller", core::KinematicControllerSettings::table(), settings);
+  (void)run;  // read for its checks (range, agreement with a private copy); the controller works on stamps
   reconfigure_ = std::make_unique<dynamic_reconfigure::Server<KinematicControllerConfig>>(pnh);
+  // The server starts from the .cfg defaults where a key is not set: hand it the gains in force first,
+  // so its first callback changes nothing.
+  KinematicControllerConfig in_force;
+  toConfig(core::kanayamaTable(), settings.gains, in_force);
+  reconfigure_->updateConfig(in_force);
   reconfigure_->setCallback([this](KinematicControllerConfig& c, uint32_t level) { reconfigure(c, level); });
   desired_pub_ = nh.advertise<DesiredVelocity>("desired_velocity", kLockstepQueue);
   error_pub_ = nh.advertise<TrackingError>("tracking_error", kLockstepQueue);
@@ -24,16 +33,15 @@ KinematicController::KinematicController(ros::NodeHandle nh, ros::NodeHandle pnh
 }
 
 void KinematicController::reconfigure(KinematicControllerConfig& config, uint32_t) {
-  const core::KanayamaGains g{config.kx, config.ky, config.ktheta};
-  const core::KanayamaGains& old = kanayama_.gains();
-  if (g.kx == old.kx && g.ky == old.ky && g.ktheta == old.ktheta) return;
-  const std::string error = g.validate();
+  const core::KanayamaGains old = kanayama_.gains();
+  core::KanayamaGains g = old;
+  std::string error = fromConfig(core::kanayamaTable(), config, g);
+  if (error.empty() && g.kx == old.kx && g.ky == old.ky && g.ktheta == old.ktheta) return;
+  if (error.empty()) error = g.validate();
   if (!error.empty()) {
     ROS_WARN("kinematic_controller: rejected gain change: %s; keeping kx %g, ky %g, ktheta %g", error.c_str(),
              old.kx, old.ky, old.ktheta);
-    config.kx = old.kx;  // the server then reports (and stores) the values really in force
-    config.ky = old.ky;
-    config.ktheta = old.ktheta;
+    toConfig(core::kanayamaTable(), old, config);  // the server then reports (and stores) the values in force
     return;
   }
   kanayama_.setGains(g);

@@ -38,6 +38,13 @@ std::string ParamReader::get(const std::string& key, const std::string& def) {
   return read<std::string>(key, def, "string");
 }
 
+core::ParamValue ParamReader::get(const std::string& key, const core::ParamValue& def) {
+  if (const bool* b = std::get_if<bool>(&def)) return get(key, *b);
+  if (const int* i = std::get_if<int>(&def)) return get(key, *i);
+  if (const double* d = std::get_if<double>(&def)) return get(key, *d);
+  return get(key, std::get<std::string>(def));
+}
+
 std::string ParamReader::unknownKeys() const {
   std::vector<std::string> names;
   ros::param::getParamNames(names);

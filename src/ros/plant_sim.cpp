@@ -22,41 +22,27 @@ PlantSim::PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh) {
   ParamReader p(pnh);
   core::RobotParams robot;
   p.allow("robot_description");  // a private URDF may override the global one
-  std::string error = loadRobotParams(pnh, robot);
-  const std::string mode = p.get("mode", "realtime");
-  if (error.empty() && mode != "realtime" && mode != "lockstep")
-    error = "mode = '" + mode + "' must be 'realtime' or 'lockstep'";
-  cfg_.lockstep = mode == "lockstep";
-  cfg_.period_ns = loadControlPeriod(p, error);
-  cfg_.duration = p.get("duration", cfg_.duration);
-  cfg_.realtime_factor = p.get("realtime_factor", cfg_.realtime_factor);
-  cfg_.torque_timeout = p.get("torque_timeout", cfg_.torque_timeout);
-  cfg_.publish_rate = p.get("publish_rate", cfg_.publish_rate);
-  cfg_.clock_rate = p.get("clock_rate", cfg_.clock_rate);
-  cfg_.lockstep_retry = p.get("lockstep_retry", cfg_.lockstep_retry);
-  cfg_.lockstep_timeout = p.get("lockstep_timeout", cfg_.lockstep_timeout);
-  cfg_.lockstep_give_up = p.get("lockstep_give_up", cfg_.lockstep_give_up);
-  cfg_.min_subscribers = p.get("min_subscribers", cfg_.min_subscribers);
-  cfg_.startup_delay = p.get("startup_delay", cfg_.startup_delay);
-  cfg_.max_speed = p.get("max_speed", cfg_.max_speed);
-  cfg_.exit_at_end = p.get("exit_at_end", cfg_.exit_at_end);
-  start_ = loadStartPose(p);
-  const core::PlantDisturbance disturbance = loadDisturbance(p);
-  if (error.empty())
-    error = core::firstError(
-        {robot.validate(), disturbance.validate(), core::checkRange("duration", cfg_.duration, 0.0, 1e7, "s"),
-         core::checkRange("realtime_factor", cfg_.realtime_factor, 0.01, 1000.0),
-         core::checkPositive("torque_timeout", cfg_.torque_timeout, "s"),
-         core::checkRange("publish_rate", cfg_.publish_rate, 0.1, 1000.0, "Hz"),
-         core::checkRange("clock_rate", cfg_.clock_rate, 0.0, 1e6, "Hz"),
-         core::checkPositive("lockstep_retry", cfg_.lockstep_retry, "s"),
-         core::checkPositive("lockstep_timeout", cfg_.lockstep_timeout, "s"),
-         core::checkNonNegative("lockstep_give_up", cfg_.lockstep_give_up, "s"),
-         core::checkRange("min_subscribers", cfg_.min_subscribers, 0, 100),
-         core::checkNonNegative("startup_delay", cfg_.startup_delay, "s"),
-         core::checkPositive("max_speed", cfg_.max_speed, "m/s"),
-         core::allFinite(start_.x, start_.y, start_.theta) ? "" : "start pose must be finite"});
-  requireValid(p, error);
+  const std::string robot_error = loadRobotParams(pnh, robot);
+  const core::RunSettings run = loadRunSettings(nh, p);
+  core::PlantSimSettings settings;
+  loadTable(p, core::PlantSimSettings::table(), settings);
+  requireValid(p, core::firstError({robot_error, robot_error.empty() ? robot.validate() : "", settings.validate()}));
+  cfg_.lockstep = run.lockstep;
+  cfg_.period_ns = run.periodNs();
+  cfg_.duration = run.duration;
+  cfg_.realtime_factor = settings.realtime_factor;
+  cfg_.torque_timeout = settings.torque_timeout;
+  cfg_.publish_rate = settings.publish_rate;
+  cfg_.clock_rate = settings.clock_rate;
+  cfg_.lockstep_retry = settings.lockstep_retry;
+  cfg_.lockstep_timeout = settings.lockstep_timeout;
+  cfg_.lockstep_give_up = settings.lockstep_give_up;
+  cfg_.min_subscribers = settings.min_subscribers;
+  cfg_.startup_delay = settings.startup_delay;
+  cfg_.max_speed = settings.max_speed;
+  cfg_.exit_at_end = settings.exit_at_end;
+  start_ = settings.start();
+  const core::PlantDisturbance& disturbance = settings.disturbance;
 
   plant_ = std::make_unique<core::Plant>(robot, disturbance);
   core::State x0 = core::State::Zero();
@@ -68,11 +54,10 @@ PlantSim::PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh) {
   if (cfg_.clock_rate > 0.0)
     clock_every_ = std::max<std::int64_t>(1, std::llround(1e9 / cfg_.clock_rate / cfg_.period_ns));
 
-  ROS_INFO("plant_sim: %s mode, %.0f Hz, duration %.3f s, m0 %.4f kg (true %.4f), I0 %.5f kg m^2 (true %.5f), "
-           "sinusoidal disturbance %s, noise std %.3f N m, start (%.3f, %.3f, %.3f)",
-           mode.c_str(), 1e9 / cfg_.period_ns, cfg_.duration, robot.m0(), plant_->trueM0(), robot.I0(),
-           plant_->trueI0(), disturbance.sinusoidal ? "on" : "off", disturbance.noise_std, start_.x, start_.y,
-           start_.theta);
+  logSettings("plant_sim", core::RunSettings::table(), run, "run/");
+  logSettings("plant_sim", core::PlantSimSettings::table(), settings);
+  ROS_INFO("plant_sim: m0 %.4f kg (true %.4f), I0 %.5f kg m^2 (true %.5f)", robot.m0(), plant_->trueM0(), robot.I0(),
+           plant_->trueI0());
 
   clock_pub_ = nh_.advertise<rosgraph_msgs::Clock>("/clock", 10);
   odom_pub_ = nh_.advertise<nav_msgs::Odometry>("odom", kLockstepQueue);
@@ -84,8 +69,9 @@ PlantSim::PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh) {
   torque_options.transport_hints = ros::TransportHints().tcpNoDelay();
   torque_sub_ = nh_.subscribe(torque_options);
 
-  odom_msg_.header.frame_id = "odom";
-  odom_msg_.child_frame_id = "base_link";
+  odom_msg_.header.frame_id = run.odom_frame;
+  odom_msg_.child_frame_id = run.base_frame;
+  path_ = PathBuffer(run.odom_frame, 0.05, 10);  // a point every 5 cm, re-sent every 10th point
   joint_msg_.name = {"right_wheel_joint", "left_wheel_joint"};
   joint_msg_.position.resize(2);
   joint_msg_.velocity.resize(2);
@@ -185,7 +171,7 @@ void PlantSim::publishState(const ros::Time& stamp, bool visuals, bool clock) {
 
   geometry_msgs::TransformStamped tf;
   tf.header = odom_msg_.header;
-  tf.child_frame_id = "base_link";
+  tf.child_frame_id = odom_msg_.child_frame_id;
   tf.transform.translation.x = s[core::X];
   tf.transform.translation.y = s[core::Y];
   tf.transform.rotation = odom_msg_.pose.pose.orientation;

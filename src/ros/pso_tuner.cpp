@@ -129,54 +129,52 @@ std::string writeGainsYaml(const std::string& path, const std::string& header, c
 
 PsoTuner::PsoTuner(ros::NodeHandle nh, ros::NodeHandle pnh) {
   ParamReader p(pnh);
-  pso_.particles = p.get("particles", pso_.particles);
-  pso_.iterations = p.get("iterations", pso_.iterations);
-  const int seed = p.get("seed", 1);
-  pso_.threads = p.get("threads", 0);
-  pso_.max_velocity_fraction = p.get("velocity_clamp", 0.2);
-  pso_.w_max = p.get("w_max", pso_.w_max);
-  pso_.w_min = p.get("w_min", pso_.w_min);
-  pso_.c1 = p.get("c1", pso_.c1);
-  pso_.c2 = p.get("c2", pso_.c2);
-  const std::string cost = p.get("cost", "itae");
-  objective_.torque_weight = p.get("torque_weight", 0.0);
-  objective_.chattering_weight = p.get("chattering_weight", 0.0);
-  const double duration = p.get("duration", 25.0);
-  std::string error;
-  const std::int64_t period = loadControlPeriod(p, error);
-  const std::string mode = p.get("mode", "atsmc");
-  output_ = p.get("output", "");
-  if (output_.empty()) output_ = defaultOutput();
+  core::PsoTunerSettings settings;
+  loadTable(p, core::PsoTunerSettings::table(), settings);
+  pso_.particles = settings.particles;
+  pso_.iterations = settings.iterations;
+  pso_.seed = static_cast<std::uint64_t>(settings.seed);
+  pso_.threads = settings.threads;
+  pso_.max_velocity_fraction = settings.velocity_clamp;
+  pso_.w_max = settings.w_max;
+  pso_.w_min = settings.w_min;
+  pso_.c1 = settings.c1;
+  pso_.c2 = settings.c2;
+  core::parseCostType(settings.cost, objective_.cost);  // one of the table's choices
+  objective_.torque_weight = settings.torque_weight;
+  objective_.chattering_weight = settings.chattering_weight;
+  output_ = settings.output.empty() ? defaultOutput() : settings.output;
   p.allow("gains");
   p.allow("gains/");
 
-  // The base scenario, read with the nodes' own loaders from the nodes' namespaces.
+  // The base scenario, read with the nodes' own tables from the nodes' namespaces; duration and rate are
+  // the tuner's own (an evaluation need not be as long as the run).
   ParamReader plant(ros::NodeHandle("/plant_sim")), kin(ros::NodeHandle("/kinematic_controller")),
       torque(ros::NodeHandle("/torque_controller")), refp(ros::NodeHandle("/reference_generator"));
   const std::string robot_error = loadRobotParams(pnh, base_.robot);
-  base_.duration = duration;
-  base_.control_period_ns = period > 0 ? period : base_.control_period_ns;
-  base_.start = loadStartPose(plant);
-  base_.disturbance = loadDisturbance(plant);
-  base_.kanayama = loadKanayama(kin);
-  std::string torque_error;
-  base_.sliding = loadSlidingMode(torque, torque_error);
-  base_.sliding.adaptive = mode == "atsmc";
-  line_v_ = refp.get("line/v_r", line_v_);
-  line_y_ = refp.get("line/y", line_y_);
-  line_x0_ = refp.get("line/x0", line_x0_);
+  core::PlantSimSettings plant_settings;
+  core::KinematicControllerSettings kin_settings;
+  core::TorqueControllerSettings torque_settings;
+  core::ReferenceGeneratorSettings ref_settings;
+  loadTable(plant, core::PlantSimSettings::table(), plant_settings);
+  loadTable(kin, core::KinematicControllerSettings::table(), kin_settings);
+  loadTable(torque, core::TorqueControllerSettings::table(), torque_settings);
+  loadTable(refp, core::ReferenceGeneratorSettings::table(), ref_settings);
+  base_.duration = settings.duration;
+  base_.control_period_ns = static_cast<std::int64_t>(std::llround(1e9 / settings.control_rate));
+  base_.start = plant_settings.start();
+  base_.disturbance = plant_settings.disturbance;
+  base_.kanayama = kin_settings.gains;
+  base_.sliding = torque_settings.sliding;
+  base_.sliding.adaptive = settings.adaptive;
+  line_v_ = ref_settings.line_v_r;
+  line_y_ = ref_settings.line_y;
+  line_x0_ = ref_settings.line_x0;
   reference_ = core::LineReference(line_v_, line_y_, line_x0_);
 
   const std::string gains_error = parseGains(pnh, gains_);
-  std::string e = core::firstError(
-      {plant.error(), kin.error(), torque.error(), refp.error(), error, robot_error, torque_error,
-       mode == "atsmc" || mode == "tsmc" ? "" : "mode = '" + mode + "' must be 'atsmc' or 'tsmc'",
-       core::parseCostType(cost, objective_.cost) ? "" : "cost = '" + cost + "' must be itae, ise, iae or itse",
-       seed >= 0 ? "" : "seed = " + std::to_string(seed) + " must be >= 0",
-       core::checkRange("duration", duration, 1e-3, 1e5, "s"),
-       core::checkRange("velocity_clamp", pso_.max_velocity_fraction, 0.0, 10.0, "(0 = no clamp)"), gains_error,
-       core::allFinite(line_v_, line_y_, line_x0_) ? "" : "reference_generator/line must be finite"});
-  pso_.seed = static_cast<std::uint64_t>(seed);
+  std::string e = core::firstError({plant.error(), kin.error(), torque.error(), refp.error(), robot_error,
+                                    settings.validate(), gains_error});
   if (e.empty()) e = core::firstError({base_.validate(), core::validateGainBounds(base_, gains_), objective_.validate()});
   if (e.empty()) {
     for (const auto& b : gains_) {
@@ -191,12 +189,8 @@ PsoTuner::PsoTuner(ros::NodeHandle nh, ros::NodeHandle pnh) {
   progress_pub_ = nh.advertise<std_msgs::Float64MultiArray>("pso/progress", 10, true);
   std::string dims;
   for (const auto& b : gains_) dims += (dims.empty() ? "" : ", ") + b.name + " [" + g(b.lower) + ", " + g(b.upper) + "]";
-  ROS_INFO("pso_tuner: %d particles x %d iterations (+ initial), seed %d, %d thread(s), velocity clamp %.3g, "
-           "w %.3g..%.3g, c1 %.3g, c2 %.3g; cost %s (x + y + theta)%s%s",
-           pso_.particles, pso_.iterations, seed, core::psoThreads(pso_), pso_.max_velocity_fraction, pso_.w_max,
-           pso_.w_min, pso_.c1, pso_.c2, cost.c_str(),
-           objective_.torque_weight > 0 ? (" + " + g(objective_.torque_weight) + " * int tau^2 dt").c_str() : "",
-           objective_.chattering_weight > 0 ? (" + " + g(objective_.chattering_weight) + " * sum |dtau|").c_str() : "");
+  logSettings("pso_tuner", core::PsoTunerSettings::table(), settings);
+  ROS_INFO("pso_tuner: %d evaluation thread(s)", core::psoThreads(pso_));
   ROS_INFO("pso_tuner: scenario %s", scenarioText().c_str());
   ROS_INFO("pso_tuner: searching %s", dims.c_str());
   ROS_INFO("pso_tuner: output %s", output_.c_str());

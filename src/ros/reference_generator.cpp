@@ -8,40 +8,40 @@
 #include "sowing_robot/core/validation.h"
 #include "sowing_robot/ros/component_params.h"
 #include "sowing_robot/ros/msg_checks.h"
+#include "sowing_robot/ros/reconfigure_bridge.h"
+#include "sowing_robot/core/seeding.h"
 
 namespace sowing_robot {
 
 ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) {
   ParamReader p(pnh);
-  const std::string type = p.get("type", "line");
-  const double v_r = p.get("line/v_r", 1.0), row_y = p.get("line/y", 3.0), x0 = p.get("line/x0", 0.0);
-  path_spacing_ = p.get("path_spacing", path_spacing_);
-  lookahead_ = p.get("lookahead", lookahead_);
-  // The field keys are read whatever the type (so a field block left in a line run is not "unknown"),
-  // but only the active type is validated.
-  std::string field_error;
-  const core::FieldParams field = loadFieldParams(p, field_error);
+  const core::RunSettings run = loadRunSettings(nh, p);
+  core::ReferenceGeneratorSettings settings;
+  loadTable(p, core::ReferenceGeneratorSettings::table(), settings);
+  std::string error = settings.validate();
+  // The field and its obstacles are read only with type field: with type line they are refused like
+  // unknown keys (a field file without `type: field` must not quietly run the line).
+  core::FieldParams field;
   std::vector<core::Obstacle> obstacles;
-  const std::string obstacle_error = loadObstacles(p, "obstacles", obstacles);
-  std::string error = type == "line" || type == "field" ? "" : "type = '" + type + "' must be 'line' or 'field'";
-  period_ns_ = loadControlPeriod(p, error);
-  if (error.empty() && type == "line")
-    error = core::firstError({core::checkRange("line/v_r", v_r, 0.0, 10.0, "m/s"),
-                              core::allFinite(row_y, x0) ? "" : "line/y and line/x0 must be finite",
-                              core::checkPositive("path_spacing", path_spacing_, "m")});
-  if (error.empty() && type == "field") {
-    error = core::firstError({field_error, obstacle_error, core::checkPositive("path_spacing", path_spacing_, "m")});
-    const std::string pe = field.potential.validate();
-    if (error.empty() && !pe.empty()) error = "potential/" + pe;
-    const std::string fe = error.empty() ? field.validate() : "";
-    if (!fe.empty()) error = "field/" + fe;
+  if (settings.field) {
+    loadTable(p, core::fieldTable(), field);
+    if (error.empty()) error = loadObstacles(p, "obstacles", obstacles);
+    if (error.empty() && p.error().empty()) error = field.validate();
+  } else {
+    for (const char* key : {"field", "potential", "obstacles"})
+      if (error.empty() && pnh.hasParam(key))
+        error = pnh.resolveName(key) + " is set but type is 'line': field, potential and obstacles are read only "
+                "with type: field (set " + pnh.resolveName("type") + ": field, or remove them)";
   }
-  if (error.empty()) error = core::checkRange("lookahead", lookahead_, 1e-6, 10.0, "s");
   requireValid(p, error);
+  odom_frame_ = run.odom_frame;
+  period_ns_ = run.periodNs();
+  lookahead_ = settings.lookahead;
+  path_spacing_ = settings.path_spacing;
   window_ns_ = std::llround(lookahead_ * 1e9);
-  if (type == "line") {
-    source_ = std::make_unique<core::LineReference>(v_r, row_y, x0);
-    ROS_INFO("reference_generator: line x = %.3f + %.3f t, y = %.3f", x0, v_r, row_y);
+  logSettings("reference_generator", core::ReferenceGeneratorSettings::table(), settings);
+  if (!settings.field) {
+    source_ = std::make_unique<core::LineReference>(settings.line_v_r, settings.line_y, settings.line_x0);
   } else {
     std::unique_ptr<core::FieldReference> f;
     try {
@@ -52,28 +52,20 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
     field_ = f.get();
     obstacles_ = obstacles;
     source_ = std::move(f);
-    const core::PotentialFieldParams& pf = field.potential;
-    ROS_INFO("reference_generator: field of %d row(s) of %.3f m, spacing %.3f m, first row from (%.3f, %.3f) "
-             "heading %.4f rad, next rows to the %s; row_speed %.3f m/s, turn_speed %.3f m/s, min_turn_radius %.3f m, "
-             "max_accel %.3f m/s^2, max_curvature_rate %.3f 1/m^2, start_from_rest %s; path %.3f m in %.3f s%s",
-             field.rows, field.row_length, field.row_spacing, field.start_x, field.start_y, field.heading,
-             field.rows_to_left ? "left" : "right", field.row_speed, field.turn_speed, field.min_turn_radius,
-             field.max_accel, field.max_curvature_rate, field.start_from_rest ? "true" : "false",
-             field_->path().length(), field_->duration(),
+    logSettings("reference_generator", core::fieldTable(), field);
+    ROS_INFO("reference_generator: field path %.3f m in %.3f s%s", field_->path().length(), field_->duration(),
              field.rows > 1 ? (field_->path().turn().isBulb() ? ", bulb turns" : ", rounded turns") : "");
-    ROS_INFO("reference_generator: potential alpha %.3f 1/s^2, beta %.3f 1/s, influence_distance %.3f m, gain %.3f "
-             "m^2/s^2, tangential_ratio %.3f, nearest_side %s, avoid_side %s, side_band %.3f m, core_fraction %.3f, "
-             "step %.6f s, heading_hold_speed %.3f m/s",
-             pf.alpha, pf.beta, pf.influence_distance, pf.gain, pf.tangential_ratio, pf.nearest_side ? "true" : "false",
-             pf.avoid_side == core::AvoidSide::kLeft ? "left" : "right", pf.side_band, pf.core_fraction, pf.step,
-             pf.heading_hold_speed);
     for (std::size_t i = 0; i < obstacles_.size(); ++i)
       ROS_INFO("reference_generator: obstacle %zu at (%.3f, %.3f), radius %.3f m", i, obstacles_[i].x, obstacles_[i].y,
                obstacles_[i].radius);
   }
   if (field_) {
-    reconfigure_ = std::make_unique<dynamic_reconfigure::Server<ReferenceGeneratorConfig>>(
-        ros::NodeHandle(pnh, "potential"));
+    ros::NodeHandle potential(pnh, "potential");
+    reconfigure_ = std::make_unique<dynamic_reconfigure::Server<ReferenceGeneratorConfig>>(potential);
+    // The server would start from the .cfg defaults where a key is not set: hand it the gains in force.
+    ReferenceGeneratorConfig in_force;
+    toConfig(core::potentialFieldTable(), field.potential, in_force);
+    reconfigure_->updateConfig(in_force);
     reconfigure_->setCallback([this](ReferenceGeneratorConfig& c, uint32_t level) { reconfigure(c, level); });
   }
   // A subscriber that connects late (a restarted controller) is sent the references already out for
@@ -82,14 +74,17 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
       "reference", kLockstepQueue, [this](const ros::SingleSubscriberPublisher& sub) { replayTo(sub); },
       ros::SubscriberStatusCallback());
   path_pub_ = nh.advertise<nav_msgs::Path>("reference_path", 1, true);
-  path_ = std::make_unique<PathBuffer>("odom", path_spacing_, 10);  // re-sent every 10th point
+  path_ = std::make_unique<PathBuffer>(odom_frame_, path_spacing_, 10);  // re-sent every 10th point
+  plan_pub_ = nh.advertise<FieldPlan>("plan", 1, true);
   if (field_) {
     marker_pub_ = nh.advertise<visualization_msgs::MarkerArray>("field_markers", 1, true);
-    publishMarkers();
     obstacles_sub_ = nh.subscribe("obstacles", 10, &ReferenceGenerator::obstaclesCallback, this);
+  } else {
+    line_ = {settings.line_x0, settings.line_y};
   }
+  publishPlan();
   clock_sub_ = nh.subscribe("/clock", 10, &ReferenceGenerator::clockCallback, this, ros::TransportHints().tcpNoDelay());
-  ROS_INFO("reference_generator: references on a %.6f s grid (control_rate), sent %.3f s ahead of /clock "
+  ROS_INFO("reference_generator: references on a %.6f s grid (run/control_rate), sent %.3f s ahead of /clock "
            "(lookahead)", core::secondsFromNanos(period_ns_), lookahead_);
 }
 
@@ -98,9 +93,9 @@ void ReferenceGenerator::obstaclesCallback(const visualization_msgs::MarkerArray
   std::vector<core::Obstacle> obstacles;
   for (const Marker& m : msg->markers) {
     if (m.type != Marker::CYLINDER || m.action != Marker::ADD) continue;
-    if (!m.header.frame_id.empty() && m.header.frame_id != "odom") {
-      ROS_WARN_THROTTLE(1.0, "reference_generator: dropping obstacles message: marker %s/%d is in frame '%s', not odom",
-                        m.ns.c_str(), m.id, m.header.frame_id.c_str());
+    if (!m.header.frame_id.empty() && m.header.frame_id != odom_frame_) {
+      ROS_WARN_THROTTLE(1.0, "reference_generator: dropping obstacles message: marker %s/%d is in frame '%s', not %s",
+                        m.ns.c_str(), m.id, m.header.frame_id.c_str(), odom_frame_.c_str());
       return;
     }
     core::Obstacle o;
@@ -123,19 +118,48 @@ void ReferenceGenerator::obstaclesCallback(const visualization_msgs::MarkerArray
   }
   obstacles_ = std::move(obstacles);
   ROS_INFO("reference_generator: %zu obstacle(s) in force now", obstacles_.size());
-  publishMarkers();
+  publishPlan();
+}
+
+void ReferenceGenerator::publishPlan() {
+  FieldPlan plan;
+  plan.header.frame_id = odom_frame_;
+  plan.header.stamp = ros::Time::now();
+  auto point = [](const Eigen::Vector2d& p) {
+    geometry_msgs::Point q;
+    q.x = p.x();
+    q.y = p.y();
+    return q;
+  };
+  if (field_) {
+    for (const core::RowSegment& r : core::rowsOf(field_->params())) {
+      plan.row_starts.push_back(point(r.a));
+      plan.row_ends.push_back(point(r.b));
+    }
+    for (const core::Obstacle& o : obstacles_) {
+      plan.obstacle_centres.push_back(point(Eigen::Vector2d(o.x, o.y)));
+      plan.obstacle_radii.push_back(o.radius);
+    }
+    plan.influence_distance = field_->potentialField().params().influence_distance;
+  } else {
+    plan.row_starts.push_back(point(line_));
+    plan.row_ends.push_back(point(line_ + Eigen::Vector2d(1e5, 0.0)));  // the thesis line, open-ended
+    plan.open_ended = true;
+  }
+  plan_pub_.publish(plan);
+  if (field_) publishMarkers();
 }
 
 void ReferenceGenerator::publishMarkers() {
   using visualization_msgs::Marker;
   visualization_msgs::MarkerArray out;
   Marker clear;
-  clear.header.frame_id = "odom";
+  clear.header.frame_id = odom_frame_;
   clear.action = Marker::DELETEALL;
   out.markers.push_back(clear);
-  auto marker = [](const std::string& ns, int id, int type, float r, float g, float b, float a) {
+  auto marker = [this](const std::string& ns, int id, int type, float r, float g, float b, float a) {
     Marker m;
-    m.header.frame_id = "odom";  // stamp 0: rviz uses the latest transform
+    m.header.frame_id = odom_frame_;  // stamp 0: rviz uses the latest transform
     m.ns = ns;
     m.id = id;
     m.type = type;
@@ -165,18 +189,14 @@ void ReferenceGenerator::publishMarkers() {
     zone.scale.z = 0.02;
     out.markers.push_back(zone);
   }
-  const core::FieldParams& fp = field_->params();
   Marker rows = marker("rows", 0, Marker::LINE_LIST, 0.1f, 0.8f, 0.1f, 1.0f);
   rows.scale.x = 0.03;
-  for (int i = 0; i < fp.rows; ++i) {
-    const Eigen::Vector2d a = field_->path().rowStart(i);
-    const double h = fp.heading + (i % 2 == 1 ? M_PI : 0.0);
-    const Eigen::Vector2d b = a + fp.row_length * Eigen::Vector2d(std::cos(h), std::sin(h));
+  for (const core::RowSegment& r : core::rowsOf(field_->params())) {
     geometry_msgs::Point pa, pb;
-    pa.x = a.x();
-    pa.y = a.y();
-    pb.x = b.x();
-    pb.y = b.y();
+    pa.x = r.a.x();
+    pa.y = r.a.y();
+    pb.x = r.b.x();
+    pb.y = r.b.y();
     rows.points.push_back(pa);
     rows.points.push_back(pb);
   }
@@ -191,10 +211,7 @@ void ReferenceGenerator::reconfigure(ReferenceGeneratorConfig& config, uint32_t)
   } catch (const std::invalid_argument& e) {
     ROS_WARN("reference_generator: rejected gain change: %s; keeping alpha %g, beta %g, gain %g, tangential_ratio %g",
              e.what(), old.alpha, old.beta, old.gain, old.tangential_ratio);
-    config.alpha = old.alpha;  // the server then reports (and stores) the values really in force
-    config.beta = old.beta;
-    config.gain = old.gain;
-    config.tangential_ratio = old.tangential_ratio;
+    toConfig(core::potentialFieldTable(), old, config);  // the server then reports the values in force
     return;
   }
   ROS_INFO("reference_generator: potential gains now alpha %g, beta %g, gain %g, tangential_ratio %g", config.alpha,
@@ -204,7 +221,7 @@ void ReferenceGenerator::reconfigure(ReferenceGeneratorConfig& config, uint32_t)
 void ReferenceGenerator::fill(ReferenceState& out, const ros::Time& stamp) {
   const core::Reference r = source_->next(stamp.toSec());
   out.header.stamp = stamp;
-  out.header.frame_id = "odom";
+  out.header.frame_id = odom_frame_;
   out.x = r.pose.x;
   out.y = r.pose.y;
   out.theta = r.pose.theta;

@@ -10,15 +10,17 @@ namespace sowing_robot {
 
 RunMonitor::RunMonitor(ros::NodeHandle nh, ros::NodeHandle pnh) {
   ParamReader p(pnh);
-  duration_ = p.get("duration", duration_);
-  output_ = p.get("output", "");
-  label_ = p.get("label", "run");
-  exit_at_end_ = p.get("exit_at_end", exit_at_end_);
+  const core::RunSettings run = loadRunSettings(nh, p);
+  core::RunMonitorSettings settings;
+  loadTable(p, core::RunMonitorSettings::table(), settings);
+  requireValid(p, core::firstError({settings.validate(), core::checkPositive("run/duration", run.duration, "s")}));
+  duration_ = run.duration;
+  output_ = settings.output;
+  label_ = settings.label;
+  exit_at_end_ = settings.exit_at_end;
   // The time-domain figures (rise, settling, overshoot) need every sample: 32 B per period, ~115 MB per
   // hour at 1 kHz. Long runs (soak) switch them off and keep only the integrals (constant memory).
-  const bool time_domain = p.get("time_domain", true);
-  requireValid(p, core::checkPositive("duration", duration_, "s"));
-  metrics_ = core::MetricsAccumulator(time_domain);
+  metrics_ = core::MetricsAccumulator(settings.time_domain);
   metrics_.reserve(static_cast<std::size_t>(duration_ * 1000.0) + 2);
   sub_ = nh.subscribe("tracking_error", kLockstepQueue, &RunMonitor::errorCallback, this, ros::TransportHints().tcpNoDelay());
 }

@@ -16,48 +16,25 @@ namespace {
 constexpr std::size_t kChunk = 1000;  // seeds per marker: rviz keeps every chunk, we resend only the last
 }
 
-SeedDrillNode::SeedDrillNode(ros::NodeHandle nh, ros::NodeHandle pnh) {
+SeedDrillNode::SeedDrillNode(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh) {
   ParamReader p(pnh);
-  core::SeedingParams sp;
-  sp.spacing = p.get("spacing", sp.spacing);
-  sp.tolerance = p.get("tolerance", sp.tolerance);
-  sp.detour_margin = p.get("detour_margin", sp.detour_margin);
-  sp.engage_distance = p.get("engage_distance", sp.engage_distance);
-  const std::string tool_link = p.get("tool_link", "tool_link");
+  const core::RunSettings run = loadRunSettings(nh, p);
+  loadTable(p, core::SeedDrillSettings::table(), settings_);
   p.allow("robot_description");
-  std::string error = sp.validate();
-
-  // The tool point comes from the URDF, the rows and obstacles from the reference generator's own
-  // parameters: the drill scores the sown line against exactly what was planned.
+  std::string error = settings_.validate();
+  // The tool point comes from the URDF; the rows and obstacles from the reference generator's `plan`.
   std::string key, xml;
   if (error.empty()) {
     if (!pnh.searchParam("robot_description", key) || !pnh.getParam(key, xml))
       error = "parameter robot_description (the URDF) is not set";
     else
-      error = linkPositionFromUrdf(xml, tool_link, tool_x_, tool_y_);
-  }
-  ParamReader ref(ros::NodeHandle("/reference_generator"));
-  const std::string type = ref.get("type", "line");
-  std::vector<core::RowSegment> rows;
-  std::vector<core::Obstacle> obstacles;
-  double influence = 0.0;
-  if (error.empty() && type == "field") {
-    const core::FieldParams field = loadFieldParams(ref, error);
-    if (error.empty()) error = loadObstacles(ref, "obstacles", obstacles);
-    if (error.empty()) {
-      rows = core::rowsOf(field);
-      influence = field.potential.influence_distance;
-    }
-  } else if (error.empty()) {
-    const double x0 = ref.get("line/x0", 0.0), y = ref.get("line/y", 3.0);
-    rows = {{Eigen::Vector2d(x0, y), Eigen::Vector2d(x0 + 1e5, y)}};  // the thesis line, open-ended
+      error = linkPositionFromUrdf(xml, settings_.tool_link, tool_x_, tool_y_);
   }
   requireValid(p, error);
-  drill_ = std::make_unique<core::SeedDrill>(sp, rows, obstacles, influence);
-  ROS_INFO("seed_drill: tool point (%.3f, %.3f) m in base_link, a seed every %.3f m, %zu row(s), %zu obstacle(s)",
-           tool_x_, tool_y_, sp.spacing, rows.size(), obstacles.size());
+  logSettings("seed_drill", core::SeedDrillSettings::table(), settings_);
+  ROS_INFO("seed_drill: tool point (%.3f, %.3f) m in base_link; waiting for the plan", tool_x_, tool_y_);
 
-  chunk_.header.frame_id = "odom";
+  chunk_.header.frame_id = run.odom_frame;
   chunk_.ns = "seeds";
   chunk_.type = visualization_msgs::Marker::SPHERE_LIST;
   chunk_.action = visualization_msgs::Marker::ADD;
@@ -69,9 +46,30 @@ SeedDrillNode::SeedDrillNode(ros::NodeHandle nh, ros::NodeHandle pnh) {
   chunk_.color.a = 1.0f;
   seeds_pub_ = nh.advertise<visualization_msgs::MarkerArray>("seeds", 10);
   report_pub_ = nh.advertise<std_msgs::Float64MultiArray>("seed_report", 1, true);
+  // The state is followed only once there is a plan to score it against (latched: it comes at once).
+  plan_sub_ = nh.subscribe("plan", 1, &SeedDrillNode::planCallback, this);
+}
+
+void SeedDrillNode::planCallback(const FieldPlan::ConstPtr& msg) {
+  const std::size_t n = std::min(msg->row_starts.size(), msg->row_ends.size());
+  std::vector<core::RowSegment> rows(n);
+  for (std::size_t i = 0; i < n; ++i)
+    rows[i] = {Eigen::Vector2d(msg->row_starts[i].x, msg->row_starts[i].y),
+               Eigen::Vector2d(msg->row_ends[i].x, msg->row_ends[i].y)};
+  std::vector<core::Obstacle> obstacles(std::min(msg->obstacle_centres.size(), msg->obstacle_radii.size()));
+  for (std::size_t i = 0; i < obstacles.size(); ++i)
+    obstacles[i] = {msg->obstacle_centres[i].x, msg->obstacle_centres[i].y, msg->obstacle_radii[i]};
+  if (drill_) {
+    drill_->setPlan(std::move(rows), std::move(obstacles), msg->influence_distance);
+    ROS_INFO("seed_drill: plan changed: %zu row(s), %zu obstacle(s)", n, msg->obstacle_radii.size());
+    return;
+  }
+  drill_ = std::make_unique<core::SeedDrill>(settings_.seeding, std::move(rows), std::move(obstacles),
+                                             msg->influence_distance);
+  ROS_INFO("seed_drill: plan of %zu row(s), %zu obstacle(s): sowing", n, msg->obstacle_radii.size());
   const auto hints = ros::TransportHints().tcpNoDelay();
-  odom_sub_ = nh.subscribe("odom", kLockstepQueue, &SeedDrillNode::odomCallback, this, hints);
-  ref_sub_ = nh.subscribe("reference", kLockstepQueue, &SeedDrillNode::referenceCallback, this, hints);
+  odom_sub_ = nh_.subscribe("odom", kLockstepQueue, &SeedDrillNode::odomCallback, this, hints);
+  ref_sub_ = nh_.subscribe("reference", kLockstepQueue, &SeedDrillNode::referenceCallback, this, hints);
   publishReport();
 }
 

@@ -3,30 +3,32 @@
 #include "sowing_robot/ros/component_params.h"
 #include "sowing_robot/core/validation.h"
 #include "sowing_robot/ros/msg_checks.h"
+#include "sowing_robot/ros/reconfigure_bridge.h"
 
 namespace sowing_robot {
+
 
 TorqueController::TorqueController(ros::NodeHandle nh, ros::NodeHandle pnh) {
   ParamReader p(pnh);
   core::RobotParams robot;
   p.allow("robot_description");  // a private URDF may override the global one
-  std::string error = loadRobotParams(pnh, robot);
-  const std::int64_t period = loadControlPeriod(p, error);
-  const core::SlidingModeParams params = loadSlidingMode(p, error);
-  input_timeout_ = p.get("input_timeout", input_timeout_);
-  if (error.empty()) error = core::firstError({params.validate(), core::checkPositive("input_timeout", input_timeout_, "s")});
-  requireValid(p, error);
-  dt_ = core::secondsFromNanos(period);
+  const std::string robot_error = loadRobotParams(pnh, robot);
+  const core::RunSettings run = loadRunSettings(nh, p, {"mode"});  // our mode is atsmc | tsmc
+  core::TorqueControllerSettings settings;
+  loadTable(p, core::TorqueControllerSettings::table(), settings);
+  requireValid(p, robot_error.empty() ? settings.validate() : robot_error);
+  const core::SlidingModeParams& params = settings.sliding;
+  input_timeout_ = settings.input_timeout;
+  dt_ = core::secondsFromNanos(run.periodNs());
   smc_ = std::make_unique<core::SlidingModeController>(params, robot);
-  ROS_INFO("torque_controller: %s, p/q %d/%d, beta %.4g/%.4g, K %.4g/%.4g, eta %.4g/%.4g, rates %.4g/%.4g, "
-           "m0 in [%.4g, %.4g] from %.4f kg, I0 in [%.4g, %.4g] from %.5f kg m^2, switching %s (width %.4g), "
-           "max torque %.4g N m, %.0f Hz",
-           params.adaptive ? "ATSMC" : "TSMC", params.p, params.q, params.beta_v, params.beta_omega, params.k1,
-           params.k2, params.eta1, params.eta2, params.rate_m, params.rate_i, params.m0_min, params.m0_max,
-           smc_->m0Hat(), params.i0_min, params.i0_max, smc_->i0Hat(),
-           core::SwitchFunction::name(params.switching.type), params.switching.width, params.max_torque, 1.0 / dt_);
+  logSettings("torque_controller", core::TorqueControllerSettings::table(), settings);
+  ROS_INFO("torque_controller: m0_hat starts at %.4f kg, I0_hat at %.5f kg m^2; %.0f Hz", smc_->m0Hat(), smc_->i0Hat(),
+           1.0 / dt_);
   state_.mode = params.adaptive ? "atsmc" : "tsmc";
   reconfigure_ = std::make_unique<dynamic_reconfigure::Server<TorqueControllerConfig>>(pnh);
+  TorqueControllerConfig in_force;  // see KinematicController: the server's first callback changes nothing
+  toConfig(core::slidingModeTable(), params, in_force);
+  reconfigure_->updateConfig(in_force);
   reconfigure_->setCallback([this](TorqueControllerConfig& c, uint32_t level) { reconfigure(c, level); });
   torque_pub_ = nh.advertise<WheelTorque>("wheel_torque", kLockstepQueue);
   state_pub_ = pnh.advertise<TorqueControllerState>("state", kLockstepQueue);
@@ -35,49 +37,20 @@ TorqueController::TorqueController(ros::NodeHandle nh, ros::NodeHandle pnh) {
   desired_sub_ = nh.subscribe("desired_velocity", kLockstepQueue, &TorqueController::desiredCallback, this, hints);
 }
 
-namespace {
-/// The live-tunable subset of SlidingModeParams and its dynamic_reconfigure fields, listed once:
-/// `each(param, config_field)` is called for every pair (P and C may be const, for the direction read).
-template <typename P, typename C, typename F>
-void forEachTunable(P& p, C& c, F each) {
-  each(p.beta_v, c.beta_v);
-  each(p.beta_omega, c.beta_omega);
-  each(p.k1, c.k1);
-  each(p.k2, c.k2);
-  each(p.eta1, c.eta1);
-  each(p.eta2, c.eta2);
-  each(p.rate_m, c.rate_m);
-  each(p.rate_i, c.rate_i);
-  each(p.max_torque, c.max_torque);
-  each(p.switching.width, c.switch_width);
-}
-void toParams(const TorqueControllerConfig& c, core::SlidingModeParams& p) {
-  forEachTunable(p, c, [](double& param, const double& field) { param = field; });
-}
-void toConfig(const core::SlidingModeParams& p, TorqueControllerConfig& c) {
-  forEachTunable(p, c, [](const double& param, double& field) { field = param; });
-  c.switching = core::SwitchFunction::name(p.switching.type);
-}
-}  // namespace
 
 void TorqueController::reconfigure(TorqueControllerConfig& config, uint32_t) {
   // The server's first call repeats the start-up values; applying them again changes nothing.
   const core::SlidingModeParams old = smc_->params();
   core::SlidingModeParams p = old;
-  toParams(config, p);
-  std::string error;
-  if (!core::SwitchFunction::parse(config.switching, p.switching.type))
-    error = "switching = '" + config.switching + "' must be one of sign, sat, relay, atan, tanh";
+  std::string error = fromConfig(core::slidingModeTable(), config, p);
   if (error.empty()) error = p.validate();
   if (!error.empty()) {
     ROS_WARN("torque_controller: rejected gain change: %s; keeping the previous gains", error.c_str());
-    toConfig(old, config);  // the server then reports (and stores) the values really in force
+    toConfig(core::slidingModeTable(), old, config);  // the server then reports (and stores) the values in force
     return;
   }
   smc_->setParams(p);
-  ROS_INFO("torque_controller: gains now beta %g/%g, K %g/%g, eta %g/%g, rates %g/%g, max torque %g, %s (%g)",
-           p.beta_v, p.beta_omega, p.k1, p.k2, p.eta1, p.eta2, p.rate_m, p.rate_i, p.max_torque,
-           core::SwitchFunction::name(p.switching.type), p.switching.width);
+  ROS_INFO("torque_controller: gains now %s", core::slidingModeTable().describe(p).c_str());
 }
 
 void TorqueController::odomCallback(const nav_msgs::Odometry::ConstPtr& msg) {

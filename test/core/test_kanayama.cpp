@@ -104,7 +104,14 @@ TEST(Kanayama, LyapunovFunctionNeverIncreasesOnTheKinematicLoop) {
 
 TEST(Kanayama, ValidationRejectsNonPositiveGains) {
   EXPECT_TRUE(KanayamaGains{}.validate().empty());
-  EXPECT_NE(KanayamaGains({0.0, 1.5, 2.2}).validate().find("kx"), std::string::npos);
-  EXPECT_NE(KanayamaGains({1.0, -1.0, 2.2}).validate().find("ky"), std::string::npos);
-  EXPECT_NE(KanayamaGains({1.0, 1.5, NAN}).validate().find("ktheta"), std::string::npos);
+  auto with = [](double kx, double ky, double ktheta) {
+    KanayamaGains g;
+    g.kx = kx;
+    g.ky = ky;
+    g.ktheta = ktheta;
+    return g;
+  };
+  EXPECT_NE(with(0.0, 1.5, 2.2).validate().find("kx"), std::string::npos);
+  EXPECT_NE(with(1.0, -1.0, 2.2).validate().find("ky"), std::string::npos);
+  EXPECT_NE(with(1.0, 1.5, NAN).validate().find("ktheta"), std::string::npos);
 }

@@ -16,7 +16,7 @@ CASES = [
     # (node type, {private param: value}, text that must appear)
     ("plant_sim", {"mode": "bogus"}, "mode"),
     ("plant_sim", {"duration": -1.0}, "duration"),
-    ("plant_sim", {"disturbance/amplitude": float("nan")}, "disturbance.amplitude"),
+    ("plant_sim", {"disturbance/amplitude": float("nan")}, "disturbance/amplitude"),
     ("plant_sim", {"mismatch/mass_scale": 0.0}, "mass_scale"),
     ("plant_sim", {"torque_timout": 0.2}, "torque_timout"),  # typo: unknown key
     ("plant_sim", {"control_rate": "fast"}, "control_rate"),  # wrong type

@@ -124,7 +124,8 @@ class LockstepDeadController(unittest.TestCase):
 
     def test_missing_controller_is_reported_before_the_start(self):
         ns = "/lonely"  # its own topics: the pipeline's torque_controller must not count as its publisher
-        node_process.set_private_params(ns + "/plant_sim", {"mode": "lockstep", "min_subscribers": 0,
+        node_process.set_private_params(ns + "/run", {"mode": "lockstep"})
+        node_process.set_private_params(ns + "/plant_sim", {"min_subscribers": 0,
                                                             "lockstep_timeout": LOCKSTEP_TIMEOUT})
         lonely_odom = []
         self.subs.append(rospy.Subscriber(ns + "/odom", Odometry, lonely_odom.append, queue_size=10))
@@ -146,7 +147,8 @@ class LockstepDeadController(unittest.TestCase):
         # A headless run whose controller never answers must end: exit 3 and one FATAL line naming what
         # is missing, once lockstep_give_up wall seconds have passed (here 3 s; the default is 120 s).
         ns = "/given_up"
-        node_process.set_private_params(ns + "/plant_sim", {"mode": "lockstep", "min_subscribers": 0,
+        node_process.set_private_params(ns + "/run", {"mode": "lockstep"})
+        node_process.set_private_params(ns + "/plant_sim", {"min_subscribers": 0,
                                                             "lockstep_timeout": LOCKSTEP_TIMEOUT,
                                                             "lockstep_give_up": 3.0})
         started_at = time.time()

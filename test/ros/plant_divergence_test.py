@@ -30,9 +30,11 @@ CASES = [
     # step (0 * inf in the Coriolis term); the run must stop on the NaN state (default max_speed).
     ("/diverge_overflow", {}, 1e308, "nan"),
 ]
-COMMON = {
+RUN = {
     "mode": "realtime",
     "control_rate": 200.0,  # light on a busy 2-core machine; the check runs after every step at any rate
+}
+COMMON = {
     "torque_timeout": 1.0,  # [s sim] generous: our torques are stamped with the last odom we received
     "disturbance/sinusoidal": False,  # the only cause of motion is the test's torque
 }
@@ -44,6 +46,7 @@ class PlantDivergence(unittest.TestCase):
         rospy.init_node("plant_divergence_test")
 
     def run_case(self, ns, params, torque, needle):
+        node_process.set_private_params(ns + "/run", RUN)  # the run-wide settings of this namespace
         node_process.set_private_params(ns + "/plant_sim", dict(COMMON, **params))
         max_speed = params.get("max_speed", 20.0)
         seen = {"stamp": None, "count": 0, "max_v": 0.0}

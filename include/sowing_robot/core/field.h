@@ -29,24 +29,29 @@
 namespace sowing_robot {
 namespace core {
 
+/// Defaults, ranges, units and meanings: fieldTable() (keys field/... and potential/...).
 struct FieldParams {
-  int rows = 1;                      ///< number of rows N, >= 1
-  double row_length = 100.0;         ///< [m], > 0
-  double row_spacing = 1.0;          ///< distance between neighbouring rows [m], > 0
-  double start_x = 0.0, start_y = 3.0;  ///< start of the first row [m] (thesis: (0, 3))
-  double heading = 0.0;              ///< direction of the first row [rad]
-  bool rows_to_left = true;          ///< the second row lies left of the first one's direction
-  double row_speed = 1.0;            ///< v_r [m/s], > 0
-  double turn_speed = 0.5;           ///< speed on the headland turns [m/s], in (0, row_speed]
-  double min_turn_radius = 0.5;      ///< the turns keep |kappa| <= 1/min_turn_radius [m], > 0
-  double max_accel = 0.5;            ///< peak |v_dot| of the speed ramps [m/s^2], > 0
+  FieldParams();
+  int rows;                      ///< number of rows N, >= 1
+  double row_length;             ///< [m], > 0
+  double row_spacing;            ///< distance between neighbouring rows [m], > 0
+  double start_x, start_y;       ///< start of the first row [m] (thesis: (0, 3))
+  double heading;                ///< direction of the first row [rad]
+  bool rows_to_left;             ///< the second row lies left of the first one's direction
+  double row_speed;              ///< v_r [m/s], > 0
+  double turn_speed;             ///< speed on the headland turns [m/s], in (0, row_speed]
+  double min_turn_radius;        ///< the turns keep |kappa| <= 1/min_turn_radius [m], > 0
+  double max_accel;              ///< peak |v_dot| of the speed ramps [m/s^2], > 0
   /// Peak |dkappa/ds| in the turns [1/m^2]; must be >= 1/(2 min_turn_radius^2) so a ramp to the
   /// largest curvature fits in a half turn.
-  double max_curvature_rate = 10.0;
-  bool start_from_rest = false;      ///< false: the first row starts at row_speed (as the thesis line)
+  double max_curvature_rate;
+  bool start_from_rest;          ///< false: the first row starts at row_speed (as the thesis line)
   PotentialFieldParams potential;    ///< alpha, beta, repulsion (see PotentialField)
   std::string validate() const;
 };
+/// field/{rows, row_length, row_spacing, start_x, start_y, heading, rows_to_left, row_speed, turn_speed,
+/// min_turn_radius, max_accel, max_curvature_rate, start_from_rest} and potential/... (potentialFieldTable()).
+const ParamTable<FieldParams>& fieldTable();
 
 /// One headland U-turn in a local frame: starts at the origin heading along +x, turns left and ends at
 /// (0, width) heading along -x. Built once; evaluation does not allocate.

@@ -3,17 +3,21 @@
 
 #include <string>
 
+#include "sowing_robot/core/param_table.h"
 #include "sowing_robot/core/types.h"
 
 namespace sowing_robot {
 namespace core {
 
+/// Defaults, ranges and units: kanayamaTable().
 struct KanayamaGains {
-  double kx = 1.0;      ///< [1/s]
-  double ky = 1.5;      ///< [1/m^2]
-  double ktheta = 2.2;  ///< [1/m]
+  KanayamaGains();
+  KanayamaGains(double kx_, double ky_, double ktheta_) : kx(kx_), ky(ky_), ktheta(ktheta_) {}
+  double kx, ky, ktheta;  ///< [1/s], [1/m^2], [1/m]
   std::string validate() const;
 };
+/// kx, ky, ktheta (Table 5.3).
+const ParamTable<KanayamaGains>& kanayamaTable();
 
 /// Posture error in the robot frame (eq 4.1).
 struct PostureError {

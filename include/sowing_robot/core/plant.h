@@ -8,6 +8,7 @@
 #include <random>
 #include <string>
 
+#include "sowing_robot/core/param_table.h"
 #include "sowing_robot/core/robot_params.h"
 
 namespace sowing_robot {
@@ -18,17 +19,21 @@ enum StateIndex { X = 0, Y, THETA, V, OMEGA, PHI_R, PHI_L, STATE_SIZE };
 using State = Eigen::Matrix<double, STATE_SIZE, 1>;
 
 /// Everything the plant does to the ideal model: disturbance, noise and parameter mismatch.
+/// Defaults, ranges, units and meanings: disturbanceTable().
 struct PlantDisturbance {
-  bool sinusoidal = false;     ///< add td_R = A sin(w t), td_L = A cos(w t) to the wheel torques (Fig 5.9)
-  double amplitude = 2.75;     ///< A [N·m]
-  double frequency = 3.0;      ///< w [rad/s]
-  double noise_std = 0.0;      ///< std of Gaussian wheel-torque noise, held over one step [N·m]; 0 = off
-  std::uint64_t seed = 1;      ///< seed of the noise generator
-  double mass_scale = 1.0;     ///< true m0 and mc·d are this times the nominal (1 = no mismatch)
-  double inertia_scale = 1.0;  ///< true I0 is this times the nominal (1 = no mismatch)
+  PlantDisturbance();
+  bool sinusoidal;        ///< add td_R = A sin(w t), td_L = A cos(w t) to the wheel torques (Fig 5.9)
+  double amplitude;       ///< A [N·m]
+  double frequency;       ///< w [rad/s]
+  double noise_std;       ///< std of Gaussian wheel-torque noise, held over one step [N·m]; 0 = off
+  std::uint64_t seed;     ///< seed of the noise generator
+  double mass_scale;      ///< true m0 and mc·d are this times the nominal (1 = no mismatch)
+  double inertia_scale;   ///< true I0 is this times the nominal (1 = no mismatch)
 
   std::string validate() const;
 };
+/// disturbance/{sinusoidal, amplitude, frequency}, noise/{std, seed}, mismatch/{mass_scale, inertia_scale}.
+const ParamTable<PlantDisturbance>& disturbanceTable();
 
 /// Fixed-step RK4 simulation of the DDMR. The pose (x, y, theta) is that of the axle midpoint
 /// (REP-105 base_link); the centre of mass sits d ahead of it.

@@ -14,6 +14,7 @@
 
 #include <Eigen/Dense>
 
+#include "sowing_robot/core/param_table.h"
 #include "sowing_robot/core/reference.h"
 #include "sowing_robot/core/types.h"
 
@@ -41,29 +42,34 @@ enum class AvoidSide {
   kRight,  ///< pass with the obstacle on the left
 };
 
+/// Defaults, ranges, units and meanings: potentialFieldTable().
 struct PotentialFieldParams {
-  double alpha = 4.0;                ///< position gain alpha [1/s^2] (thesis: 4)
-  double beta = 16.0;                ///< damping of the velocity relative to the target, beta [1/s] (thesis: 16)
-  double influence_distance = 0.5;   ///< d: no repulsion beyond this clearance from the obstacle SURFACE [m]
-  double gain = 5.0;                 ///< k: mu_radial = -k grad V_a [m^2/s^2], >= 0 (0 disables avoidance)
-  double tangential_ratio = 1.0;     ///< |tangential| / |radial| repulsion [-], >= 0
+  PotentialFieldParams();
+  double alpha;                ///< position gain alpha [1/s^2] (thesis: 4)
+  double beta;                 ///< damping of the velocity relative to the target, beta [1/s] (thesis: 16)
+  double influence_distance;   ///< d: no repulsion beyond this clearance from the obstacle SURFACE [m]
+  double gain;                 ///< k: mu_radial = -k grad V_a [m^2/s^2], >= 0 (0 disables avoidance)
+  double tangential_ratio;     ///< |tangential| / |radial| repulsion [-], >= 0
   /// true: when the reference enters an obstacle's influence zone it picks the side it is already on
   /// (offset from the centre of the obstacles whose zones it is in, along the left normal of travel,
   /// beyond +-side_band) and keeps it until it leaves the zone; obstacles with overlapping zones share
   /// the side. false: always avoid_side.
-  bool nearest_side = true;
+  bool nearest_side;
   /// Forced side (nearest_side = false) and tie-break inside the band: the on-line case goes this way.
-  AvoidSide avoid_side = AvoidSide::kLeft;
-  double side_band = 0.05;           ///< half-width of the tie band [m], >= 0
+  AvoidSide avoid_side;
+  double side_band;           ///< half-width of the tie band [m], >= 0
   /// Below this fraction of d the clearance potential continues linearly (finite force, so a reference
   /// that starts inside an obstacle is pushed out instead of blowing up the integrator) [-], (0, 1).
-  double core_fraction = 0.1;
-  double step = 1e-3;                ///< internal RK4 step h [s], (0, 1e-3]
+  double core_fraction;
+  double step;                ///< internal RK4 step h [s], (0, 1e-3]
   /// While both the reference and the target move slower than this [m/s], theta is held and
   /// omega = omega_dot = 0 (stops: a residual sideways creep must not turn the heading), >= 0.
-  double heading_hold_speed = 0.02;
+  double heading_hold_speed;
   std::string validate() const;
 };
+/// alpha, beta, influence_distance, gain, tangential_ratio, nearest_side, avoid_side, side_band,
+/// core_fraction, step, heading_hold_speed (keys without the `potential/` the nodes put before them).
+const ParamTable<PotentialFieldParams>& potentialFieldTable();
 
 /// Kinematic state of a target at one time; a, j are exact time derivatives of v, a.
 struct TargetState {

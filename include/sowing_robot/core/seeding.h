@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "sowing_robot/core/field.h"
+#include "sowing_robot/core/param_table.h"
 #include "sowing_robot/core/potential_field.h"
 
 namespace sowing_robot {
@@ -21,16 +22,20 @@ struct RowSegment {
 /// The rows of a field (row i from rowStart(i), alternating direction, length row_length).
 std::vector<RowSegment> rowsOf(const FieldParams& field);
 
+/// Defaults, ranges, units and meanings: seedingTable().
 struct SeedingParams {
-  double spacing = 0.1;        ///< distance between seeds along the tool's path [m] (> 0)
-  double tolerance = 0.02;     ///< cross-track error counted as "off the line" beyond this [m] (> 0)
-  double detour_margin = 0.5;  ///< seeds closer than radius + influence + margin to an obstacle are detour seeds [m]
+  SeedingParams();
+  double spacing;        ///< distance between seeds along the tool's path [m] (> 0)
+  double tolerance;      ///< cross-track error counted as "off the line" beyond this [m] (> 0)
+  double detour_margin;  ///< seeds closer than radius + influence + margin to an obstacle are detour seeds [m]
   /// The tool is lowered only once the tool point is this close to a row, between its ends, and the
   /// reference says tool down, as an operator would: the approach from a start off the row and the
   /// end of a headland turn sow nothing [m] (> 0).
-  double engage_distance = 0.01;
+  double engage_distance;
   std::string validate() const;
 };
+/// spacing, tolerance, detour_margin, engage_distance (seed_drill's keys).
+const ParamTable<SeedingParams>& seedingTable();
 
 /// Cross-track figures of a set of seeds [m].
 struct SeedStats {
@@ -49,6 +54,9 @@ class SeedDrill {
   /// position) when a seed falls here. A non-finite p is refused (false, state untouched, counted by
   /// rejected()), so it can neither drop a seed nor spoil the distance travelled.
   bool update(const Eigen::Vector2d& p, bool tool_down, Eigen::Vector2d& seed);
+  /// A new plan (the obstacles changed at run time): seeds from now on are scored against it; the
+  /// seeds already scored, the distance travelled and the tool's state are kept.
+  void setPlan(std::vector<RowSegment> rows, std::vector<Obstacle> obstacles, double influence);
 
   /// Distance from p to the nearest row segment [m].
   double crossTrack(const Eigen::Vector2d& p) const;

@@ -14,21 +14,27 @@ namespace core {
 /// Real power x^(num/den) for an odd den, i.e. the real root: sign(x)^num |x|^(num/den).
 double realPower(double x, int num, int den);
 
+/// Defaults, ranges, units and meanings: slidingModeTable().
 struct SlidingModeParams {
-  bool adaptive = true;  ///< true: ATSMC (eq 4.22 with projection); false: TSMC (fixed nominal)
-  int p = 5, q = 3;      ///< terminal exponent p/q, both odd, 1 < p/q < 2
-  double beta_v = 1.0, beta_omega = 1.0;  ///< surface gains beta per channel (not given in the thesis)
-  double k1 = 1.0, k2 = 150.0;            ///< feedback gains K1 [N·m·s/m], K2 [N·m·s/rad]
-  double eta1 = 2.0, eta2 = 2.0;          ///< switching gains [N·m]
-  double rate_m = 0.1, rate_i = 0.1;      ///< adaptation rates of m0_hat and I0_hat (Table 5.3 gamma1/2)
-  double m0_min = 17.51, m0_max = 37.51;  ///< projection bounds on m0_hat [kg]
-  double i0_min = 0.57, i0_max = 4.57;    ///< projection bounds on I0_hat [kg·m^2]
-  double m0_initial = 0.0, i0_initial = 0.0;  ///< initial/nominal estimates; <= 0 means "from the URDF"
-  double max_torque = 100.0;              ///< per-wheel motor limit [N·m]
+  SlidingModeParams();
+  bool adaptive;  ///< true: ATSMC (eq 4.22 with projection); false: TSMC (fixed nominal)
+  int p, q;       ///< terminal exponent p/q, both odd, 1 < p/q < 2
+  double beta_v, beta_omega;  ///< surface gains beta per channel (not given in the thesis)
+  double k1, k2;              ///< feedback gains K1 [N·m·s/m], K2 [N·m·s/rad]
+  double eta1, eta2;          ///< switching gains [N·m]
+  double rate_m, rate_i;      ///< adaptation rates of m0_hat and I0_hat (Table 5.3 gamma1/2)
+  double m0_min, m0_max;      ///< projection bounds on m0_hat [kg]
+  double i0_min, i0_max;      ///< projection bounds on I0_hat [kg·m^2]
+  double m0_initial, i0_initial;  ///< initial/nominal estimates; 0 means "from the URDF"
+  double max_torque;              ///< per-wheel motor limit [N·m]
   SwitchFunction switching;
 
+  /// Ranges (the table), then p/q odd with 1 < p/q < 2, min < max, initial estimates within the bounds.
   std::string validate() const;
 };
+/// mode, p, q, beta_v, beta_omega, k1, k2, eta1, eta2, rate_m, rate_i, m0_min, m0_max, i0_min, i0_max,
+/// m0_initial, i0_initial, max_torque, switching, switch_width.
+const ParamTable<SlidingModeParams>& slidingModeTable();
 
 /// What one control update produced, for logging and plots.
 struct SlidingModeOutput {

@@ -1,6 +1,8 @@
 // The robustness term's switching function: sign and its chattering remedies (eqs 4.46-4.48).
 #pragma once
 
+#include "sowing_robot/core/param_table.h"
+
 #include <string>
 
 namespace sowing_robot {
@@ -8,11 +10,14 @@ namespace core {
 
 enum class SwitchType { Sign, Saturation, Relay, Atan, Tanh };
 
+/// Defaults, ranges and units: switchingTable().
 struct SwitchFunction {
-  SwitchType type = SwitchType::Sign;
+  SwitchFunction();
+  SwitchFunction(SwitchType t, double w) : type(t), width(w) {}
+  SwitchType type;
   /// Width of the smoothing: boundary layer phi of sat(S/phi) and tanh(S/phi), delta of the relay
   /// S/(|S|+delta), and 1/Delta of the normalised arctangent (2/pi) atan(S/width).
-  double width = 0.01;
+  double width;
 
   /// Value in [-1, 1]; odd in s; tends to sign(s) as |s| grows.
   double operator()(double s) const;
@@ -22,6 +27,8 @@ struct SwitchFunction {
   static bool parse(const std::string& name, SwitchType& type);
   static const char* name(SwitchType type);
 };
+/// switching, switch_width (eqs 4.46-4.48).
+const ParamTable<SwitchFunction>& switchingTable();
 
 }  // namespace core
 }  // namespace sowing_robot

@@ -1,18 +1,17 @@
-// One loader per core component: parameter names, defaults and units live here and in the core
-// params structs (whose validate() holds the ranges). Nodes, the PSO tuner and the pipeline test all
-// load through these, so a gain means the same thing everywhere.
+// Loading through the parameter tables (core/param_table.h): every key, default, range and unit comes
+// from the component's table, so nodes, the PSO tuner and the pipeline test read a gain the same way.
 #pragma once
 
 #include <cstdint>
 #include <string>
 #include <vector>
 
+#include <ros/console.h>
+
 #include "sowing_robot/core/field.h"
-#include "sowing_robot/core/kanayama.h"
-#include "sowing_robot/core/plant.h"
+#include "sowing_robot/core/node_settings.h"
 #include "sowing_robot/core/robot_params.h"
 #include "sowing_robot/core/runner.h"
-#include "sowing_robot/core/sliding_mode.h"
 #include "sowing_robot/ros/param_reader.h"
 
 namespace sowing_robot {
@@ -20,29 +19,36 @@ namespace sowing_robot {
 /// Robot geometry and inertia from the URDF in `robot_description` (searched upwards from nh).
 std::string loadRobotParams(const ros::NodeHandle& nh, core::RobotParams& out);
 
-/// control_rate [Hz] -> control period [ns]; 0 on a bad rate (error set in the reader's message).
-std::int64_t loadControlPeriod(ParamReader& p, std::string& error);
+/// Reads every entry of `table` (its keys under `prefix`) into `out`: an absent key keeps the table's
+/// default; a wrong type or an out-of-range value becomes the reader's first error, naming the full key.
+template <typename S>
+void loadTable(ParamReader& p, const core::ParamTable<S>& table, S& out, const std::string& prefix = "") {
+  for (const auto& e : table.entries()) {
+    const std::string key = prefix + e.info.key;
+    const bool had_error = !p.error().empty();
+    const core::ParamValue v = p.get(key, e.info.default_value);
+    if (!had_error && !p.error().empty()) continue;  // a type error, recorded by the reader
+    const std::string bad = e.info.check(v, p.handle().getNamespace() + "/" + prefix);
+    if (!bad.empty()) {
+      p.fail(bad);
+      continue;
+    }
+    e.set(out, v);
+  }
+}
 
-/// disturbance/{sinusoidal, amplitude, frequency}, noise/{std, seed}, mismatch/{mass_scale, inertia_scale}.
-core::PlantDisturbance loadDisturbance(ParamReader& p);
+/// The run-wide settings (`run/...` relative to nh: mode, control_rate, duration, odom_frame,
+/// base_frame). A node that also has one of them among its private parameters (`own`) must agree with
+/// the run's value, else the reader's error names both; keys in `own_keys` are the node's own
+/// parameters of the same name (torque_controller's `mode`: atsmc | tsmc) and are not compared.
+core::RunSettings loadRunSettings(const ros::NodeHandle& nh, ParamReader& own,
+                                  const std::vector<std::string>& own_keys = {});
 
-/// kx, ky, ktheta.
-core::KanayamaGains loadKanayama(ParamReader& p);
-
-/// mode (atsmc|tsmc), p, q, beta_v, beta_omega, k1, k2, eta1, eta2, rate_m, rate_i, m0_min, m0_max,
-/// i0_min, i0_max, m0_initial, i0_initial, max_torque, switching (sign|sat|relay|atan|tanh), switch_width.
-core::SlidingModeParams loadSlidingMode(ParamReader& p, std::string& error);
-
-/// start/{x, y, theta}.
-core::Pose2D loadStartPose(ParamReader& p);
-
-/// potential/{alpha, beta, influence_distance, gain, tangential_ratio, nearest_side, avoid_side (left|right),
-/// side_band, core_fraction, step, heading_hold_speed}.
-core::PotentialFieldParams loadPotentialField(ParamReader& p, std::string& error);
-
-/// field/{rows, row_length, row_spacing, start_x, start_y, heading, rows_to_left, row_speed, turn_speed,
-/// min_turn_radius, max_accel, max_curvature_rate, start_from_rest} plus potential/ (loadPotentialField).
-core::FieldParams loadFieldParams(ParamReader& p, std::string& error);
+/// "<node>: key value unit, ..." of the values in force, logged once at start-up.
+template <typename S>
+void logSettings(const char* node, const core::ParamTable<S>& table, const S& s, const std::string& prefix = "") {
+  ROS_INFO("%s: %s", node, table.describe(s, prefix).c_str());
+}
 
 /// The list `key` of {x, y, radius} maps (radius optional, default core::Obstacle's); marks `key` as read.
 /// Returns "" or one line naming the bad entry (absent key: empty list).
@@ -52,8 +58,8 @@ std::string loadObstacles(ParamReader& p, const std::string& key, std::vector<co
 /// Refuses to start (exit 1) on the first problem.
 void requireValid(const ParamReader& p, const std::string& validate_message);
 
-/// The scenario the node pipeline runs, read from the nodes' own namespaces (/plant_sim,
-/// /kinematic_controller, /torque_controller): what the in-process runner needs to repeat a run.
+/// The scenario the node pipeline runs, read from the run settings and the nodes' own namespaces
+/// (/plant_sim, /kinematic_controller, /torque_controller): what the in-process runner needs to repeat a run.
 std::string loadPipelineScenario(core::Scenario& sc, double& duration);
 
 }  // namespace sowing_robot

@@ -7,6 +7,8 @@
 #include <set>
 #include <string>
 
+#include "sowing_robot/core/param_table.h"
+
 namespace sowing_robot {
 
 class ParamReader {
@@ -19,10 +21,16 @@ class ParamReader {
   bool get(const std::string& key, bool def);
   std::string get(const std::string& key, const std::string& def);
   std::string get(const std::string& key, const char* def) { return get(key, std::string(def)); }
+  /// The same, with the type taken from the default's (a parameter table's entry).
+  core::ParamValue get(const std::string& key, const core::ParamValue& def);
 
   /// Mark a key (or a whole sub-namespace ending in '/') as known without reading it.
   void allow(const std::string& key) { read_.insert(nh_.getNamespace() + "/" + key); }
 
+  /// Record a problem found by the caller (a range check); the first one is kept.
+  void fail(const std::string& message) {
+    if (error_.empty()) error_ = message;
+  }
   /// First type error, or "" when every read succeeded.
   const std::string& error() const { return error_; }
   /// "" when every parameter under the handle's namespace was read, else one line listing the others

@@ -21,6 +21,7 @@
 #include <memory>
 #include <vector>
 
+#include "sowing_robot/FieldPlan.h"
 #include "sowing_robot/ReferenceGeneratorConfig.h"
 #include "sowing_robot/ReferenceState.h"
 #include "sowing_robot/core/field.h"
@@ -43,6 +44,8 @@ class ReferenceGenerator {
   /// type field: every ADD CYLINDER marker is an obstacle (centre = pose.position, radius = scale.x / 2);
   /// the message replaces the whole list. A message with a non-finite or non-positive value is dropped.
   void obstaclesCallback(const visualization_msgs::MarkerArray::ConstPtr& msg);
+  /// The plan in force (rows, obstacles, influence) on `plan`, latched; type field: field_markers too.
+  void publishPlan();
   /// type field: obstacles, influence zones and row lines on field_markers.
   void publishMarkers();
   /// type field: live avoidance gains, validated like the start-up values (a rejected change keeps them).
@@ -52,7 +55,9 @@ class ReferenceGenerator {
   core::FieldReference* field_ = nullptr;  ///< source_ when type is field, else null
   std::vector<core::Obstacle> obstacles_;  ///< the obstacles in force (type field)
   ros::Subscriber clock_sub_, obstacles_sub_;
-  ros::Publisher ref_pub_, path_pub_, marker_pub_;
+  ros::Publisher ref_pub_, path_pub_, marker_pub_, plan_pub_;
+  std::string odom_frame_ = "odom";   ///< run/odom_frame
+  Eigen::Vector2d line_{0.0, 3.0};    ///< type line: (x0, y), where the open-ended row starts
   std::deque<ReferenceState> sent_;   ///< published, for times not yet passed (replayed to late subscribers)
   double lookahead_ = 0.05;           ///< [s] send references this far ahead of /clock
   std::int64_t window_ns_ = 50000000; ///< [ns] lookahead, or twice the largest /clock gap seen if longer

@@ -10,7 +10,9 @@
 
 #include <memory>
 
+#include "sowing_robot/FieldPlan.h"
 #include "sowing_robot/ReferenceState.h"
+#include "sowing_robot/core/node_settings.h"
 #include "sowing_robot/core/seeding.h"
 #include "sowing_robot/ros/stamp_pair.h"
 
@@ -24,14 +26,19 @@ class SeedDrillNode {
  private:
   void odomCallback(const nav_msgs::Odometry::ConstPtr& msg);
   void referenceCallback(const ReferenceState::ConstPtr& msg);
+  /// The reference generator's plan: the first one starts the drill, later ones replace its rows and
+  /// obstacles (run-time obstacle changes).
+  void planCallback(const FieldPlan::ConstPtr& msg);
   /// The state and the reference for the same time: move the tool, maybe drop a seed.
   void update(const nav_msgs::Odometry& odom, bool tool_down);
   void publishReport();
 
-  std::unique_ptr<core::SeedDrill> drill_;
+  ros::NodeHandle nh_;
+  core::SeedDrillSettings settings_;
+  std::unique_ptr<core::SeedDrill> drill_;  ///< null until the first plan
   double tool_x_ = 0.0, tool_y_ = 0.0;  // tool point in base_link [m]
   StampPair<nav_msgs::Odometry, ReferenceState> inputs_;  // the reference is sent ahead of the state
-  ros::Subscriber odom_sub_, ref_sub_;
+  ros::Subscriber plan_sub_, odom_sub_, ref_sub_;
   ros::Publisher seeds_pub_, report_pub_;
   visualization_msgs::Marker chunk_;  // the current SPHERE_LIST of up to kChunk seeds
   int chunk_id_ = 0;

@@ -1,0 +1,110 @@
+// What each node reads besides the core components it wraps: the run-wide settings (set once per run,
+// read by every node) and each node's own timing and I/O. Plain data with a parameter table each, so
+// the ROS loader, the error texts, the logs and docs/parameters.md follow from one declaration, and
+// the docs tool needs no ROS. Components (gains, disturbance, field, seeding) are nested tables.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "sowing_robot/core/field.h"
+#include "sowing_robot/core/kanayama.h"
+#include "sowing_robot/core/param_table.h"
+#include "sowing_robot/core/plant.h"
+#include "sowing_robot/core/seeding.h"
+#include "sowing_robot/core/sliding_mode.h"
+#include "sowing_robot/core/types.h"
+
+namespace sowing_robot {
+namespace core {
+
+/// Run-wide settings, under `run/` relative to each node's namespace (sim.launch sets them once).
+struct RunSettings {
+  RunSettings();
+  bool lockstep;          ///< mode: lockstep (headless) or realtime (paced to the wall clock)
+  double control_rate;    ///< plant step and control rate [Hz]
+  double duration;        ///< scenario length [s]; 0 = forever
+  std::string odom_frame, base_frame;  ///< REP-105 frame ids
+  std::string validate() const { return table().checkRanges(*this, "run/"); }
+  /// The control period on the ns grid every node stamps its messages on.
+  std::int64_t periodNs() const;
+  static const ParamTable<RunSettings>& table();
+};
+
+/// plant_sim: timing of the two drivers, start pose, and the disturbance (nested).
+struct PlantSimSettings {
+  PlantSimSettings();
+  double realtime_factor, torque_timeout, publish_rate, clock_rate;
+  double lockstep_retry, lockstep_timeout, lockstep_give_up, startup_delay, max_speed;
+  int min_subscribers;
+  bool exit_at_end;
+  double start_x, start_y, start_theta;
+  PlantDisturbance disturbance;
+  Pose2D start() const { return {start_x, start_y, start_theta}; }
+  std::string validate() const;
+  static const ParamTable<PlantSimSettings>& table();
+};
+
+/// kinematic_controller: the Kanayama gains (nested) and the reference timeout.
+struct KinematicControllerSettings {
+  KinematicControllerSettings();
+  double input_timeout;
+  KanayamaGains gains;
+  std::string validate() const { return table().checkRanges(*this); }
+  static const ParamTable<KinematicControllerSettings>& table();
+};
+
+/// torque_controller: the sliding-mode parameters (nested) and the desired-velocity timeout.
+struct TorqueControllerSettings {
+  TorqueControllerSettings();
+  double input_timeout;
+  SlidingModeParams sliding;
+  std::string validate() const;
+  static const ParamTable<TorqueControllerSettings>& table();
+};
+
+/// reference_generator: the reference type and its line; the field (FieldParams, fieldTable()) and the
+/// obstacles are read only with type field.
+struct ReferenceGeneratorSettings {
+  ReferenceGeneratorSettings();
+  bool field;  ///< type: field (rows + potential field) or line (the thesis line)
+  double line_x0, line_v_r, line_y;
+  double path_spacing, lookahead;
+  std::string validate() const { return table().checkRanges(*this); }
+  static const ParamTable<ReferenceGeneratorSettings>& table();
+};
+
+/// seed_drill: the seeding parameters (nested) and the URDF link of the seed-drop point.
+struct SeedDrillSettings {
+  SeedDrillSettings();
+  std::string tool_link;
+  SeedingParams seeding;
+  std::string validate() const { return table().checkRanges(*this); }
+  static const ParamTable<SeedDrillSettings>& table();
+};
+
+/// run_monitor: where the metrics go and whether the run ends with them.
+struct RunMonitorSettings {
+  RunMonitorSettings();
+  std::string label, output;
+  bool time_domain, exit_at_end;
+  std::string validate() const { return table().checkRanges(*this); }
+  static const ParamTable<RunMonitorSettings>& table();
+};
+
+/// pso_tuner (offline): the swarm, the cost and the simulated run of each evaluation. The base scenario
+/// comes from the run and node settings; the search box is the `gains` list (tuning.h).
+struct PsoTunerSettings {
+  PsoTunerSettings();
+  int particles, iterations, seed, threads;
+  double velocity_clamp, w_max, w_min, c1, c2;
+  bool adaptive;  ///< mode: the controller tuned
+  double duration, control_rate;
+  std::string cost, output;
+  double torque_weight, chattering_weight;
+  std::string validate() const;
+  static const ParamTable<PsoTunerSettings>& table();
+};
+
+}  // namespace core
+}  // namespace sowing_robot
