@@ -4,22 +4,29 @@
 
 #include "sowing_robot/core/validation.h"
 #include "sowing_robot/ros/component_params.h"
+#include "sowing_robot/ros/failure_log.h"
 #include "sowing_robot/ros/msg_checks.h"
 
 namespace sowing_robot {
 
-RunMonitor::RunMonitor(ros::NodeHandle nh, ros::NodeHandle pnh) {
+RunMonitor::RunMonitor(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh), pnh_(pnh) {
   ParamReader p(pnh);
   duration_ = p.get("duration", duration_);
   output_ = p.get("output", "");
   label_ = p.get("label", "run");
   exit_at_end_ = p.get("exit_at_end", exit_at_end_);
+  recorder_topic_ = p.get("recorder", "");
+  recorder_timeout_ = p.get("recorder_timeout", recorder_timeout_);
   // The time-domain figures (rise, settling, overshoot) need every sample: 32 B per period, ~115 MB per
   // hour at 1 kHz. Long runs (soak) switch them off and keep only the integrals (constant memory).
   const bool time_domain = p.get("time_domain", true);
-  requireValid(p, core::checkPositive("duration", duration_, "s"));
+  requireValid(p, core::firstError({core::checkPositive("duration", duration_, "s"),
+                                    core::checkPositive("recorder_timeout", recorder_timeout_, "s")}));
   metrics_ = core::MetricsAccumulator(time_domain);
   metrics_.reserve(static_cast<std::size_t>(duration_ * 1000.0) + 2);
+  // Subscribed from the start: the recorder's latched stamp is then already here when the run ends.
+  if (!recorder_topic_.empty())
+    recorder_sub_ = nh.subscribe(recorder_topic_, 10, &RunMonitor::recordedCallback, this);
   sub_ = nh.subscribe("tracking_error", kLockstepQueue, &RunMonitor::errorCallback, this, ros::TransportHints().tcpNoDelay());
 }
 
@@ -37,12 +44,51 @@ void RunMonitor::errorCallback(const TrackingError::ConstPtr& msg) {
 void RunMonitor::finish() {
   done_ = true;
   const auto m = metrics_.result();
-  const std::string table = core::metricsTable({label_}, {m});
-  ROS_INFO("run_monitor: %zu samples up to t = %.3f s\n%s", metrics_.samples(), last_.toSec(), table.c_str());
-  std::printf("%s", table.c_str());
+  // The table goes to stdout once, as plain text (it used to be logged with ROS_INFO as well, so every
+  // run printed it twice).
+  ROS_INFO("run_monitor: %zu samples up to t = %.3f s", metrics_.samples(), last_.toSec());
+  std::printf("%s", core::metricsTable({label_}, {m}).c_str());
   std::fflush(stdout);
   if (!output_.empty() && !core::writeMetricsYaml(output_, label_, m))
     ROS_ERROR("run_monitor: could not write %s", output_.c_str());
+  if (!exit_at_end_) return;
+  if (recorder_topic_.empty() || recorded_until_ >= last_) {
+    endRun();
+    return;
+  }
+  // The recorder may be seconds of simulated time behind the loop (its queues hold them); the launch
+  // must not end before it has them, or they die with their publishers.
+  ROS_INFO("run_monitor: waiting (up to %.0f s) for the recorder to write up to t = %.3f s (it has %.3f s)",
+           recorder_timeout_, last_.toSec(), recorded_until_.toSec());
+  waiting_for_recorder_ = true;
+  wait_start_ = ros::WallTime::now();
+  recorder_timer_ = nh_.createWallTimer(ros::WallDuration(recorder_timeout_), &RunMonitor::recorderTimedOut, this,
+                                        /*oneshot=*/true);
+}
+
+void RunMonitor::recordedCallback(const std_msgs::Time::ConstPtr& msg) {
+  recorded_until_ = msg->data;
+  if (!waiting_for_recorder_ || recorded_until_ < last_) return;
+  waiting_for_recorder_ = false;
+  recorder_timer_.stop();
+  ROS_INFO("run_monitor: the recorder has the whole run (waited %.2f s)", (ros::WallTime::now() - wait_start_).toSec());
+  endRun();
+}
+
+void RunMonitor::recorderTimedOut(const ros::WallTimerEvent&) {
+  if (!waiting_for_recorder_) return;
+  waiting_for_recorder_ = false;
+  char text[256];
+  std::snprintf(text, sizeof text,
+                "the recorder (%s) wrote the run only up to t = %.3f s of %.3f s within %.1f s wall "
+                "(recorder_timeout): the bag lacks the end of the run",
+                recorder_sub_.getTopic().c_str(), recorded_until_.toSec(), last_.toSec(), recorder_timeout_);
+  failure_.emplace(ExitCode::kGaveUp, text);
+  logFailure(pnh_.getNamespace(), *failure_);  // the run's last word; the main exits with its code
+  endRun();
+}
+
+void RunMonitor::endRun() {
   if (exit_at_end_) ros::requestShutdown();  // safe from any thread (as a nodelet: the shared callback thread)
 }
 
