@@ -1,5 +1,6 @@
 #include "sowing_robot/ros/run_monitor.h"
 
+#include <chrono>
 #include <cstdio>
 
 #include "sowing_robot/core/validation.h"
@@ -9,7 +10,7 @@
 
 namespace sowing_robot {
 
-RunMonitor::RunMonitor(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh), pnh_(pnh) {
+RunMonitor::RunMonitor(ros::NodeHandle nh, ros::NodeHandle pnh) : pnh_(pnh) {
   ParamReader p(pnh);
   duration_ = p.get("duration", duration_);
   output_ = p.get("output", "");
@@ -52,40 +53,62 @@ void RunMonitor::finish() {
   if (!output_.empty() && !core::writeMetricsYaml(output_, label_, m))
     ROS_ERROR("run_monitor: could not write %s", output_.c_str());
   if (!exit_at_end_) return;
-  if (recorder_topic_.empty() || recorded_until_ >= last_) {
+  if (recorder_topic_.empty()) {
     endRun();
     return;
   }
   // The recorder may be seconds of simulated time behind the loop (its queues hold them); the launch
   // must not end before it has them, or they die with their publishers.
+  std::lock_guard<std::mutex> lock(wait_mutex_);
+  if (recorded_until_ >= last_) {
+    endRun();
+    return;
+  }
   ROS_INFO("run_monitor: waiting (up to %.0f s) for the recorder to write up to t = %.3f s (it has %.3f s)",
            recorder_timeout_, last_.toSec(), recorded_until_.toSec());
-  waiting_for_recorder_ = true;
-  wait_start_ = ros::WallTime::now();
-  recorder_timer_ = nh_.createWallTimer(ros::WallDuration(recorder_timeout_), &RunMonitor::recorderTimedOut, this,
-                                        /*oneshot=*/true);
+  waiting_ = true;
+  waiter_ = std::thread([this] { waitForRecorder(); });
 }
 
 void RunMonitor::recordedCallback(const std_msgs::Time::ConstPtr& msg) {
+  std::lock_guard<std::mutex> lock(wait_mutex_);
   recorded_until_ = msg->data;
-  if (!waiting_for_recorder_ || recorded_until_ < last_) return;
-  waiting_for_recorder_ = false;
-  recorder_timer_.stop();
-  ROS_INFO("run_monitor: the recorder has the whole run (waited %.2f s)", (ros::WallTime::now() - wait_start_).toSec());
+  if (waiting_ && recorded_until_ >= last_) recorded_.notify_all();
+}
+
+void RunMonitor::waitForRecorder() {
+  const ros::WallTime start = ros::WallTime::now();
+  std::unique_lock<std::mutex> lock(wait_mutex_);
+  const bool caught_up = recorded_.wait_for(lock, std::chrono::duration<double>(recorder_timeout_),
+                                            [this] { return stop_ || recorded_until_ >= last_; });
+  waiting_ = false;
+  if (stop_) return;
+  if (caught_up) {
+    ROS_INFO("run_monitor: the recorder has the whole run (waited %.2f s)", (ros::WallTime::now() - start).toSec());
+  } else {
+    char text[256];
+    std::snprintf(text, sizeof text,
+                  "the recorder (%s) wrote the run only up to t = %.3f s of %.3f s within %.1f s wall "
+                  "(recorder_timeout): the bag lacks the end of the run",
+                  recorder_topic_.c_str(), recorded_until_.toSec(), last_.toSec(), recorder_timeout_);
+    failure_.emplace(ExitCode::kGaveUp, text);
+    logFailure(pnh_.getNamespace(), *failure_);  // the run's last word; the main exits with its code
+  }
   endRun();
 }
 
-void RunMonitor::recorderTimedOut(const ros::WallTimerEvent&) {
-  if (!waiting_for_recorder_) return;
-  waiting_for_recorder_ = false;
-  char text[256];
-  std::snprintf(text, sizeof text,
-                "the recorder (%s) wrote the run only up to t = %.3f s of %.3f s within %.1f s wall "
-                "(recorder_timeout): the bag lacks the end of the run",
-                recorder_sub_.getTopic().c_str(), recorded_until_.toSec(), last_.toSec(), recorder_timeout_);
-  failure_.emplace(ExitCode::kGaveUp, text);
-  logFailure(pnh_.getNamespace(), *failure_);  // the run's last word; the main exits with its code
-  endRun();
+int RunMonitor::exitCode() const {
+  std::lock_guard<std::mutex> lock(wait_mutex_);
+  return failure_ ? failure_->exitCode() : 0;
+}
+
+RunMonitor::~RunMonitor() {
+  {
+    std::lock_guard<std::mutex> lock(wait_mutex_);
+    stop_ = true;
+  }
+  recorded_.notify_all();
+  if (waiter_.joinable()) waiter_.join();
 }
 
 void RunMonitor::endRun() {

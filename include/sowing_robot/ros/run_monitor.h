@@ -7,8 +7,11 @@
 #include <ros/ros.h>
 #include <std_msgs/Time.h>
 
+#include <condition_variable>
+#include <mutex>
 #include <optional>
 #include <string>
+#include <thread>
 
 #include "sowing_robot/TrackingError.h"
 #include "sowing_robot/core/metrics.h"
@@ -19,28 +22,36 @@ namespace sowing_robot {
 class RunMonitor {
  public:
   RunMonitor(ros::NodeHandle nh, ros::NodeHandle pnh);
+  ~RunMonitor();
 
   /// The exit code the run ended with: 0, or kGaveUp when the recorder never confirmed the end.
-  int exitCode() const { return failure_ ? failure_->exitCode() : 0; }
+  int exitCode() const;
 
  private:
   void errorCallback(const TrackingError::ConstPtr& msg);
   void recordedCallback(const std_msgs::Time::ConstPtr& msg);
-  void recorderTimedOut(const ros::WallTimerEvent&);
+  void waitForRecorder();
   void finish();
   void endRun();
 
   double duration_ = 25.0;
   double recorder_timeout_ = 60.0;  // [s wall] for the recorder to catch up after the last period
   std::string output_, label_, recorder_topic_;
-  bool exit_at_end_ = false, done_ = false, waiting_for_recorder_ = false;
+  bool exit_at_end_ = false, done_ = false;
   core::MetricsAccumulator metrics_;
-  ros::Time last_, recorded_until_;
-  ros::WallTime wait_start_;
-  std::optional<NodeFailure> failure_;
-  ros::NodeHandle nh_, pnh_;
+  ros::Time last_;
+  ros::NodeHandle pnh_;
   ros::Subscriber sub_, recorder_sub_;
-  ros::WallTimer recorder_timer_;
+
+  // The wait for the recorder: a thread of its own with a bounded wait, not a ros::WallTimer: roscpp's
+  // timer thread queues a callback while holding its timer lock, and InlineCallbackQueue runs it right
+  // there, where re-scheduling the timer takes that lock again (a deadlock, seen).
+  mutable std::mutex wait_mutex_;
+  std::condition_variable recorded_;
+  ros::Time recorded_until_;           // under wait_mutex_
+  bool waiting_ = false, stop_ = false;  // under wait_mutex_
+  std::optional<NodeFailure> failure_;   // under wait_mutex_
+  std::thread waiter_;
 };
 
 }  // namespace sowing_robot
