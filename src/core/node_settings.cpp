@@ -140,6 +140,10 @@ const ParamTable<RunMonitorSettings>& RunMonitorSettings::table() {
            "rise, settling and overshoot too (keeps every sample: ~115 MB per hour at 1 kHz); false: integrals "
            "only, constant memory"),
       flag("exit_at_end", &S::exit_at_end, false, "end the launch when the metrics are printed (headless)"),
+      text("recorder", &S::recorder, "",
+           "the recorder's recorded_until topic: the end waits until it has the last period (\"\" = no recorder)"),
+      number("recorder_timeout", &S::recorder_timeout, 60.0, Limits::positive(), "s",
+             "longest wait for the recorder at the end (wall time); then FATAL and exit 3"),
   });
   return table;
 }

@@ -18,6 +18,7 @@
 #include <mutex>
 #include <thread>
 
+#include "sowing_robot/ros/failure_log.h"
 #include "sowing_robot/ros/kinematic_controller.h"
 #include "sowing_robot/ros/plant_sim.h"
 #include "sowing_robot/ros/reference_generator.h"
@@ -51,6 +52,15 @@ class SharedCallbackThread {
 };
 
 /// Callback-driven nodes: the wrapper lives as long as the nodelet.
+///
+/// A wrapper that cannot start (NodeFailure: a bad parameter) is logged as this nodelet's one FATAL line
+/// and rethrown. nodelet::Loader::load (nodelet 1.10, Debian 12) catches any exception from init(),
+/// erases the nodelet and returns false: the load_nodelet service fails, `nodelet load` exits non-zero,
+/// and the manager with its other nodelets runs on (upstream's test_nodelet/FailingNodelet relies on
+/// the same). Swallowing the error instead would leave an inert nodelet that claims to be loaded.
+/// Nothing is created on the Nodelet's own callback queues before the throw, so 1.10's order of
+/// destruction after a failed init (the queues before the nodelet; fixed upstream in 1.11) finds no
+/// subscription of ours to tear down on a freed queue.
 template <typename Wrapper>
 class WrapperNodelet : public nodelet::Nodelet {
  private:
@@ -59,7 +69,12 @@ class WrapperNodelet : public nodelet::Nodelet {
     ros::NodeHandle nh = getNodeHandle(), pnh = getPrivateNodeHandle();
     nh.setCallbackQueue(thread_->queue());
     pnh.setCallbackQueue(thread_->queue());
-    impl_ = std::make_unique<Wrapper>(nh, pnh);
+    try {
+      impl_ = std::make_unique<Wrapper>(nh, pnh);
+    } catch (const NodeFailure& failure) {
+      logFailure(getName(), failure);  // the nodelet's name: the manager's would say nothing
+      throw;
+    }
   }
   // impl_ (its subscriptions) goes before the queue it uses.
   std::shared_ptr<SharedCallbackThread> thread_;

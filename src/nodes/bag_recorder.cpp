@@ -4,63 +4,184 @@
 // on a loaded machine it drops whole blocks (measured: up to 241 of 25,001 tracking errors). This
 // recorder subscribes with a large queue, and on SIGINT (roslaunch's shutdown, Ctrl-C) it first drains
 // every message already received, then closes the bag: complete, indexed, nothing recorded is lost.
+//
+// What it has not received yet it cannot drain: a recorder seconds of simulated time behind the loop
+// (a loaded machine) would lose them with their publishers when the launch ends. So it says how far it
+// has got: ~recorded_until (std_msgs/Time, latched) is the oldest of the newest header stamps written on
+// the ~period_topics (those published once per control period), and the node that ends a headless run
+// (run_monitor, `~recorder`) waits for it to reach the run's last period.
 //   rosrun sowing_robot bag_recorder _output:=run.bag _topics:="/odom /reference ..." [_queue:=200000]
+//     [_period_topics:="/odom ..."] [_receive_delay:=0 (s per message, tests: a recorder starved of CPU)]
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
+#include <ros/serialization.h>
 #include <rosbag/bag.h>
+#include <std_msgs/Time.h>
 #include <topic_tools/shape_shifter.h>
 
+#include <algorithm>
+#include <cmath>
 #include <csignal>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "sowing_robot/ros/failure_log.h"
+#include "sowing_robot/ros/param_reader.h"
+
 namespace {
 volatile std::sig_atomic_t g_stop = 0;
 void onSignal(int) { g_stop = 1; }
-}  // namespace
 
-int main(int argc, char** argv) {
-  ros::init(argc, argv, "bag_recorder", ros::init_options::NoSigintHandler);
-  std::signal(SIGINT, onSignal);
-  std::signal(SIGTERM, onSignal);
-  ros::NodeHandle nh, pnh("~");
-  std::string output, topic_list;
-  int queue = 200000;
-  pnh.getParam("output", output);
-  pnh.getParam("topics", topic_list);
-  pnh.getParam("queue", queue);
-  std::vector<std::string> topics;
-  std::istringstream ss(topic_list);
-  for (std::string t; ss >> t;) topics.push_back(t);
-  if (output.empty() || topics.empty() || queue < 1) {
-    ROS_FATAL("bag_recorder: refusing to start: ~output (a path) and ~topics (space-separated) are required, "
-              "~queue >= 1 (got output '%s', %zu topics, queue %d)", output.c_str(), topics.size(), queue);
-    return 1;
+std::vector<std::string> words(const std::string& text) {
+  std::vector<std::string> out;
+  std::istringstream ss(text);
+  for (std::string t; ss >> t;) out.push_back(t);
+  return out;
+}
+
+/// Hands each received message to `target` after `delay`, on roscpp's network thread: with a delay
+/// the recorder reads its connections slowly and the backlog stays with the publishers, as on a machine
+/// that starves the recorder of CPU (the run whose last 2 s died with their publishers). Tests only.
+class DelayingQueue : public ros::CallbackQueueInterface {
+ public:
+  DelayingQueue(ros::CallbackQueueInterface* target, double delay) : target_(target), delay_(delay) {}
+  void addCallback(const ros::CallbackInterfacePtr& callback, uint64_t owner_id) override {
+    delay_.sleep();
+    target_->addCallback(callback, owner_id);
   }
+  void removeByID(uint64_t owner_id) override { target_->removeByID(owner_id); }
+
+ private:
+  ros::CallbackQueueInterface* target_;
+  ros::WallDuration delay_;
+};
+
+/// The oldest of the newest header stamps written on the period topics: everything up to it is in the
+/// bag on every one of them (each topic's messages come in stamp order over one connection).
+class RecordedUntil {
+ public:
+  RecordedUntil(ros::NodeHandle& pnh, std::size_t topics)
+      : newest_(topics), checked_(topics, false), pub_(pnh.advertise<std_msgs::Time>("recorded_until", 1, true)) {}
+
+  /// A message of period topic `i` was written. Its header stamp is at bytes 4..11 of the serialised
+  /// message (std_msgs/Header: uint32 seq, then the stamp).
+  void written(std::size_t i, const std::string& topic, const topic_tools::ShapeShifter& msg) {
+    if (!checked_[i]) {
+      checked_[i] = true;
+      if (!startsWithHeader(msg.getMessageDefinition())) {
+        ROS_ERROR("bag_recorder: period topic %s (%s) has no header first; not counted in recorded_until",
+                  topic.c_str(), msg.getDataType().c_str());
+        ignored_.push_back(i);
+      }
+    }
+    if (std::find(ignored_.begin(), ignored_.end(), i) != ignored_.end() || msg.size() < 12) return;
+    buffer_.resize(msg.size());
+    ros::serialization::OStream stream(buffer_.data(), static_cast<std::uint32_t>(buffer_.size()));
+    msg.write(stream);
+    std::uint32_t sec, nsec;
+    std::memcpy(&sec, buffer_.data() + 4, 4);
+    std::memcpy(&nsec, buffer_.data() + 8, 4);
+    newest_[i] = std::max(newest_[i], ros::Time(sec, nsec));
+    ros::Time oldest = ros::TIME_MAX;
+    for (std::size_t k = 0; k < newest_.size(); ++k)
+      if (std::find(ignored_.begin(), ignored_.end(), k) == ignored_.end()) oldest = std::min(oldest, newest_[k]);
+    if (oldest != ros::TIME_MAX && oldest > published_.data) {
+      published_.data = oldest;
+      pub_.publish(published_);
+    }
+  }
+
+ private:
+  static bool startsWithHeader(const std::string& definition) {
+    std::istringstream ss(definition);
+    for (std::string line; std::getline(ss, line);) {
+      const std::size_t first = line.find_first_not_of(" \t");
+      if (first == std::string::npos || line[first] == '#') continue;
+      return line.compare(first, 13, "Header header") == 0;
+    }
+    return false;
+  }
+
+  std::vector<ros::Time> newest_;  // zero until the topic's first message
+  std::vector<bool> checked_;
+  std::vector<std::size_t> ignored_;
+  std::vector<std::uint8_t> buffer_;
+  std_msgs::Time published_;
+  ros::Publisher pub_;
+};
+
+struct Options {
+  std::string output;
+  std::vector<std::string> topics, period_topics;
+  int queue = 200000;
+  double receive_delay = 0.0;
+};
+
+/// Reads and checks the private parameters; throws badParameter (node_failure.h) on the first problem.
+Options readOptions(const ros::NodeHandle& pnh) {
+  sowing_robot::ParamReader p(pnh);
+  Options o;
+  o.output = p.get("output", "");
+  o.topics = words(p.get("topics", ""));
+  o.period_topics = words(p.get("period_topics", ""));
+  o.queue = p.get("queue", o.queue);
+  o.receive_delay = p.get("receive_delay", o.receive_delay);
+  if (!p.error().empty()) sowing_robot::refuseToStart(p.error());
+  const std::string unknown = p.unknownKeys();
+  if (!unknown.empty()) sowing_robot::refuseToStart(unknown);
+  if (o.output.empty() || o.topics.empty() || o.queue < 1) {
+    sowing_robot::refuseToStart("~output (a path) and ~topics (space-separated) are required, ~queue >= 1 (got output '" +
+                                o.output + "', " + std::to_string(o.topics.size()) + " topics, queue " +
+                                std::to_string(o.queue) + ")");
+  }
+  if (!(o.receive_delay >= 0.0 && o.receive_delay < 1.0))
+    sowing_robot::refuseToStart("~receive_delay = " + std::to_string(o.receive_delay) + " must be in [0, 1) s");
+  for (const std::string& t : o.period_topics)
+    if (std::find(o.topics.begin(), o.topics.end(), t) == o.topics.end())
+      sowing_robot::refuseToStart("~period_topics: " + t + " is not among ~topics");
+  return o;
+}
+
+int record(ros::NodeHandle& nh, ros::NodeHandle& pnh, const Options& o) {
   rosbag::Bag bag;
-  const std::string active = output + ".active";
+  const std::string active = o.output + ".active";
   try {
     bag.open(active, rosbag::bagmode::Write);
   } catch (const rosbag::BagException& e) {
-    ROS_FATAL("bag_recorder: cannot open %s: %s", active.c_str(), e.what());
-    return 1;
+    throw sowing_robot::badParameter("cannot open " + active + ": " + e.what());
   }
+  RecordedUntil recorded(pnh, o.period_topics.size());
+  ros::CallbackQueue* q = ros::getGlobalCallbackQueue();
+  DelayingQueue delaying(q, o.receive_delay);
   std::size_t written = 0;
   std::vector<ros::Subscriber> subs;
-  for (const std::string& topic : topics) {
+  for (const std::string& topic : o.topics) {
+    const auto period = std::find(o.period_topics.begin(), o.period_topics.end(), topic);
+    const std::size_t index = static_cast<std::size_t>(period - o.period_topics.begin());
+    const bool is_period = period != o.period_topics.end();
     boost::function<void(const ros::MessageEvent<topic_tools::ShapeShifter const>&)> cb =
-        [&bag, &written, topic](const ros::MessageEvent<topic_tools::ShapeShifter const>& event) {
+        [&bag, &written, &recorded, topic, index,
+         is_period](const ros::MessageEvent<topic_tools::ShapeShifter const>& event) {
           ros::Time t = ros::Time::now();
           if (t < ros::TIME_MIN) t = ros::TIME_MIN;  // before the first /clock
           bag.write(topic, t, event.getMessage(), event.getConnectionHeaderPtr());
           ++written;
+          if (is_period) recorded.written(index, topic, *event.getMessage());
         };
-    subs.push_back(nh.subscribe<topic_tools::ShapeShifter>(topic, static_cast<std::uint32_t>(queue), cb,
-                                                           ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay()));
+    ros::SubscribeOptions so;
+    so.initByFullCallbackType<const ros::MessageEvent<topic_tools::ShapeShifter const>&>(
+        topic, static_cast<std::uint32_t>(o.queue), cb);
+    so.transport_hints = ros::TransportHints().tcpNoDelay();
+    if (o.receive_delay > 0.0) so.callback_queue = &delaying;
+    subs.push_back(nh.subscribe(so));
   }
-  ROS_INFO("bag_recorder: recording %zu topics to %s", topics.size(), output.c_str());
-  ros::CallbackQueue* q = ros::getGlobalCallbackQueue();
+  ROS_INFO("bag_recorder: recording %zu topics to %s%s", o.topics.size(), o.output.c_str(),
+           o.receive_delay > 0.0 ? (" (receive_delay " + std::to_string(o.receive_delay) + " s per message)").c_str()
+                                 : "");
   while (!g_stop && ros::ok()) q->callAvailable(ros::WallDuration(0.1));
   // Drain: keep writing until nothing has arrived for a second, then close.
   subs.clear();
@@ -70,12 +191,29 @@ int main(int argc, char** argv) {
     if (written != before) quiet = ros::WallTime::now();
   }
   bag.close();
-  if (std::rename(active.c_str(), output.c_str()) != 0) {
-    ROS_ERROR("bag_recorder: could not rename %s to %s", active.c_str(), output.c_str());
+  if (std::rename(active.c_str(), o.output.c_str()) != 0) {
+    ROS_ERROR("bag_recorder: could not rename %s to %s", active.c_str(), o.output.c_str());
     return 1;
   }
-  std::printf("bag_recorder: %zu messages written to %s\n", written, output.c_str());
+  std::printf("bag_recorder: %zu messages written to %s\n", written, o.output.c_str());
   std::fflush(stdout);
-  ros::shutdown();
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  ros::init(argc, argv, "bag_recorder", ros::init_options::NoSigintHandler);
+  std::signal(SIGINT, onSignal);
+  std::signal(SIGTERM, onSignal);
+  ros::NodeHandle nh, pnh("~");
+  int code = 0;
+  try {
+    code = record(nh, pnh, readOptions(pnh));
+  } catch (const sowing_robot::NodeFailure& failure) {
+    sowing_robot::logFailure(ros::this_node::getName(), failure);
+    sowing_robot::exitProcess(failure.exitCode());
+  }
+  ros::shutdown();
+  return code;
 }

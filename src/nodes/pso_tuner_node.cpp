@@ -1,13 +1,22 @@
 // Standalone pso_tuner node: the wrapper class does the work, then the process exits (offline tool).
+// A bad parameter (NodeFailure) becomes one FATAL line and exit 1.
 #include <ros/ros.h>
 
+#include "sowing_robot/ros/failure_log.h"
+#include "sowing_robot/ros/param_reader.h"
 #include "sowing_robot/ros/pso_tuner.h"
 
 int main(int argc, char** argv) {
   ros::init(argc, argv, "pso_tuner");
   ros::NodeHandle nh, pnh("~");
-  sowing_robot::PsoTuner tuner(nh, pnh);
-  const int code = tuner.run();
+  int code = 0;
+  try {
+    sowing_robot::PsoTuner tuner(nh, pnh);
+    code = tuner.run();
+  } catch (const sowing_robot::NodeFailure& failure) {
+    sowing_robot::logFailure(ros::this_node::getName(), failure);
+    sowing_robot::exitProcess(failure.exitCode());
+  }
   ros::shutdown();
   return code;
 }

@@ -1,5 +1,7 @@
 #include "sowing_robot/ros/param_reader.h"
 
+#include "sowing_robot/ros/node_failure.h"
+
 #include <ros/console.h>
 #include <ros/param.h>
 #include <ros/this_node.h>
@@ -60,10 +62,7 @@ std::string ParamReader::unknownKeys() const {
   return unknown.empty() ? "" : "unknown parameter(s): " + unknown;
 }
 
-void refuseToStart(const std::string& message) {
-  ROS_FATAL("%s: refusing to start: %s", ros::this_node::getName().c_str(), message.c_str());
-  exitProcess(1);
-}
+void refuseToStart(const std::string& message) { throw badParameter(message); }
 
 void exitProcess(int code) {
   ros::shutdown();

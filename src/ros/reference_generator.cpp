@@ -7,6 +7,7 @@
 
 #include "sowing_robot/core/validation.h"
 #include "sowing_robot/ros/component_params.h"
+#include "sowing_robot/ros/node_failure.h"
 #include "sowing_robot/ros/msg_checks.h"
 #include "sowing_robot/ros/reconfigure_bridge.h"
 #include "sowing_robot/core/seeding.h"
@@ -47,7 +48,7 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
     try {
       f = std::make_unique<core::FieldReference>(field, obstacles);
     } catch (const std::invalid_argument& e) {
-      refuseToStart(e.what());
+      throw badParameter(e.what());
     }
     field_ = f.get();
     obstacles_ = obstacles;

@@ -1,14 +1,16 @@
 #include "sowing_robot/ros/run_monitor.h"
 
+#include <chrono>
 #include <cstdio>
 
 #include "sowing_robot/core/validation.h"
 #include "sowing_robot/ros/component_params.h"
+#include "sowing_robot/ros/failure_log.h"
 #include "sowing_robot/ros/msg_checks.h"
 
 namespace sowing_robot {
 
-RunMonitor::RunMonitor(ros::NodeHandle nh, ros::NodeHandle pnh) {
+RunMonitor::RunMonitor(ros::NodeHandle nh, ros::NodeHandle pnh) : pnh_(pnh) {
   ParamReader p(pnh);
   const core::RunSettings run = loadRunSettings(nh, p);
   core::RunMonitorSettings settings;
@@ -18,10 +20,15 @@ RunMonitor::RunMonitor(ros::NodeHandle nh, ros::NodeHandle pnh) {
   output_ = settings.output;
   label_ = settings.label;
   exit_at_end_ = settings.exit_at_end;
+  recorder_topic_ = settings.recorder;
+  recorder_timeout_ = settings.recorder_timeout;
   // The time-domain figures (rise, settling, overshoot) need every sample: 32 B per period, ~115 MB per
   // hour at 1 kHz. Long runs (soak) switch them off and keep only the integrals (constant memory).
   metrics_ = core::MetricsAccumulator(settings.time_domain);
   metrics_.reserve(static_cast<std::size_t>(duration_ * 1000.0) + 2);
+  // Subscribed from the start: the recorder's latched stamp is then already here when the run ends.
+  if (!recorder_topic_.empty())
+    recorder_sub_ = nh.subscribe(recorder_topic_, 10, &RunMonitor::recordedCallback, this);
   sub_ = nh.subscribe("tracking_error", kLockstepQueue, &RunMonitor::errorCallback, this, ros::TransportHints().tcpNoDelay());
 }
 
@@ -39,12 +46,73 @@ void RunMonitor::errorCallback(const TrackingError::ConstPtr& msg) {
 void RunMonitor::finish() {
   done_ = true;
   const auto m = metrics_.result();
-  const std::string table = core::metricsTable({label_}, {m});
-  ROS_INFO("run_monitor: %zu samples up to t = %.3f s\n%s", metrics_.samples(), last_.toSec(), table.c_str());
-  std::printf("%s", table.c_str());
+  // The table goes to stdout once, as plain text (it used to be logged with ROS_INFO as well, so every
+  // run printed it twice).
+  ROS_INFO("run_monitor: %zu samples up to t = %.3f s", metrics_.samples(), last_.toSec());
+  std::printf("%s", core::metricsTable({label_}, {m}).c_str());
   std::fflush(stdout);
   if (!output_.empty() && !core::writeMetricsYaml(output_, label_, m))
     ROS_ERROR("run_monitor: could not write %s", output_.c_str());
+  if (!exit_at_end_) return;
+  if (recorder_topic_.empty()) {
+    endRun();
+    return;
+  }
+  // The recorder may be seconds of simulated time behind the loop (its queues hold them); the launch
+  // must not end before it has them, or they die with their publishers.
+  std::lock_guard<std::mutex> lock(wait_mutex_);
+  if (recorded_until_ >= last_) {
+    endRun();
+    return;
+  }
+  ROS_INFO("run_monitor: waiting (up to %.0f s) for the recorder to write up to t = %.3f s (it has %.3f s)",
+           recorder_timeout_, last_.toSec(), recorded_until_.toSec());
+  waiting_ = true;
+  waiter_ = std::thread([this] { waitForRecorder(); });
+}
+
+void RunMonitor::recordedCallback(const std_msgs::Time::ConstPtr& msg) {
+  std::lock_guard<std::mutex> lock(wait_mutex_);
+  recorded_until_ = msg->data;
+  if (waiting_ && recorded_until_ >= last_) recorded_.notify_all();
+}
+
+void RunMonitor::waitForRecorder() {
+  const ros::WallTime start = ros::WallTime::now();
+  std::unique_lock<std::mutex> lock(wait_mutex_);
+  const bool caught_up = recorded_.wait_for(lock, std::chrono::duration<double>(recorder_timeout_),
+                                            [this] { return stop_ || recorded_until_ >= last_; });
+  waiting_ = false;
+  if (stop_) return;
+  if (caught_up) {
+    ROS_INFO("run_monitor: the recorder has the whole run (waited %.2f s)", (ros::WallTime::now() - start).toSec());
+  } else {
+    char text[256];
+    std::snprintf(text, sizeof text,
+                  "the recorder (%s) wrote the run only up to t = %.3f s of %.3f s within %.1f s wall "
+                  "(recorder_timeout): the bag lacks the end of the run",
+                  recorder_topic_.c_str(), recorded_until_.toSec(), last_.toSec(), recorder_timeout_);
+    failure_.emplace(ExitCode::kGaveUp, text);
+    logFailure(pnh_.getNamespace(), *failure_);  // the run's last word; the main exits with its code
+  }
+  endRun();
+}
+
+int RunMonitor::exitCode() const {
+  std::lock_guard<std::mutex> lock(wait_mutex_);
+  return failure_ ? failure_->exitCode() : 0;
+}
+
+RunMonitor::~RunMonitor() {
+  {
+    std::lock_guard<std::mutex> lock(wait_mutex_);
+    stop_ = true;
+  }
+  recorded_.notify_all();
+  if (waiter_.joinable()) waiter_.join();
+}
+
+void RunMonitor::endRun() {
   if (exit_at_end_) ros::requestShutdown();  // safe from any thread (as a nodelet: the shared callback thread)
 }
 

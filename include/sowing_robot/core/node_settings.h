@@ -86,8 +86,9 @@ struct SeedDrillSettings {
 /// run_monitor: where the metrics go and whether the run ends with them.
 struct RunMonitorSettings {
   RunMonitorSettings();
-  std::string label, output;
+  std::string label, output, recorder;
   bool time_domain, exit_at_end;
+  double recorder_timeout;
   std::string validate() const { return table().checkRanges(*this); }
   static const ParamTable<RunMonitorSettings>& table();
 };

@@ -55,7 +55,7 @@ void logSettings(const char* node, const core::ParamTable<S>& table, const S& s,
 std::string loadObstacles(ParamReader& p, const std::string& key, std::vector<core::Obstacle>& out);
 
 /// Everything one node needs checked: reader errors, unknown keys, then the given validate() text.
-/// Refuses to start (exit 1) on the first problem.
+/// Refuses to start on the first problem: throws badParameter (node_failure.h).
 void requireValid(const ParamReader& p, const std::string& validate_message);
 
 /// The scenario the node pipeline runs, read from the run settings and the nodes' own namespaces

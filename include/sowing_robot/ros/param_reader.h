@@ -47,12 +47,15 @@ class ParamReader {
   std::string error_;
 };
 
-/// Log `message` as FATAL with the node name and exit(1): the refusal to start that STYLE.md asks for.
+/// The refusal to start that STYLE.md asks for: throws badParameter(message) (node_failure.h). The node's
+/// main (or nodelet's onInit) logs it as "<node>: refusing to start: <message>" (logFailure) and exits 1
+/// (a nodelet is not loaded); library code never ends the process.
 [[noreturn]] void refuseToStart(const std::string& message);
 
-/// Ends the process with `code` once a FATAL line has been logged: ros::shutdown(), flush stdout and
-/// stderr, then std::_Exit. Not std::exit: its static destructors raced roscpp's threads, which were
-/// still running, and now and then turned the exit code into an abort (seen in CI).
+/// For a node's main only: ends the process with `code` once its FATAL line has been logged:
+/// ros::shutdown(), flush stdout and stderr, then std::_Exit. Not std::exit: its static destructors raced
+/// roscpp's threads, which were still running, and now and then turned the exit code into an abort (seen
+/// in CI).
 [[noreturn]] void exitProcess(int code);
 
 }  // namespace sowing_robot

@@ -1,31 +1,57 @@
 // run_monitor: accumulates the tracking-error metrics of a run (Tables 5.5/5.6) and prints them when
-// the scenario ends; optionally writes them to YAML and ends the launch (headless runs).
+// the scenario ends; optionally writes them to YAML and ends the launch (headless runs). With a recorder
+// (`~recorder`: its recorded_until topic) it ends the launch only once the recorder has written the
+// run's last period, or, after `~recorder_timeout` wall seconds without that, with a failure (exit 3).
 #pragma once
 
 #include <ros/ros.h>
+#include <std_msgs/Time.h>
 
+#include <condition_variable>
+#include <mutex>
+#include <optional>
 #include <string>
+#include <thread>
 
 #include "sowing_robot/TrackingError.h"
 #include "sowing_robot/core/metrics.h"
+#include "sowing_robot/ros/node_failure.h"
 
 namespace sowing_robot {
 
 class RunMonitor {
  public:
   RunMonitor(ros::NodeHandle nh, ros::NodeHandle pnh);
+  ~RunMonitor();
+
+  /// The exit code the run ended with: 0, or kGaveUp when the recorder never confirmed the end.
+  int exitCode() const;
 
  private:
   void errorCallback(const TrackingError::ConstPtr& msg);
+  void recordedCallback(const std_msgs::Time::ConstPtr& msg);
+  void waitForRecorder();
   void finish();
+  void endRun();
 
   double duration_ = 25.0;
-  std::string output_, label_;
+  double recorder_timeout_ = 60.0;  // [s wall] for the recorder to catch up after the last period
+  std::string output_, label_, recorder_topic_;
   bool exit_at_end_ = false, done_ = false;
   core::MetricsAccumulator metrics_;
   ros::Time last_;
-  ros::Subscriber sub_;
-};
+  ros::NodeHandle pnh_;
+  ros::Subscriber sub_, recorder_sub_;
 
+  // The wait for the recorder: a thread of its own with a bounded wait, not a ros::WallTimer: roscpp's
+  // timer thread queues a callback while holding its timer lock, and InlineCallbackQueue runs it right
+  // there, where re-scheduling the timer takes that lock again (a deadlock, seen).
+  mutable std::mutex wait_mutex_;
+  std::condition_variable recorded_;
+  ros::Time recorded_until_;           // under wait_mutex_
+  bool waiting_ = false, stop_ = false;  // under wait_mutex_
+  std::optional<NodeFailure> failure_;   // under wait_mutex_
+  std::thread waiter_;
+};
 
 }  // namespace sowing_robot

@@ -1,0 +1,97 @@
+#!/usr/bin/env python3
+"""rostest: the end of a headless run. Through `rosrun sowing_robot sim` (what scripts/run calls):
+  * a normal end prints the metric table once, no "REQUIRED process ... has died!" banner, exits 0;
+  * `controller:=foo` (as processes and as nodelets) ends at once with exit 1 and torque_controller's FATAL
+    line as the last line;
+  * a lockstep give-up (plant_sim waiting for 50 odom subscribers, lockstep_give_up 3 s) exits 3 with
+    plant_sim's FATAL line last.
+Through plain `roslaunch sim.launch headless:=true controller:=foo`: the launch ends at once (every node
+is required when headless), not after lockstep_give_up (120 s).
+
+Verified to fail without the fix: with scripts/run's old `roslaunch` call the codes are 0 and the last
+lines roslaunch's; without sim.launch's `required` on every headless node the plain-roslaunch refusal
+runs into the 60 s bound (the plant waits 120 s for torques)."""
+import os
+import signal
+import subprocess
+import tempfile
+import time
+import unittest
+
+import roslib.packages
+import rostest
+
+BOUND = 60.0  # [s wall] for a run that must end "at once": start-up of every node plus shutdown
+
+
+def run(port, cmd, timeout=240):
+    env = dict(os.environ, ROS_MASTER_URI="http://localhost:%d" % port)
+    start = time.time()
+    proc = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True,
+                            start_new_session=True)  # a hung launch is killed whole
+    try:
+        out, _ = proc.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        out, _ = proc.communicate()
+        out += "\n(killed after %d s)" % timeout
+    return proc.returncode, out, time.time() - start
+
+
+def sim(port, *args, timeout=240):
+    return run(port, [roslib.packages.find_node("sowing_robot", "sim")[0], "headless:=true"] + list(args), timeout)
+
+
+def last_line(out):
+    return out.rstrip().splitlines()[-1]
+
+
+class HeadlessEnd(unittest.TestCase):
+    def check_normal_end(self, port, *args):
+        code, out, _ = sim(port, "field:=line", "duration:=2.0", *args)
+        self.assertEqual(code, 0, out[-4000:])
+        self.assertEqual(out.count("| ITAE | y |"), 1, "the metric table is not printed exactly once:\n" + out[-4000:])
+        self.assertNotIn("REQUIRED process", out)
+        self.assertEqual(last_line(out), "sim: the run ended normally")
+
+    def test_normal_end(self):
+        self.check_normal_end(11671)
+
+    def test_normal_end_nodelets(self):
+        self.check_normal_end(11672, "nodelets:=true")
+
+    def check_refusal(self, port, *args):
+        code, out, seconds = sim(port, "controller:=foo", *args, timeout=BOUND)
+        self.assertEqual(code, 1, out[-4000:])
+        self.assertLess(seconds, BOUND)
+        last = last_line(out)
+        self.assertIn("[FATAL]", last)
+        self.assertIn("/torque_controller: refusing to start: /torque_controller/mode = 'foo'", last)
+
+    def test_refusal_ends_the_run_at_once(self):
+        self.check_refusal(11673)
+
+    def test_refusal_of_a_nodelet_ends_the_run_at_once(self):
+        self.check_refusal(11674, "nodelets:=true")
+
+    def test_give_up(self):
+        with tempfile.NamedTemporaryFile("w", suffix=".yaml", delete=False) as f:
+            # odom subscribers that never come: the plant waits for the loop to connect, then gives up
+            f.write("plant_sim: {lockstep_give_up: 3.0, min_subscribers: 50}\n")
+        code, out, _ = sim(11675, "field:=line", "duration:=3.0", "config:=" + f.name)
+        os.unlink(f.name)
+        self.assertEqual(code, 3, out[-4000:])
+        last = last_line(out)
+        self.assertIn("[FATAL]", last)
+        self.assertIn("plant_sim: lockstep gave up", last)
+
+    def test_plain_roslaunch_refusal_ends_at_once(self):
+        code, out, seconds = run(11676, ["roslaunch", "-p", "11676", "sowing_robot", "sim.launch", "headless:=true",
+                                         "controller:=foo"], timeout=BOUND)
+        self.assertLess(seconds, BOUND, out[-3000:])
+        self.assertIn("/torque_controller: refusing to start: /torque_controller/mode = 'foo'", out)
+        self.assertIn("REQUIRED process [torque_controller", out)  # as well as plain roslaunch can say it
+
+
+if __name__ == "__main__":
+    rostest.rosrun("sowing_robot", "headless_end_test", HeadlessEnd)
