@@ -56,6 +56,7 @@ const ParamTable<FieldParams>& fieldTable() {
         flag("field/start_from_rest", &F::start_from_rest, false,
              "true: the first row starts at rest and ramps up; false: at row_speed"),
     });
+    t.nest("field/avoidance/", &F::avoidance, avoidanceTable());
     return t.nest("potential/", &F::potential, potentialFieldTable());
   }();
   return table;
@@ -64,7 +65,7 @@ const ParamTable<FieldParams>& fieldTable() {
 FieldParams::FieldParams() { fieldTable().applyDefaults(*this); }
 
 std::string FieldParams::validate() const {
-  std::string e = fieldTable().checkRanges(*this);
+  std::string e = firstError({fieldTable().checkRanges(*this), avoidance.validate()});
   if (!e.empty()) return e;
   if (turn_speed > row_speed)
     return "field/turn_speed = " + formatNumber(turn_speed) + " m/s must be <= field/row_speed = " +
@@ -252,10 +253,15 @@ void FieldPath::addPhase(double distance, double v0, double v1) {
   duration_ += ph.duration;
 }
 
-FieldPath::FieldPath(const FieldParams& params) : params_(params) {
+FieldPath::FieldPath(const FieldParams& params, const std::vector<Obstacle>& obstacles) : params_(params) {
   const std::string e = params_.validate();
   if (!e.empty()) throw std::invalid_argument("FieldParams: " + e);
-  const int n = params_.rows;
+  for (std::size_t i = 0; i < obstacles.size(); ++i) {
+    const std::string oe = obstacles[i].validate();
+    if (!oe.empty()) throw std::invalid_argument("obstacles[" + std::to_string(i) + "]: " + oe);
+  }
+  const bool plan = params_.avoidance.plan_detours && !obstacles.empty();
+  int n = params_.rows;
   if (n > 1) turn_ = HeadlandTurn(params_.row_spacing, 1.0 / params_.min_turn_radius, params_.max_curvature_rate);
 
   // Geometry.
@@ -267,6 +273,17 @@ FieldPath::FieldPath(const FieldParams& params) : params_(params) {
     row.length = params_.row_length;
     row.p0 = rowStart(i);
     row.heading = h;
+    if (plan) {
+      const RowPlan rp = planRow(i, row.p0, h, row.length, params_.row_speed, obstacles, params_.avoidance,
+                                 params_.potential.influence_distance, status_);
+      row.detour_first = detours_.size();
+      row.detour_count = rp.detours.size();
+      detours_.insert(detours_.end(), rp.detours.begin(), rp.detours.end());
+      if (rp.cut) {  // the path ends here, at rest
+        row.length = rp.stop;
+        n = i + 1;
+      }
+    }
     elements_.push_back(row);
     s += row.length;
     if (i + 1 < n) {
@@ -284,20 +301,56 @@ FieldPath::FieldPath(const FieldParams& params) : params_(params) {
   total_length_ = s;
 
   // Speed profile along the same sequence.
-  const double a = params_.max_accel, vr = params_.row_speed, vt = params_.turn_speed;
+  const double vt = params_.turn_speed;
+  std::size_t k = 0;
   for (int i = 0; i < n; ++i) {
-    double v_in, v_out;
-    rowSpeeds(params_, i, v_in, v_out);
-    const double L = params_.row_length;
-    const double vp = std::max(
-        {std::min(vr, std::sqrt(0.5 * (4.0 * a * L / M_PI + v_in * v_in + v_out * v_out))), v_in, v_out});
-    const double d1 = vp > v_in ? rampDistance(v_in, vp, a) : 0.0;
-    const double d2 = vp > v_out ? rampDistance(vp, v_out, a) : 0.0;
-    if (d1 > 0.0) addPhase(d1, v_in, vp);
-    const double cruise = L - d1 - d2;
-    if (cruise > 1e-12 * L) addPhase(cruise, vp, vp);
-    if (d2 > 0.0) addPhase(d2, vp, v_out);
+    const double v_in = i == 0 ? (params_.start_from_rest ? 0.0 : params_.row_speed) : vt;
+    const double v_out = i == n - 1 ? 0.0 : vt;
+    const Element& row = elements_[k];
+    addRowPhases(row.length, v_in, v_out, row);
+    k += 2;
     if (i + 1 < n) addPhase(turn_.length(), vt, vt);
+  }
+}
+
+void FieldPath::addRowPhases(double L, double v_in, double v_out, const Element& row) {
+  const double a = params_.max_accel, vr = params_.row_speed;
+  // Knots: the row start, each detour's speed window [begin, end], the row end; each with its speed.
+  struct Knot {
+    double b, e, w;
+  };
+  std::vector<Knot> knots{{0.0, 0.0, v_in}};
+  for (std::size_t d = row.detour_first; d < row.detour_first + row.detour_count; ++d)
+    knots.push_back({detours_[d].begin, detours_[d].end(), detours_[d].speed});
+  knots.push_back({L, L, v_out});
+  const std::size_t m = knots.size();
+  auto reach = [&](double w, double gap) { return std::sqrt(w * w + 4.0 * a * std::max(0.0, gap) / M_PI); };
+  if (m > 2) {
+    // Backward: each window slow enough to brake for the next; forward: no faster than it can speed up
+    // to. The row start and end speeds are fixed; where they cannot be met, the bounds do not hold.
+    for (std::size_t j = m - 2; j >= 1; --j) knots[j].w = std::min(knots[j].w, reach(knots[j + 1].w, knots[j + 1].b - knots[j].e));
+    for (std::size_t j = 0; j + 1 < m; ++j) {
+      const double gap = knots[j + 1].b - knots[j].e;
+      if (j + 1 < m - 1) knots[j + 1].w = std::min(knots[j + 1].w, reach(knots[j].w, gap));
+      if (knots[j].w > reach(knots[j + 1].w, gap) * (1.0 + 1e-12) && j + 1 < m - 1) {
+        knots[j + 1].w = std::sqrt(std::max(0.0, knots[j].w * knots[j].w - 4.0 * a * gap / M_PI));
+        status_.within_bounds = false;
+        if (status_.bounds_note.empty())
+          status_.bounds_note = "row speed cannot drop to a detour's speed in time (detour too close to the row start)";
+      }
+    }
+  }
+  for (std::size_t j = 0; j + 1 < m; ++j) {
+    const double wa = knots[j].w, wb = knots[j + 1].w;
+    const double gap = knots[j + 1].b - knots[j].e;
+    const double vp = std::max({std::min(vr, std::sqrt(0.5 * (4.0 * a * gap / M_PI + wa * wa + wb * wb))), wa, wb});
+    const double d1 = vp > wa ? rampDistance(wa, vp, a) : 0.0;
+    const double d2 = vp > wb ? rampDistance(vp, wb, a) : 0.0;
+    if (d1 > 0.0) addPhase(d1, wa, vp);
+    const double cruise = gap - d1 - d2;
+    if (cruise > 1e-12 * gap) addPhase(cruise, vp, vp);
+    if (d2 > 0.0) addPhase(d2, vp, wb);
+    if (j + 2 < m && knots[j + 1].e > knots[j + 1].b) addPhase(knots[j + 1].e - knots[j + 1].b, wb, wb);
   }
 }
 
@@ -345,6 +398,23 @@ TargetState FieldPath::at(double t) const {
     kappa = el.side * k_l;
     dkappa = el.side * dk_l;
   } else {
+    for (std::size_t d = el.detour_first; d < el.detour_first + el.detour_count; ++d) {
+      const Detour& dt = detours_[d];
+      if (sigma <= dt.begin || sigma >= dt.end()) continue;
+      // On a detour: p = p0 + sigma u + y(sigma) n with sigma' = sd (along-row speed).
+      double y, y1, y2, y3;
+      dt.lateral(sigma, y, y1, y2, y3);
+      const Eigen::Vector2d u(std::cos(el.heading), std::sin(el.heading)), nl(-u.y(), u.x());
+      const Eigen::Vector2d tang = u + y1 * nl;
+      TargetState out;
+      out.p = el.p0 + sigma * u + y * nl;
+      out.v = sd * tang;
+      out.a = sdd * tang + (sd * sd * y2) * nl;
+      out.j = sddd * tang + (3.0 * sd * sdd * y2) * nl + (sd * sd * sd * y3) * nl;
+      out.heading = wrapAngle(el.heading + std::atan(y1));
+      out.tool_down = t < duration_;
+      return out;
+    }
     p = el.p0 + sigma * Eigen::Vector2d(std::cos(el.heading), std::sin(el.heading));
     theta = el.heading;
   }
@@ -370,11 +440,50 @@ bool FieldPath::onTurn(double t) const {
 // FieldReference
 
 namespace {
-std::unique_ptr<TargetTrajectory> makePath(const FieldParams& p) { return std::make_unique<FieldPath>(p); }
+std::unique_ptr<FieldPath> makePath(const FieldParams& p, const std::vector<Obstacle>& obstacles) {
+  return std::make_unique<FieldPath>(p, obstacles);
+}
+/// What the repulsion sees: the raw obstacles (thesis), or, with a plan, the ones shrunk to the plan.
+std::vector<Obstacle> fieldObstacles(const FieldParams& p, const std::vector<Obstacle>& obstacles) {
+  if (!p.avoidance.plan_detours) return obstacles;
+  return repulsionObstacles(obstacles, p.avoidance, p.potential.influence_distance);
+}
 }  // namespace
 
 FieldReference::FieldReference(const FieldParams& params, std::vector<Obstacle> obstacles)
-    : params_(params), field_(params.potential, makePath(params), std::move(obstacles)), duration_(path().duration()) {}
+    : params_(params),
+      obstacles_(std::move(obstacles)),
+      field_(params.potential, makePath(params, obstacles_), fieldObstacles(params, obstacles_)),
+      duration_(path().duration()),
+      status_(path().status()) {}
+
+void FieldReference::setObstacles(std::vector<Obstacle> obstacles) {
+  if (!params_.avoidance.plan_detours) {
+    field_.setObstacles(obstacles);
+    obstacles_ = std::move(obstacles);
+    return;
+  }
+  std::unique_ptr<FieldPath> path = makePath(params_, obstacles);  // throws before anything changes
+  std::vector<Obstacle> repulsion = fieldObstacles(params_, obstacles);
+  const double t = field_.gridTime();
+  const TargetState before = field_.target().at(t), after = path->at(t);
+  AvoidanceStatus status = path->status();
+  const double moved = std::max((before.p - after.p).norm(), (before.v - after.v).norm());
+  if (moved > 1e-9 && status.within_bounds) {
+    char b[200];
+    std::snprintf(b, sizeof(b),
+                  "the obstacles changed at t = %.3f s too close ahead to plan for: the plan moved %.3f m (or m/s) "
+                  "at once, and the reference is pulled onto it",
+                  t, moved);
+    status.within_bounds = false;
+    status.bounds_note = b;
+  }
+  field_.setObstacles(std::move(repulsion));
+  field_.setTarget(std::move(path));
+  obstacles_ = std::move(obstacles);
+  duration_ = this->path().duration();
+  status_ = status;
+}
 
 std::unique_ptr<ReferenceSource> FieldReference::clone() const {
   auto c = std::make_unique<FieldReference>(*this);

@@ -154,6 +154,16 @@ void PotentialField::setObstacles(std::vector<Obstacle> obstacles) {
   updateSides(tgt.p + state_.e, tgt);
 }
 
+void PotentialField::setTarget(std::unique_ptr<TargetTrajectory> target) {
+  if (!target) throw std::invalid_argument("PotentialField: target is empty");
+  const double t = gridTime();
+  const TargetState a = target_->at(t), b = target->at(t);
+  state_.e += a.p - b.p;
+  state_.ed += a.v - b.v;
+  target_ = std::move(target);
+  if (!obstacles_.empty()) updateSides(b.p + state_.e, b);
+}
+
 double PotentialField::sideFor(std::size_t i, const Eigen::Vector2d& p, const TargetState& target) const {
   const double fixed = params_.avoid_side == AvoidSide::kLeft ? 1.0 : -1.0;
   if (!params_.nearest_side) return fixed;

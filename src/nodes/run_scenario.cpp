@@ -1,7 +1,13 @@
 // run_scenario: the thesis closed loop in-process (no ROS), for quick comparisons and benchmarks.
 //   run_scenario [--tsmc] [--atsmc] [--disturbance] [--mismatch S] [--noise STD] [--duration T] [--rate HZ]
 //                [--switching NAME --width W] [--repeat N] [--yaml FILE (metrics of the last mode)]
-// Prints the Table 5.5/5.6 metrics as Markdown and the wall time per run.
+//   run_scenario --field [--potential-only] [--rate HZ]
+// Prints the Table 5.5/5.6 metrics as Markdown and the wall time per run. --field runs the thesis field
+// (config/field_thesis.yaml: a 100 m row at y = 3, obstacles r 0.3 at x = 20, 50, 80; ATSMC, disturbance,
+// 20 % mismatch, 110 s) measured on the body (the URDF's footprint) and prints clearance, contacts, peak
+// yaw rate and v omega (from t = 12 s, after the approach from the start; and over the whole run), and
+// the seeds on the rows and on the detours; --potential-only is the thesis potential field without the
+// planned detours (the figures before issue 15).
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -9,12 +15,57 @@
 #include <string>
 #include <vector>
 
+#include "sowing_robot/core/field_run.h"
 #include "sowing_robot/core/runner.h"
 
 using namespace sowing_robot::core;
 
+namespace {
+/// The thesis field on the body; returns the exit code.
+int runThesisField(bool potential_only, std::int64_t period_ns) {
+  FieldRunSetup s;
+  s.scenario.duration = 110.0;
+  if (period_ns > 0) s.scenario.control_period_ns = period_ns;
+  s.field.rows = 1;
+  s.field.row_length = 100.0;
+  s.field.start_x = 0.0;
+  s.field.start_y = 3.0;
+  s.field.potential.beta = 4.0;  // config/field_thesis.yaml (alpha 4, influence 0.5, gain 5, ratio 1 are the defaults)
+  s.field.avoidance.plan_detours = !potential_only;
+  s.obstacles = {{20.0, 3.0, 0.3}, {50.0, 3.0, 0.3}, {80.0, 3.0, 0.3}};
+  const std::string err = s.field.validate();
+  if (!err.empty()) {
+    std::fprintf(stderr, "run_scenario: %s\n", err.c_str());
+    return 2;
+  }
+  FieldRunSetup whole = s;
+  s.peaks_from = 12.0;
+  const auto t0 = std::chrono::steady_clock::now();
+  const FieldRunReport r = runField(s);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const FieldRunReport w = runField(whole);
+  std::printf("thesis field, %s (%.0f ms wall), footprint circumscribed radius %.3f m:\n",
+              potential_only ? "potential field only (thesis)" : "planned detours (issue 15)", 1e3 * wall,
+              s.footprint.circumscribedRadius());
+  std::printf("| body clearance | contacts | peak yaw rate | peak v*omega | peak yaw rate / v*omega, whole run | "
+              "seeds on rows: count, max, RMS | detour seeds: count, max | end |\n|---|---|---|---|---|---|---|---|\n");
+  std::printf("| %.3f m | %zu | %.2f rad/s | %.2f m/s^2 | %.2f rad/s / %.2f m/s^2 | %zu, %.2f mm, %.2f mm | %zu, %.3f m | "
+              "(%.2f, %.2f) |\n",
+              r.min_clearance, r.contacts, r.peak_yaw_rate, r.peak_lateral, w.peak_yaw_rate, w.peak_lateral,
+              r.rows.count, 1e3 * r.rows.max, 1e3 * r.rows.rms, r.detours.count, r.detours.max, r.end.x(), r.end.y());
+  for (const ContactEvent& e : r.events)
+    std::printf("contact: obstacle %zu, t = %.3f .. %.3f s, max depth %.3f m\n", e.obstacle, e.start, e.end,
+                e.max_depth);
+  std::printf("reference (from t = 12 s): peak yaw rate %.2f rad/s, v*omega %.2f m/s^2, curvature %.2f 1/m; status %s%s%s\n",
+              r.peak_ref_yaw_rate, r.peak_ref_lateral, r.peak_ref_curvature, AvoidanceStatus::name(r.status.code),
+              r.status.reason.empty() ? "" : ": ", r.status.reason.c_str());
+  return r.diverged ? 1 : 0;
+}
+}  // namespace
+
 int main(int argc, char** argv) {
   std::vector<bool> modes;
+  bool field = false, potential_only = false;
   Scenario sc;
   int repeat = 1;
   std::string yaml;
@@ -27,7 +78,9 @@ int main(int argc, char** argv) {
       }
       return std::strtod(argv[++i], nullptr);
     };
-    if (a == "--tsmc") modes.push_back(false);
+    if (a == "--field") field = true;
+    else if (a == "--potential-only") potential_only = true;
+    else if (a == "--tsmc") modes.push_back(false);
     else if (a == "--atsmc") modes.push_back(true);
     else if (a == "--disturbance") sc.disturbance.sinusoidal = true;
     else if (a == "--mismatch") sc.disturbance.mass_scale = sc.disturbance.inertia_scale = value("--mismatch");
@@ -47,6 +100,7 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
+  if (field) return runThesisField(potential_only, sc.control_period_ns);
   if (modes.empty()) modes = {true, false};
   std::vector<std::string> names;
   std::vector<std::array<AxisMetrics, AXIS_COUNT>> results;

@@ -278,3 +278,75 @@ std::string linkPositionFromUrdf(const std::string& urdf_xml, const std::string&
 }
 
 }  // namespace sowing_robot
+
+namespace sowing_robot {
+
+namespace {
+/// Ground-plane points of one collision shape whose frame is `t` in base_link (appended to `pts`).
+std::string projectGeometry(const urdf::Geometry& g, const Eigen::Isometry3d& t, const std::string& link,
+                            std::vector<Eigen::Vector2d>& pts) {
+  const int kCircle = 64;
+  auto add = [&](const Eigen::Vector3d& local) {
+    const Eigen::Vector3d w = t * local;
+    pts.emplace_back(w.x(), w.y());
+  };
+  auto circle = [&](const Eigen::Vector3d& centre, const Eigen::Vector3d& e1, const Eigen::Vector3d& e2, double r) {
+    for (int k = 0; k < kCircle; ++k) {
+      const double a = 2.0 * M_PI * k / kCircle;
+      add(centre + r * (std::cos(a) * e1 + std::sin(a) * e2));
+    }
+  };
+  switch (g.type) {
+    case urdf::Geometry::BOX: {
+      const urdf::Vector3& s = static_cast<const urdf::Box&>(g).dim;
+      for (int i = 0; i < 8; ++i)
+        add(Eigen::Vector3d((i & 1 ? 0.5 : -0.5) * s.x, (i & 2 ? 0.5 : -0.5) * s.y, (i & 4 ? 0.5 : -0.5) * s.z));
+      return "";
+    }
+    case urdf::Geometry::CYLINDER: {  // axis along the shape's local z
+      const auto& c = static_cast<const urdf::Cylinder&>(g);
+      for (const double z : {-0.5 * c.length, 0.5 * c.length})
+        circle(Eigen::Vector3d(0, 0, z), Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(), c.radius);
+      return "";
+    }
+    case urdf::Geometry::SPHERE: {  // its ground-plane outline is the horizontal great circle
+      const double r = static_cast<const urdf::Sphere&>(g).radius;
+      const Eigen::Matrix3d back = t.linear().transpose();  // base_link x, y in the shape frame
+      circle(Eigen::Vector3d::Zero(), back * Eigen::Vector3d::UnitX(), back * Eigen::Vector3d::UnitY(), r);
+      return "";
+    }
+    default:
+      return "link " + quoted(link) + " has a mesh collision geometry; the footprint needs box, cylinder or sphere";
+  }
+}
+}  // namespace
+
+std::string footprintFromUrdf(const std::string& urdf_xml, core::Footprint& out) {
+  urdf::ModelInterfaceSharedPtr model;
+  std::string err = parse(urdf_xml, model);
+  if (!err.empty()) return err;
+  if (!model->getLink(kBaseLink)) return "URDF " + quoted(model->getName()) + ": link " + quoted(kBaseLink) + " not found";
+  std::vector<Eigen::Vector2d> pts;
+  for (const auto& kv : model->links_) {
+    const urdf::LinkConstSharedPtr link = kv.second;
+    if (!link) continue;
+    std::vector<urdf::CollisionSharedPtr> collisions = link->collision_array;
+    if (collisions.empty() && link->collision) collisions.push_back(link->collision);
+    if (collisions.empty()) continue;
+    Eigen::Isometry3d frame;
+    err = frameInBase(*model, kv.first, true, frame);
+    if (!err.empty()) return "URDF " + quoted(model->getName()) + ": " + err;
+    for (const auto& c : collisions) {
+      if (!c || !c->geometry) continue;
+      err = projectGeometry(*c->geometry, frame * toIsometry(c->origin), kv.first, pts);
+      if (!err.empty()) return "URDF " + quoted(model->getName()) + ": " + err;
+    }
+  }
+  core::Footprint f = core::Footprint::convexHull(pts);
+  err = f.validate();
+  if (!err.empty()) return "URDF " + quoted(model->getName()) + ": collision geometry gives no usable footprint: " + err;
+  out = f;
+  return "";
+}
+
+}  // namespace sowing_robot

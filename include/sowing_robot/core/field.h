@@ -22,6 +22,7 @@
 
 #include <Eigen/Dense>
 
+#include "sowing_robot/core/detour.h"
 #include "sowing_robot/core/potential_field.h"
 #include "sowing_robot/core/reference.h"
 #include "sowing_robot/core/types.h"
@@ -47,6 +48,7 @@ struct FieldParams {
   double max_curvature_rate;
   bool start_from_rest;          ///< false: the first row starts at row_speed (as the thesis line)
   PotentialFieldParams potential;    ///< alpha, beta, repulsion (see PotentialField)
+  AvoidanceParams avoidance;         ///< planned detours around the inflated obstacles (detour.h)
   std::string validate() const;
 };
 /// field/{rows, row_length, row_spacing, start_x, start_y, heading, rows_to_left, row_speed, turn_speed,
@@ -90,10 +92,12 @@ class HeadlandTurn {
 };
 
 /// The whole field as a target trajectory (rows, turns and the speed profile); a pure function of t.
+/// With obstacles and avoidance.plan_detours, the rows carry planned detours (detour.h) driven at their
+/// detour speed, and the path ends early, at rest, before a group it cannot pass.
 class FieldPath : public TargetTrajectory {
  public:
-  /// Throws std::invalid_argument on invalid parameters.
-  explicit FieldPath(const FieldParams& params);
+  /// Throws std::invalid_argument on invalid parameters or obstacles.
+  explicit FieldPath(const FieldParams& params, const std::vector<Obstacle>& obstacles = {});
   TargetState at(double t) const override;
   std::unique_ptr<TargetTrajectory> clone() const override { return std::make_unique<FieldPath>(*this); }
 
@@ -104,10 +108,14 @@ class FieldPath : public TargetTrajectory {
   bool onTurn(double t) const;
   /// Start point of row i [m].
   Eigen::Vector2d rowStart(int i) const;
+  /// The plan: its status and its detours (empty without obstacles or with plan_detours false).
+  const AvoidanceStatus& status() const { return status_; }
+  const std::vector<Detour>& detours() const { return detours_; }
 
  private:
   struct Element {
     double s0 = 0.0, length = 0.0;
+    std::size_t detour_first = 0, detour_count = 0;  ///< its detours in detours_ (rows only)
     bool turn = false;
     Eigen::Vector2d p0 = Eigen::Vector2d::Zero();
     double heading = 0.0;  ///< direction at the start [rad]
@@ -118,19 +126,24 @@ class FieldPath : public TargetTrajectory {
     double t0 = 0.0, s0 = 0.0, duration = 0.0, v0 = 0.0, v1 = 0.0;
   };
   void addPhase(double distance, double v0, double v1);
+  /// Speed phases of one row of `length` from v_in to v_out through its detours' speed windows.
+  void addRowPhases(double length, double v_in, double v_out, const Element& row);
   void arcLength(double t, double& s, double& sd, double& sdd, double& sddd) const;
 
   FieldParams params_;
   HeadlandTurn turn_;
   std::vector<Element> elements_;
   std::vector<Phase> phases_;
+  std::vector<Detour> detours_;
+  AvoidanceStatus status_;
   double duration_ = 0.0, total_length_ = 0.0;
 };
 
 /// Reference for a whole field: PotentialField tracking of a FieldPath.
 class FieldReference : public ReferenceSource {
  public:
-  /// Throws std::invalid_argument on invalid parameters or obstacles.
+  /// Throws std::invalid_argument on invalid parameters or obstacles. With avoidance.plan_detours the
+  /// path is planned around the obstacles (FieldPath) and the repulsion gets repulsionObstacles().
   explicit FieldReference(const FieldParams& params, std::vector<Obstacle> obstacles = {});
 
   std::unique_ptr<ReferenceSource> clone() const override;
@@ -139,7 +152,16 @@ class FieldReference : public ReferenceSource {
   bool finished(double t) const { return t >= duration_; }
   double duration() const { return duration_; }  ///< [s]
 
-  void setObstacles(std::vector<Obstacle> obstacles) { field_.setObstacles(std::move(obstacles)); }
+  /// Replace the obstacles at run time (throws std::invalid_argument, keeping the old ones). With a plan,
+  /// the path is re-planned as if the new list had been known from the start; the reference point and
+  /// its velocity are kept, so where the new plan differs from the old one at the current time (the
+  /// obstacle came too close ahead to plan for) the potential field pulls the reference onto it and
+  /// status().within_bounds turns false.
+  void setObstacles(std::vector<Obstacle> obstacles);
+  /// The obstacles as given (not inflated).
+  const std::vector<Obstacle>& obstacles() const { return obstacles_; }
+  /// The plan's status: the node logs it and publishes it (a stop, no safe way, bounds not held).
+  const AvoidanceStatus& status() const { return status_; }
   /// See PotentialField::setGains.
   void setGains(double alpha, double beta, double gain, double tangential_ratio) {
     field_.setGains(alpha, beta, gain, tangential_ratio);
@@ -155,8 +177,10 @@ class FieldReference : public ReferenceSource {
 
  private:
   FieldParams params_;
+  std::vector<Obstacle> obstacles_;
   PotentialField field_;
   double duration_ = 0.0;
+  AvoidanceStatus status_;
 };
 
 }  // namespace core

@@ -139,6 +139,12 @@ class PotentialField : public ReferenceSource {
   /// internal grid time on; the state is kept.
   void setObstacles(std::vector<Obstacle> obstacles);
   const std::vector<Obstacle>& obstacles() const { return obstacles_; }
+  /// Replace the target (not empty; throws std::invalid_argument) keeping the reference point: the error
+  /// state is re-based at the current grid time so the position and velocity there are unchanged, and
+  /// the attraction then pulls the reference onto the new target. Used to re-plan at run time.
+  void setTarget(std::unique_ptr<TargetTrajectory> target);
+  /// The internal grid time the state is at [s].
+  double gridTime() const { return static_cast<double>(steps_) * params_.step; }
 
   /// Sum over the obstacles of V_a(p) [-] (without the gain k).
   double repulsivePotential(const Eigen::Vector2d& p) const;
