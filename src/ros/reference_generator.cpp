@@ -10,6 +10,7 @@
 #include "sowing_robot/ros/node_failure.h"
 #include "sowing_robot/ros/msg_checks.h"
 #include "sowing_robot/ros/reconfigure_bridge.h"
+#include "sowing_robot/ros/urdf_params.h"
 #include "sowing_robot/core/seeding.h"
 
 namespace sowing_robot {
@@ -27,6 +28,15 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
   if (settings.field) {
     loadTable(p, core::fieldTable(), field);
     if (error.empty()) error = loadObstacles(p, "obstacles", obstacles);
+    // The plan keeps the body clear, not the axle point: the obstacles are inflated by the footprint's
+    // circumscribed radius, from the URDF's collision geometry (the one source of the robot's shape).
+    p.allow("robot_description");
+    std::string key, xml;
+    core::Footprint footprint;
+    if (error.empty() && (!pnh.searchParam("robot_description", key) || !pnh.getParam(key, xml)))
+      error = "parameter robot_description (the URDF) is not set";
+    if (error.empty()) error = footprintFromUrdf(xml, footprint);
+    field.avoidance.footprint_radius = footprint.circumscribedRadius();
     if (error.empty() && p.error().empty()) error = field.validate();
   } else {
     for (const char* key : {"field", "potential", "obstacles"})
@@ -54,6 +64,8 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
     obstacles_ = obstacles;
     source_ = std::move(f);
     logSettings("reference_generator", core::fieldTable(), field);
+    ROS_INFO("reference_generator: footprint circumscribed radius %.3f m (URDF collision geometry): obstacles "
+             "are inflated by it + field/avoidance/safety_margin", field.avoidance.footprint_radius);
     ROS_INFO("reference_generator: field path %.3f m in %.3f s%s", field_->path().length(), field_->duration(),
              field.rows > 1 ? (field_->path().turn().isBulb() ? ", bulb turns" : ", rounded turns") : "");
     for (std::size_t i = 0; i < obstacles_.size(); ++i)
@@ -122,7 +134,18 @@ void ReferenceGenerator::obstaclesCallback(const visualization_msgs::MarkerArray
   publishPlan();
 }
 
+void ReferenceGenerator::reportStatus() {
+  const core::AvoidanceStatus& s = field_->status();
+  if (s.code == core::AvoidanceStatus::Code::kOk)
+    ROS_INFO("reference_generator: plan ok, %zu detour(s)", s.detours);
+  else
+    ROS_WARN("reference_generator: plan %s: %s; the reference stops at (%.3f, %.3f)",
+             core::AvoidanceStatus::name(s.code), s.reason.c_str(), s.stop_point.x(), s.stop_point.y());
+  if (!s.within_bounds) ROS_WARN("reference_generator: plan outside its bounds: %s", s.bounds_note.c_str());
+}
+
 void ReferenceGenerator::publishPlan() {
+  if (field_) reportStatus();
   FieldPlan plan;
   plan.header.frame_id = odom_frame_;
   plan.header.stamp = ros::Time::now();
@@ -142,6 +165,11 @@ void ReferenceGenerator::publishPlan() {
       plan.obstacle_radii.push_back(o.radius);
     }
     plan.influence_distance = field_->potentialField().params().influence_distance;
+    const core::AvoidanceStatus& s = field_->status();
+    plan.status = core::AvoidanceStatus::name(s.code);
+    plan.reason = s.code == core::AvoidanceStatus::Code::kOk ? s.bounds_note : s.reason;
+    plan.within_bounds = s.within_bounds;
+    plan.detours = static_cast<std::uint32_t>(s.detours);
   } else {
     plan.row_starts.push_back(point(line_));
     plan.row_ends.push_back(point(line_ + Eigen::Vector2d(1e5, 0.0)));  // the thesis line, open-ended

@@ -46,6 +46,8 @@ class ReferenceGenerator {
   void obstaclesCallback(const visualization_msgs::MarkerArray::ConstPtr& msg);
   /// The plan in force (rows, obstacles, influence) on `plan`, latched; type field: field_markers too.
   void publishPlan();
+  /// type field: the plan's status in the log (a stop short of a target, no safe way, bounds not held).
+  void reportStatus();
   /// type field: obstacles, influence zones and row lines on field_markers.
   void publishMarkers();
   /// type field: live avoidance gains, validated like the start-up values (a rejected change keeps them).
