@@ -73,7 +73,9 @@ using RunMonitorNodelet = WrapperNodelet<RunMonitor>;
 using SeedDrillNodelet = WrapperNodelet<SeedDrillNode>;
 
 /// The plant's run() on a thread of its own: in lockstep it only supervises (the torque callback steps);
-/// in realtime it paces the steps and serves the wheel_torque queue.
+/// in realtime it paces the steps and serves the wheel_torque queue. A run that cannot go on (the state
+/// diverged, or lockstep gave up) is logged as this nodelet's one FATAL line and ends there: nothing more
+/// is stepped or published, and the manager and its other nodelets run on.
 class PlantSimNodelet : public nodelet::Nodelet {
  public:
   ~PlantSimNodelet() override {
@@ -85,7 +87,12 @@ class PlantSimNodelet : public nodelet::Nodelet {
   void onInit() override {
     impl_ = std::make_unique<PlantSim>(getNodeHandle(), getPrivateNodeHandle());
     thread_ = std::thread([this] {
-      impl_->run();
+      try {
+        impl_->run();
+      } catch (const NodeFailure& failure) {
+        ROS_FATAL("%s: %s", getName().c_str(), failure.what());  // the nodelet's name, not the manager's
+        return;
+      }
       if (impl_->exitAtEnd()) ros::shutdown();
     });
   }

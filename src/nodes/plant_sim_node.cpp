@@ -1,6 +1,10 @@
-// Standalone plant_sim node: the wrapper class does the work.
+// Standalone plant_sim node: the wrapper class does the work; this main decides how the process ends.
+// A run that cannot go on (NodeFailure: the state diverged, or lockstep gave up) is logged as the node's
+// one FATAL line and becomes its exit code (2, 3).
 #include <ros/ros.h>
 
+#include "sowing_robot/ros/node_failure.h"
+#include "sowing_robot/ros/param_reader.h"
 #include "sowing_robot/ros/plant_sim.h"
 
 int main(int argc, char** argv) {
@@ -9,7 +13,13 @@ int main(int argc, char** argv) {
   sowing_robot::PlantSim node(nh, pnh);
   ros::AsyncSpinner spinner(1);  // the global queue; run() serves the wheel_torque queue itself
   spinner.start();
-  node.run();
+  try {
+    node.run();
+  } catch (const sowing_robot::NodeFailure& failure) {
+    ROS_FATAL("%s: %s", ros::this_node::getName().c_str(), failure.what());
+    // roscpp's threads still run (a torque callback may be waiting): shut it down before the end.
+    sowing_robot::exitProcess(failure.exitCode());
+  }
   if (!node.exitAtEnd()) ros::waitForShutdown();
   return 0;
 }

@@ -4,10 +4,11 @@
 #include "sowing_robot/ros/component_params.h"
 #include "sowing_robot/core/validation.h"
 #include "sowing_robot/ros/msg_checks.h"
+#include "sowing_robot/ros/run_settings.h"
 
 namespace sowing_robot {
 
-KinematicController::KinematicController(ros::NodeHandle nh, ros::NodeHandle pnh) {
+KinematicController::KinematicController(ros::NodeHandle nh, ros::NodeHandle pnh) : lockstep_(lockstepRun(nh)) {
   ParamReader p(pnh);
   const core::KanayamaGains gains = loadKanayama(p);
   input_timeout_ = p.get("input_timeout", input_timeout_);
@@ -63,6 +64,10 @@ void KinematicController::odomCallback(const nav_msgs::Odometry::ConstPtr& msg) 
 }
 
 void KinematicController::stopIfStale(const nav_msgs::Odometry& odom) {
+  // Lockstep: the reference for this stamp is on its way (or being replayed to a restarted controller),
+  // and simulated time stands still until the loop answers, so no age of it can mean the generator is
+  // gone; a stop here would be a wrong answer to a state the plant waits for.
+  if (lockstep_) return;
   const double age = (odom.header.stamp - (inputs_.any() ? inputs_.lastStamp() : ros::Time(0))).toSec();
   if (age <= input_timeout_) return;
   // No reference (generator dead or restarting): ask the inner loop to stop the robot.

@@ -3,10 +3,11 @@
 #include "sowing_robot/ros/component_params.h"
 #include "sowing_robot/core/validation.h"
 #include "sowing_robot/ros/msg_checks.h"
+#include "sowing_robot/ros/run_settings.h"
 
 namespace sowing_robot {
 
-TorqueController::TorqueController(ros::NodeHandle nh, ros::NodeHandle pnh) {
+TorqueController::TorqueController(ros::NodeHandle nh, ros::NodeHandle pnh) : lockstep_(lockstepRun(nh)) {
   ParamReader p(pnh);
   core::RobotParams robot;
   p.allow("robot_description");  // a private URDF may override the global one
@@ -93,6 +94,9 @@ void TorqueController::odomCallback(const nav_msgs::Odometry::ConstPtr& msg) {
 }
 
 bool TorqueController::holdZeroIfStale(const nav_msgs::Odometry& odom) {
+  // Lockstep: the desired velocity for this stamp is on its way (a restarted kinematic controller answers
+  // the re-sent state), and simulated time stands still until it comes: wait for it.
+  if (lockstep_) return false;
   const bool have = inputs_.any();
   const double age = have ? (odom.header.stamp - inputs_.lastStamp()).toSec() : odom.header.stamp.toSec();
   if (age <= input_timeout_) return false;
