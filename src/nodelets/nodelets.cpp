@@ -88,7 +88,9 @@ using RunMonitorNodelet = WrapperNodelet<RunMonitor>;
 using SeedDrillNodelet = WrapperNodelet<SeedDrillNode>;
 
 /// The plant's run() on a thread of its own: in lockstep it only supervises (the torque callback steps);
-/// in realtime it paces the steps and serves the wheel_torque queue.
+/// in realtime it paces the steps and serves the wheel_torque queue. A run that cannot go on (the state
+/// diverged, or lockstep gave up) is logged as this nodelet's one FATAL line and ends there: nothing more
+/// is stepped or published, and the manager and its other nodelets run on.
 class PlantSimNodelet : public nodelet::Nodelet {
  public:
   ~PlantSimNodelet() override {
@@ -98,9 +100,19 @@ class PlantSimNodelet : public nodelet::Nodelet {
 
  private:
   void onInit() override {
-    impl_ = std::make_unique<PlantSim>(getNodeHandle(), getPrivateNodeHandle());
+    try {
+      impl_ = std::make_unique<PlantSim>(getNodeHandle(), getPrivateNodeHandle());
+    } catch (const NodeFailure& failure) {
+      logFailure(getName(), failure);  // as WrapperNodelet: logged, and the loader unloads it
+      throw;
+    }
     thread_ = std::thread([this] {
-      impl_->run();
+      try {
+        impl_->run();
+      } catch (const NodeFailure& failure) {
+        logFailure(getName(), failure);  // the nodelet's name, not the manager's
+        return;
+      }
       if (impl_->exitAtEnd()) ros::shutdown();
     });
   }

@@ -1,15 +1,26 @@
-// Standalone plant_sim node: the wrapper class does the work.
+// Standalone plant_sim node: the wrapper class does the work; this main decides how the process ends.
+// A run that cannot go on (NodeFailure: the state diverged, or lockstep gave up) is logged as the node's
+// one FATAL line and becomes its exit code (2, 3).
 #include <ros/ros.h>
 
+#include "sowing_robot/ros/failure_log.h"
+#include "sowing_robot/ros/node_failure.h"
+#include "sowing_robot/ros/param_reader.h"
 #include "sowing_robot/ros/plant_sim.h"
 
 int main(int argc, char** argv) {
   ros::init(argc, argv, "plant_sim");
   ros::NodeHandle nh, pnh("~");
-  sowing_robot::PlantSim node(nh, pnh);
-  ros::AsyncSpinner spinner(1);  // the global queue; run() serves the wheel_torque queue itself
-  spinner.start();
-  node.run();
-  if (!node.exitAtEnd()) ros::waitForShutdown();
+  try {
+    sowing_robot::PlantSim node(nh, pnh);
+    ros::AsyncSpinner spinner(1);  // the global queue; run() serves the wheel_torque queue itself
+    spinner.start();
+    node.run();
+    if (!node.exitAtEnd()) ros::waitForShutdown();
+  } catch (const sowing_robot::NodeFailure& failure) {
+    sowing_robot::logFailure(ros::this_node::getName(), failure);
+    // roscpp's threads still run (a torque callback may be waiting): shut it down before the end.
+    sowing_robot::exitProcess(failure.exitCode());
+  }
   return 0;
 }

@@ -17,7 +17,7 @@ KinematicController::KinematicController(ros::NodeHandle nh, ros::NodeHandle pnh
   input_timeout_ = settings.input_timeout;
   kanayama_.setGains(settings.gains);
   logSettings("kinematic_controller", core::KinematicControllerSettings::table(), settings);
-  (void)run;  // read for its checks (range, agreement with a private copy); the controller works on stamps
+  lockstep_ = run.lockstep;  // lockstep: wait for the paired reference, never time out
   reconfigure_ = std::make_unique<dynamic_reconfigure::Server<KinematicControllerConfig>>(pnh);
   // The server starts from the .cfg defaults where a key is not set: hand it the gains in force first,
   // so its first callback changes nothing.
@@ -71,6 +71,10 @@ void KinematicController::odomCallback(const nav_msgs::Odometry::ConstPtr& msg) 
 }
 
 void KinematicController::stopIfStale(const nav_msgs::Odometry& odom) {
+  // Lockstep: the reference for this stamp is on its way (or being replayed to a restarted controller),
+  // and simulated time stands still until the loop answers, so no age of it can mean the generator is
+  // gone; a stop here would be a wrong answer to a state the plant waits for.
+  if (lockstep_) return;
   const double age = (odom.header.stamp - (inputs_.any() ? inputs_.lastStamp() : ros::Time(0))).toSec();
   if (age <= input_timeout_) return;
   // No reference (generator dead or restarting): ask the inner loop to stop the robot.

@@ -7,7 +7,6 @@
 
 namespace sowing_robot {
 
-
 TorqueController::TorqueController(ros::NodeHandle nh, ros::NodeHandle pnh) {
   ParamReader p(pnh);
   core::RobotParams robot;
@@ -19,6 +18,7 @@ TorqueController::TorqueController(ros::NodeHandle nh, ros::NodeHandle pnh) {
   requireValid(p, robot_error.empty() ? settings.validate() : robot_error);
   const core::SlidingModeParams& params = settings.sliding;
   input_timeout_ = settings.input_timeout;
+  lockstep_ = run.lockstep;  // lockstep: wait for the paired desired velocity, never time out
   dt_ = core::secondsFromNanos(run.periodNs());
   smc_ = std::make_unique<core::SlidingModeController>(params, robot);
   logSettings("torque_controller", core::TorqueControllerSettings::table(), settings);
@@ -66,6 +66,9 @@ void TorqueController::odomCallback(const nav_msgs::Odometry::ConstPtr& msg) {
 }
 
 bool TorqueController::holdZeroIfStale(const nav_msgs::Odometry& odom) {
+  // Lockstep: the desired velocity for this stamp is on its way (a restarted kinematic controller answers
+  // the re-sent state), and simulated time stands still until it comes: wait for it.
+  if (lockstep_) return false;
   const bool have = inputs_.any();
   const double age = have ? (odom.header.stamp - inputs_.lastStamp()).toSec() : odom.header.stamp.toSec();
   if (age <= input_timeout_) return false;

@@ -2,20 +2,29 @@
 """rostest: plant_sim (realtime, started here as a child process so its exit code can be checked) is
 driven to divergence by sustained wheel torques from this test. It must stop the run: a FATAL line
 saying the state diverged, exit code 2, and no diverged state ever published on odom.
+As a nodelet the same divergence must stop that run only: one FATAL line, no more states, and the
+manager with its other nodelets (here a second plant_sim) running on.
 
-Protection checked: PlantSim::requireHealthy() (src/ros/plant_sim.cpp), the |v| > max_speed / non-finite
-check after every step. plant_sim does not clip incoming torques (max_torque is the torque controller's
-limit), so a finite torque can drive the state anywhere.
-Verified to fail without it: with requireHealthy() reduced to `return;` plant_sim runs on at any speed,
-the wait for its exit times out and both cases fail (and odom carries |v| > max_speed)."""
+Protection checked: SimulatedPlant::step() (src/ros/plant_sim_plant.cpp), the |v| > max_speed /
+non-finite check after every step, whose failure run() throws as a NodeFailure (kDiverged) that
+plant_sim's main turns into exit 2 and PlantSimNodelet into a stopped run. plant_sim does not clip
+incoming torques (max_torque is the torque controller's limit), so a finite torque can drive the state
+anywhere.
+Verified to fail without it: with the check reduced to `return true;` plant_sim runs on at any speed,
+the wait for its exit times out and both process cases fail (and odom carries |v| > max_speed); with
+the nodelet ending the process on the failure (as plant_sim did with _Exit before), the nodelet case
+fails: the manager is gone."""
 import math
+import subprocess
 import tempfile
 import time
 import unittest
 
+import roslib.packages
 import rospy
 import rostest
 from nav_msgs.msg import Odometry
+from nodelet.srv import NodeletList, NodeletLoad
 from sowing_robot.msg import WheelTorque
 
 import node_process
@@ -88,6 +97,74 @@ class PlantDivergence(unittest.TestCase):
 
     def test_overspeed_stops_the_run(self):
         self.run_case(*CASES[0])
+
+    def test_divergence_in_a_nodelet_manager_stops_only_that_run(self):
+        manager_ns, diverging, healthy = "/diverge_manager", "/diverge_nodelet", "/healthy_nodelet"
+        for ns in (diverging, healthy):
+            node_process.set_private_params(ns + "/run", RUN)
+        node_process.set_private_params(diverging + "/plant_sim", dict(COMMON, max_speed=2.0))
+        node_process.set_private_params(healthy + "/plant_sim", COMMON)  # no torque: it runs at rest
+        seen = {diverging: [], healthy: []}  # odom |v| received, per plant
+        subs = [rospy.Subscriber(ns + "/odom", Odometry, lambda m, ns=ns: seen[ns].append(abs(m.twist.twist.linear.x)),
+                                 queue_size=1000) for ns in seen]
+        pub = rospy.Publisher(diverging + "/wheel_torque", WheelTorque, queue_size=10)
+        stamp = {"last": None}
+        subs.append(rospy.Subscriber(diverging + "/odom", Odometry, lambda m: stamp.update(last=m.header.stamp),
+                                     queue_size=10))
+        nodelet = roslib.packages.find_node("nodelet", "nodelet")[0]
+        with tempfile.TemporaryFile(mode="w+") as log:
+            manager = subprocess.Popen([nodelet, "manager", "__name:=manager", "__ns:=" + manager_ns], stdout=log,
+                                       stderr=subprocess.STDOUT)
+            try:
+                rospy.wait_for_service(manager_ns + "/manager/load_nodelet", timeout=EXIT_LIMIT)
+                load = rospy.ServiceProxy(manager_ns + "/manager/load_nodelet", NodeletLoad)
+                for ns in (healthy, diverging):
+                    self.assertTrue(load(ns + "/plant_sim", "sowing_robot/plant_sim", [], [], [], "").success, ns)
+
+                def fatal_lines():
+                    log.flush()
+                    log.seek(0)
+                    return [line for line in log.read().splitlines() if "[FATAL]" in line]
+
+                deadline = time.time() + EXIT_LIMIT
+                while not fatal_lines() and manager.poll() is None and time.time() < deadline:
+                    if stamp["last"] is not None:  # stamped like a controller's answer, so it is fresh
+                        msg = WheelTorque()
+                        msg.header.stamp = stamp["last"]
+                        msg.right = msg.left = 20.0
+                        pub.publish(msg)
+                    time.sleep(0.01)
+                self.assertIsNone(manager.poll(), "the manager ended (exit %s)" % manager.returncode)
+                fatal = fatal_lines()
+                self.assertEqual(len(fatal), 1, "expected one FATAL line within %.0f s" % EXIT_LIMIT)
+                self.assertIn(diverging + "/plant_sim: state diverged", fatal[0])
+                self.assertIn("max_speed 2 m/s", fatal[0])
+                # The diverged run publishes nothing more; the healthy plant in the same manager goes on.
+                # (A realtime plant at 200 Hz publishes a state every 5 ms: 40 would come in this window.)
+                stopped_at, healthy_at = len(seen[diverging]), len(seen[healthy])
+                time.sleep(0.2)
+                self.assertEqual(len(seen[diverging]), stopped_at, "states published after the divergence")
+                try:
+                    listed = rospy.ServiceProxy(manager_ns + "/manager/list", NodeletList)().nodelets
+                except rospy.ServiceException as e:
+                    self.fail("the manager does not answer after the divergence (%s; exit %s)" % (e, manager.poll()))
+                self.assertIn(healthy + "/plant_sim", listed)
+                self.wait_for_more(seen[healthy], healthy_at + 20, "states from the healthy plant")
+                self.assertIsNone(manager.poll(), "the manager ended (exit %s)" % manager.returncode)
+                self.assertLessEqual(max(seen[diverging]), 2.0, "a diverged state was published")
+            finally:
+                node_process.stop(manager)
+                for sub in subs:
+                    sub.unregister()
+                pub.unregister()
+
+    @staticmethod
+    def wait_for_more(items, count, what):
+        deadline = time.time() + EXIT_LIMIT
+        while len(items) < count:
+            if time.time() > deadline:
+                raise AssertionError("no %s after %.0f s" % (what, EXIT_LIMIT))
+            time.sleep(0.01)
 
     def test_overflowing_state_stops_the_run(self):
         self.run_case(*CASES[1])

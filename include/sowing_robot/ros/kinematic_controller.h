@@ -27,7 +27,7 @@ class KinematicController {
   void compute();
   /// Live gain change: validated like the start-up values; a rejected change keeps the old gains.
   void reconfigure(KinematicControllerConfig& config, uint32_t level);
-  /// Command a stop for this odom stamp when the reference is older than input_timeout.
+  /// Realtime only: command a stop for this odom stamp when the reference is older than input_timeout.
   void stopIfStale(const nav_msgs::Odometry& odom);
 
   core::Kanayama kanayama_;
@@ -38,6 +38,7 @@ class KinematicController {
   DesiredVelocity desired_;
   TrackingError error_;
   long rejected_ = 0;
+  bool lockstep_;  // run/mode: wait for the paired reference, never time out
   double input_timeout_ = 0.05;  // [s] sim (shorter than torque_controller's: see config/controllers.yaml)
   std::unique_ptr<dynamic_reconfigure::Server<KinematicControllerConfig>> reconfigure_;
 };

@@ -27,11 +27,12 @@ class TorqueController {
   void compute();
   /// Live gain change: validated like the start-up values; a rejected change keeps the old gains.
   void reconfigure(TorqueControllerConfig& config, uint32_t level);
-  /// Zero torque for this odom stamp when the desired velocity is older than input_timeout.
+  /// Realtime only: zero torque for this odom stamp when the desired velocity is older than input_timeout.
   bool holdZeroIfStale(const nav_msgs::Odometry& odom);
 
   std::unique_ptr<core::SlidingModeController> smc_;
   double dt_ = 0.001;
+  bool lockstep_;               // run/mode: wait for the paired desired velocity, never time out
   double input_timeout_ = 0.1;  // [s] sim
   bool stale_ = false;          // the last output was the zero hold
   std::unique_ptr<dynamic_reconfigure::Server<TorqueControllerConfig>> reconfigure_;

@@ -1,0 +1,113 @@
+#include "sowing_robot/ros/plant_sim_plant.h"
+
+#include <rosgraph_msgs/Clock.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "sowing_robot/ros/msg_checks.h"
+
+namespace sowing_robot {
+
+namespace {
+core::State restAt(const core::Pose2D& start) {
+  core::State x0 = core::State::Zero();
+  x0[core::X] = start.x;
+  x0[core::Y] = start.y;
+  x0[core::THETA] = start.theta;
+  return x0;
+}
+}  // namespace
+
+SimulatedPlant::SimulatedPlant(ros::NodeHandle nh, const core::RobotParams& robot,
+                               const core::PlantDisturbance& disturbance, const core::Pose2D& start,
+                               const Rates& rates)
+    : rates_(rates), plant_(robot, disturbance) {
+  plant_.reset(restAt(start), 0.0);
+  visual_every_ = std::max<std::int64_t>(1, std::llround(1e9 / rates_.publish_rate / rates_.period_ns));
+  if (rates_.clock_rate > 0.0)
+    clock_every_ = std::max<std::int64_t>(1, std::llround(1e9 / rates_.clock_rate / rates_.period_ns));
+
+  clock_pub_ = nh.advertise<rosgraph_msgs::Clock>("/clock", 10);
+  odom_pub_ = nh.advertise<nav_msgs::Odometry>("odom", kLockstepQueue);
+  joint_pub_ = nh.advertise<sensor_msgs::JointState>("joint_states", 10);
+  path_pub_ = nh.advertise<nav_msgs::Path>("travelled_path", 1, true);
+
+  odom_msg_.header.frame_id = rates.odom_frame;
+  odom_msg_.child_frame_id = rates.base_frame;
+  path_ = PathBuffer(rates.odom_frame, 0.05, 10);
+  joint_msg_.name = {"right_wheel_joint", "left_wheel_joint"};
+  joint_msg_.position.resize(2);
+  joint_msg_.velocity.resize(2);
+}
+
+ros::Time SimulatedPlant::stampOf(std::int64_t k) const {
+  ros::Time t;
+  t.fromNSec(static_cast<std::uint64_t>(k * rates_.period_ns));
+  return t;
+}
+
+bool SimulatedPlant::step(const core::WheelTorques& torque) {
+  plant_.step(torque.right, torque.left, dt());
+  return healthy();
+}
+
+bool SimulatedPlant::healthy() const {
+  const core::State& s = plant_.state();
+  return std::isfinite(s.sum()) && std::fabs(s[core::V]) <= rates_.max_speed;
+}
+
+std::string SimulatedPlant::divergence() const {
+  const core::State& s = plant_.state();
+  char text[320];
+  std::snprintf(text, sizeof text,
+                "state diverged at t=%.6f s (x %g, y %g, theta %g, v %g, omega %g; max_speed %g m/s): stopping the "
+                "run instead of publishing garbage",
+                plant_.time(), s[core::X], s[core::Y], s[core::THETA], s[core::V], s[core::OMEGA], rates_.max_speed);
+  return text;
+}
+
+void SimulatedPlant::publish(std::int64_t k, bool visuals, bool clock) {
+  const ros::Time stamp = stampOf(k);
+  const core::State& s = plant_.state();
+  odom_msg_.header.stamp = stamp;
+  odom_msg_.pose.pose.position.x = s[core::X];
+  odom_msg_.pose.pose.position.y = s[core::Y];
+  odom_msg_.pose.pose.orientation = yawQuaternion(s[core::THETA]);
+  odom_msg_.twist.twist.linear.x = s[core::V];
+  odom_msg_.twist.twist.angular.z = s[core::OMEGA];
+  publishShared(odom_pub_, odom_msg_);
+  // Nothing in the control loop reads /clock (every node works on header stamps); it serves ROS time
+  // for logs, rosbag and rviz, so it may go out less often than every step (clock_rate), and after the
+  // state, off the loop's critical path (it has a link to every node).
+  if (clock || visuals || k % clock_every_ == 0) {
+    rosgraph_msgs::Clock c;
+    c.clock = stamp;
+    clock_pub_.publish(c);
+  }
+  if (!visuals) return;
+
+  geometry_msgs::TransformStamped tf;
+  tf.header = odom_msg_.header;
+  tf.child_frame_id = odom_msg_.child_frame_id;
+  tf.transform.translation.x = s[core::X];
+  tf.transform.translation.y = s[core::Y];
+  tf.transform.rotation = odom_msg_.pose.pose.orientation;
+  tf_.sendTransform(tf);
+
+  joint_msg_.header.stamp = stamp;
+  joint_msg_.position[0] = s[core::PHI_R];
+  joint_msg_.position[1] = s[core::PHI_L];
+  const core::State ds = plant_.derivative(s, 0.0, 0.0);  // wheel rates do not depend on torque
+  joint_msg_.velocity[0] = ds[core::PHI_R];
+  joint_msg_.velocity[1] = ds[core::PHI_L];
+  joint_pub_.publish(joint_msg_);
+
+  geometry_msgs::PoseStamped pose;
+  pose.header = odom_msg_.header;
+  pose.pose = odom_msg_.pose.pose;
+  if (path_.add(pose)) path_pub_.publish(path_.path());
+}
+
+}  // namespace sowing_robot
