@@ -116,9 +116,18 @@ class AnalyzeBag(unittest.TestCase):
         return os.path.join(self.tmp, name)
 
     # --- metrics -----------------------------------------------------------------------------------------
-    def test_stamp_to_sec_is_ros_time_to_sec(self):
-        for sec, nsec in ((0, 3000000), (7, 123000000), (24, 999000000), (1, 1)):
-            self.assertEqual(ab.stamp_to_sec(rospy.Time(sec, nsec)), float(sec) + 1e-9 * float(nsec))
+    def test_stamps_are_ros_time_to_sec(self):
+        path = self.path("stamps.bag")
+        stamps = ((0, 3000000), (7, 123000000), (24, 999000000), (1, 1), (1700000000, 123456789))
+        with rosbag.Bag(path, "w") as bag:
+            for i, (sec, nsec) in enumerate(stamps):
+                m = TrackingError()
+                m.header.stamp = rospy.Time(sec, nsec)
+                bag.write("/tracking_error", m, rospy.Time(1, i + 1))
+        s = ab.load_bag(path).get("/tracking_error")
+        expected = sorted((sec * 10**9 + nsec, float(sec) + 1e-9 * float(nsec)) for sec, nsec in stamps)
+        self.assertEqual(list(s.stamp_ns), [ns for ns, _ in expected])
+        self.assertEqual([t.hex() for t in s.stamps], [t.hex() for _, t in expected])
 
     def test_exponential_error_analytic(self):
         m = ab.load_bag(self.exp_bag).metrics()

@@ -1,6 +1,7 @@
 """The thesis-style PNG figures of one or more bags."""
-import math
 import os
+
+import numpy as np
 
 from sowing_robot.analyze_bag.bag import AXES
 
@@ -25,29 +26,42 @@ def projection_bounds():
     return bounds
 
 
-def _yaw(q):
-    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+def _yaw(odom):
+    """Yaw of /odom's orientation quaternions (array)."""
+    qx, qy, qz, qw = (odom["pose.pose.orientation." + c] for c in "xyzw")
+    return np.arctan2(2.0 * (qw * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz))
 
 
-def _markers(data):
-    """Obstacle shapes from /field_markers: (kind, x, y, sx, sy) in the odom frame."""
-    out = []
-    s = data.get("/field_markers")
-    if not len(s):
-        return out
-    last = s.msgs[-1]
-    for mk in getattr(last, "markers", [last]):
-        if mk.action != 0:  # ADD/MODIFY only
-            continue
-        p = mk.pose.position
-        if mk.type in (2, 3):  # SPHERE, CYLINDER
-            out.append(("circle", p.x, p.y, mk.scale.x, mk.scale.y))
-        elif mk.type == 1:  # CUBE
-            out.append(("box", p.x, p.y, mk.scale.x, mk.scale.y))
-        elif mk.type in (6, 7, 8):  # CUBE_LIST, SPHERE_LIST, POINTS
-            for q in mk.points:
-                out.append(("circle" if mk.type != 6 else "box", p.x + q.x, p.y + q.y, mk.scale.x, mk.scale.y))
-    return out
+# Points per plotted line: a figure is at most 1430 px wide (13 in at 110 dpi). Drawing, and above all the
+# legend's loc="best" (which tests every vertex), took ~15 s for the 110 k samples of two field runs.
+ENVELOPE_BUCKETS = 2000
+PATH_POINTS = 20000
+
+
+def envelope(t, y, buckets=ENVELOPE_BUCKETS):
+    """(t, y) thinned to the first, the smallest and the largest sample of each of `buckets` runs of samples
+    (and the tail), in time order: at the figures' resolution the same line, peaks included."""
+    t, y = np.asarray(t), np.asarray(y, dtype=float)
+    n = len(y)
+    k = n // buckets
+    if k < 2:
+        return t, y
+    m = (n // k) * k
+    base = np.arange(0, m, k)
+    runs = y[:m].reshape(-1, k)
+    finite = np.isfinite(runs)  # a NaN sample is no extreme (nor drawn)
+    keep = np.concatenate((base, base + np.argmin(np.where(finite, runs, np.inf), axis=1),
+                           base + np.argmax(np.where(finite, runs, -np.inf), axis=1), np.arange(m, n), [n - 1]))
+    keep = np.unique(keep)
+    return t[keep], y[keep]
+
+
+def thin(x, y, points=PATH_POINTS):
+    """Every k-th point of a path in the plane (and its last), at most points + 1 (the samples are 1 mm apart)."""
+    x, y = np.asarray(x), np.asarray(y)
+    k = max(1, -(-len(x) // points))  # ceil
+    keep = np.unique(np.append(np.arange(0, len(x), k), len(x) - 1)) if len(x) else np.arange(0)
+    return x[keep], y[keep]
 
 
 def write_plots(datas, out_dir, prefix):
@@ -55,7 +69,6 @@ def write_plots(datas, out_dir, prefix):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    import numpy as np
 
     os.makedirs(out_dir, exist_ok=True)
     colors = ["tab:blue", "tab:red", "tab:green", "tab:purple", "tab:orange", "tab:brown"]
@@ -66,8 +79,11 @@ def write_plots(datas, out_dir, prefix):
         kw.setdefault("lw", 1.3)
         return dict(color=colors[i % len(colors)], ls=styles[i % len(styles)], **kw)
 
-    def arr(series, fn):
-        return np.array(series.stamps), np.array([fn(m) for m in series.msgs], dtype=float)
+    def plot(ax, t, y, *args, **kw):
+        ax.plot(*envelope(t, y), *args, **kw)
+
+    def arr(series, field):
+        return series.stamps, np.asarray(series[field], dtype=float)
 
     def finish(fig, name, title):
         fig.suptitle(title, fontsize=13)
@@ -86,15 +102,14 @@ def write_plots(datas, out_dir, prefix):
     fig, ax = plt.subplots(figsize=(9, 6))
     ref = datas[0].get("/reference")
     if len(ref):
-        ax.plot([m.x for m in ref.msgs], [m.y for m in ref.msgs], "k--", lw=1.5, label="reference")
+        ax.plot(*thin(ref["x"], ref["y"]), "k--", lw=1.5, label="reference")
     for i, d in enumerate(datas):
         odom = d.get("/odom")
         if len(odom):
-            xs = [m.pose.pose.position.x for m in odom.msgs]
-            ys = [m.pose.pose.position.y for m in odom.msgs]
-            ax.plot(xs, ys, label="robot, %s" % d.label, **sty(i, lw=1.6))
+            xs, ys = odom["pose.pose.position.x"], odom["pose.pose.position.y"]
+            ax.plot(*thin(xs, ys), label="robot, %s" % d.label, **sty(i, lw=1.6))
             ax.plot(xs[0], ys[0], "o", color=colors[i % len(colors)], ms=5)
-    obstacles = _markers(datas[0])
+    obstacles = datas[0].obstacles()
     for k, (kind, x, y, sx, sy) in enumerate(obstacles):
         lab = "obstacle" if k == 0 else None
         if kind == "circle":
@@ -111,21 +126,18 @@ def write_plots(datas, out_dir, prefix):
     fig, axs = plt.subplots(3, 1, figsize=(10, 9), sharex=True)
     units = ("m", "m", "rad")
     if len(ref):
-        t = np.array(ref.stamps)
-        vals = (np.array([m.x for m in ref.msgs]), np.array([m.y for m in ref.msgs]),
-                np.unwrap(np.array([m.theta for m in ref.msgs])))
+        t = ref.stamps
+        vals = (ref["x"], ref["y"], np.unwrap(ref["theta"]))
         for a in range(3):
-            axs[a].plot(t, vals[a], "k--", lw=1.5, label="reference")
+            plot(axs[a], t, vals[a], "k--", lw=1.5, label="reference")
     for i, d in enumerate(datas):
         odom = d.get("/odom")
         if not len(odom):
             continue
-        t = np.array(odom.stamps)
-        vals = (np.array([m.pose.pose.position.x for m in odom.msgs]),
-                np.array([m.pose.pose.position.y for m in odom.msgs]),
-                np.unwrap(np.array([_yaw(m.pose.pose.orientation) for m in odom.msgs])))
+        t = odom.stamps
+        vals = (odom["pose.pose.position.x"], odom["pose.pose.position.y"], np.unwrap(_yaw(odom)))
         for a in range(3):
-            axs[a].plot(t, vals[a], label=d.label, **sty(i))
+            plot(axs[a], t, vals[a], label=d.label, **sty(i))
     for a, axis in enumerate(AXES):
         axs[a].set_ylabel("%s [%s]" % (axis, units[a]))
     axs[-1].set_xlabel("time [s]")
@@ -136,7 +148,7 @@ def write_plots(datas, out_dir, prefix):
     for i, d in enumerate(datas):
         t, ex, ey, eth, _ = d.error_samples()
         for a, e in enumerate((ex, ey, eth)):
-            axs[a].plot(t, e, label=d.label, **sty(i))
+            plot(axs[a], t, e, label=d.label, **sty(i))
     for a, axis in enumerate(AXES):
         axs[a].axhline(0.0, color="k", lw=0.6)
         axs[a].set_ylabel("e_%s [%s]" % (axis, units[a]))
@@ -149,20 +161,20 @@ def write_plots(datas, out_dir, prefix):
         c = colors[i % len(colors)]
         odom, des, st = d.get("/odom"), d.get("/desired_velocity"), d.get("/torque_controller/state")
         if len(des):
-            t, v = arr(des, lambda m: m.v)
-            axs[0, 0].plot(t, v, color=c, lw=4, alpha=0.3, label="desired v_d, %s" % d.label)
-            t, w = arr(des, lambda m: m.omega)
-            axs[1, 0].plot(t, w, color=c, lw=4, alpha=0.3, label="desired ω_d, %s" % d.label)
+            t, v = arr(des, "v")
+            plot(axs[0, 0], t, v, color=c, lw=4, alpha=0.3, label="desired v_d, %s" % d.label)
+            t, w = arr(des, "omega")
+            plot(axs[1, 0], t, w, color=c, lw=4, alpha=0.3, label="desired ω_d, %s" % d.label)
         if len(odom):
-            t, v = arr(odom, lambda m: m.twist.twist.linear.x)
-            axs[0, 0].plot(t, v, label="actual v, %s" % d.label, **sty(i))
-            t, w = arr(odom, lambda m: m.twist.twist.angular.z)
-            axs[1, 0].plot(t, w, label="actual ω, %s" % d.label, **sty(i))
+            t, v = arr(odom, "twist.twist.linear.x")
+            plot(axs[0, 0], t, v, label="actual v, %s" % d.label, **sty(i))
+            t, w = arr(odom, "twist.twist.angular.z")
+            plot(axs[1, 0], t, w, label="actual ω, %s" % d.label, **sty(i))
         if len(st):
-            t, ev = arr(st, lambda m: m.e_v)
-            axs[0, 1].plot(t, ev, label=d.label, **sty(i))
-            t, ew = arr(st, lambda m: m.e_omega)
-            axs[1, 1].plot(t, ew, label=d.label, **sty(i))
+            t, ev = arr(st, "e_v")
+            plot(axs[0, 1], t, ev, label=d.label, **sty(i))
+            t, ew = arr(st, "e_omega")
+            plot(axs[1, 1], t, ew, label=d.label, **sty(i))
     axs[0, 0].set_ylabel("v [m/s]")
     axs[1, 0].set_ylabel("ω [rad/s]")
     axs[0, 1].set_ylabel("e_v = v_d - v [m/s]")
@@ -180,10 +192,10 @@ def write_plots(datas, out_dir, prefix):
     for i, d in enumerate(datas):
         tq = d.get("/wheel_torque")
         if len(tq):
-            t, r = arr(tq, lambda m: m.right)
-            axs[0].plot(t, r, label=d.label, **sty(i, lw=1.0))
-            t, l_ = arr(tq, lambda m: m.left)
-            axs[1].plot(t, l_, label=d.label, **sty(i, lw=1.0))
+            t, r = arr(tq, "right")
+            plot(axs[0], t, r, label=d.label, **sty(i, lw=1.0))
+            t, l_ = arr(tq, "left")
+            plot(axs[1], t, l_, label=d.label, **sty(i, lw=1.0))
     axs[0].set_ylabel("τ_R [N·m]")
     axs[1].set_ylabel("τ_L [N·m]")
     axs[0].set_title("right wheel")
@@ -196,10 +208,10 @@ def write_plots(datas, out_dir, prefix):
     for i, d in enumerate(datas):
         st = d.get("/torque_controller/state")
         if len(st):
-            t, s1 = arr(st, lambda m: m.s_v)
-            axs[0].plot(t, s1, label=d.label, **sty(i, lw=1.0))
-            t, s2 = arr(st, lambda m: m.s_omega)
-            axs[1].plot(t, s2, label=d.label, **sty(i, lw=1.0))
+            t, s1 = arr(st, "s_v")
+            plot(axs[0], t, s1, label=d.label, **sty(i, lw=1.0))
+            t, s2 = arr(st, "s_omega")
+            plot(axs[1], t, s2, label=d.label, **sty(i, lw=1.0))
     axs[0].set_ylabel("S1 = s_v [m/s]")
     axs[1].set_ylabel("S2 = s_ω [rad/s]")
     for ax in axs:
@@ -210,15 +222,15 @@ def write_plots(datas, out_dir, prefix):
     # 7. adaptive estimates: left with the projection bounds, right zoomed on the estimates
     b = projection_bounds()
     fig, axs = plt.subplots(2, 2, figsize=(13, 7), sharex=True)
-    rows = ((lambda m: m.m0_hat, "m0_min", "m0_max", "m0_hat [kg]", "mass estimate"),
-            (lambda m: m.i0_hat, "i0_min", "i0_max", "I0_hat [kg·m²]", "inertia estimate"))
+    rows = (("m0_hat", "m0_min", "m0_max", "m0_hat [kg]", "mass estimate"),
+            ("i0_hat", "i0_min", "i0_max", "I0_hat [kg·m²]", "inertia estimate"))
     for r, (fn, lo, hi, ylabel, title) in enumerate(rows):
         for i, d in enumerate(datas):
             st = d.get("/torque_controller/state")
             if len(st):
                 t, v = arr(st, fn)
                 for c in range(2):
-                    axs[r, c].plot(t, v, label=d.label, **sty(i, lw=1.6))
+                    plot(axs[r, c], t, v, label=d.label, **sty(i, lw=1.6))
         axs[r, 0].axhline(b[lo], color="k", ls="--", lw=1.0, label="projection bounds [%g, %g]" % (b[lo], b[hi]))
         axs[r, 0].axhline(b[hi], color="k", ls="--", lw=1.0)
         axs[r, 0].set_ylabel(ylabel)

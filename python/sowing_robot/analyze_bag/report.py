@@ -1,4 +1,6 @@
 """Per-bag summary lines and the detection of recorder gaps."""
+import numpy as np
+
 from sowing_robot.analyze_bag.bag import TOPICS
 
 
@@ -6,17 +8,13 @@ def gaps(stamps):
     """(missing samples, gaps) in a series sampled at a constant period (the median step)."""
     if len(stamps) < 3:
         return 0, 0
-    steps = sorted(b - a for a, b in zip(stamps, stamps[1:]))
-    period = steps[len(steps) // 2]
+    steps = np.diff(np.asarray(stamps, dtype=float))
+    period = np.sort(steps)[len(steps) // 2]
     if not period > 0.0:
         return 0, 0
-    missing = count = 0
-    for a, b in zip(stamps, stamps[1:]):
-        k = int(round((b - a) / period))
-        if k >= 2:
-            missing += k - 1
-            count += 1
-    return missing, count
+    k = np.rint(steps / period)  # round half to even, as round()
+    k = k[k >= 2]
+    return int((k - 1).sum()), int(len(k))
 
 
 def summary(data, until=None):
@@ -43,14 +41,14 @@ def summary(data, until=None):
     torque = data.get("/wheel_torque")
     if len(torque):
         lines.append("- max |torque|: right %.4g N·m, left %.4g N·m"
-                     % (max(abs(m.right) for m in torque.msgs), max(abs(m.left) for m in torque.msgs)))
+                     % (np.abs(torque["right"]).max(), np.abs(torque["left"]).max()))
     state = data.get("/torque_controller/state")
     if len(state):
-        sat = [bool(m.saturated) for m in state.msgs]
-        runs = sum(1 for i, s in enumerate(sat) if s and (i == 0 or not sat[i - 1]))
-        lines.append("- saturated: %d control periods (%d episodes)" % (sum(sat), runs))
-        last = state.msgs[-1]
-        lines.append("- final m0_hat %.5g kg, i0_hat %.5g kg·m²  (mode %s)" % (last.m0_hat, last.i0_hat, last.mode))
+        sat = np.asarray(state["saturated"], dtype=bool)
+        runs = int((sat & ~np.concatenate(([False], sat[:-1]))).sum())  # rising edges
+        lines.append("- saturated: %d control periods (%d episodes)" % (int(sat.sum()), runs))
+        lines.append("- final m0_hat %.5g kg, i0_hat %.5g kg·m²  (mode %s)"
+                     % (state["m0_hat"][-1], state["i0_hat"][-1], state["mode"][-1]))
     others = ["%s %d" % (topic, len(data.get(topic))) for topic in TOPICS if topic != "/tracking_error"]
     lines.append("- other topics (unique stamps): " + ", ".join(others))
     return "\n".join(lines)
