@@ -145,6 +145,12 @@ class DeserializationError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// A message of the expected type name with another definition (md5), e.g. recorded before a field was added.
+class DefinitionMismatch : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 /// One topic being read: its columns and how to fill them from a message.
 class TopicReader {
  public:
@@ -210,8 +216,9 @@ class TypedReader : public TopicReader {
     } catch (const ros::Exception& e) {  // StreamOverrunException and friends: a corrupt message
       throw DeserializationError(m.getTopic() + ": " + e.what());
     }
-    if (!msg) throw DeserializationError(m.getTopic() + ": not a " + ros::message_traits::datatype<T>() +
-                                         " (type " + m.getDataType() + ", md5 " + m.getMD5Sum() + ")");
+    if (!msg)
+      throw DefinitionMismatch(m.getTopic() + ": " + m.getDataType() + " recorded with another definition (md5 " +
+                               m.getMD5Sum() + ", this build's " + ros::message_traits::md5sum<T>() + ")");
     return msg;
   }
 
@@ -422,6 +429,7 @@ PYBIND11_MODULE(_bag, m) {
   static py::exception<rosbag::BagFormatException> format_error(m, "BagFormatError", bag_error.ptr());
   static py::exception<rosbag::BagIOException> io_error(m, "BagIOError", bag_error.ptr());
   static py::exception<DeserializationError> deser(m, "DeserializationError", bag_error.ptr());
+  static py::exception<DefinitionMismatch> mismatch(m, "DefinitionMismatch", bag_error.ptr());
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);
@@ -433,6 +441,8 @@ PYBIND11_MODULE(_bag, m) {
       io_error(e.what());
     } catch (const DeserializationError& e) {
       deser(e.what());
+    } catch (const DefinitionMismatch& e) {
+      mismatch(e.what());
     } catch (const rosbag::BagException& e) {
       bag_error(e.what());
     } catch (const ros::Exception& e) {  // serialization errors while reading the index or a chunk

@@ -233,7 +233,10 @@ sliding-mode controller on the thesis's line, as the lockstep node pipeline does
         AxisMetrics a;
         timeDomainMetrics(tv, ev, a);
         py::dict d;
-        for (const char* k : {"rise_time", "settling_time", "overshoot", "peak"}) d[k] = axisToDict(a)[k];
+        d["rise_time"] = a.rise_time;
+        d["settling_time"] = a.settling_time;
+        d["overshoot"] = a.overshoot;
+        d["peak"] = a.peak;
         return d;
       },
       py::arg("t"), py::arg("e"), "core::timeDomainMetrics of one series: rise_time, settling_time, overshoot, peak.");

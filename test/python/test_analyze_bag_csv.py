@@ -168,3 +168,24 @@ def test_envelope_keeps_the_extremes():
     assert np.array_equal(short_t, t[:3000])
     x, yp = thin(np.arange(110001.0), np.zeros(110001))
     assert len(x) <= 20002 and x[-1] == 110000.0
+
+
+def test_another_message_definition_is_a_one_line_error(tmp_path):
+    """A bag recorded with an older TrackingError (no robot-frame errors): exit 3, one line naming both md5s."""
+    import genpy.dynamic
+    import rosbag
+    import rospy
+    old = genpy.dynamic.generate_dynamic(
+        "sowing_robot/TrackingError", "Header header\nfloat64 x\nfloat64 y\nfloat64 theta\n" + "=" * 80 +
+        "\nMSG: std_msgs/Header\nuint32 seq\ntime stamp\nstring frame_id\n")["sowing_robot/TrackingError"]
+    path = str(tmp_path / "old.bag")
+    with rosbag.Bag(path, "w") as bag:
+        for k in range(3):
+            m = old()
+            m.header.stamp = rospy.Time(0, k * 1000000)
+            bag.write("/tracking_error", m, rospy.Time(1, k + 1))
+    proc = subprocess.run([sys.executable, script(), path, "--no-plots"], stdout=subprocess.PIPE,
+                          stderr=subprocess.PIPE, universal_newlines=True, timeout=120)
+    lines = proc.stderr.strip().splitlines()
+    assert proc.returncode == 3 and len(lines) == 1, proc.stderr
+    assert "another definition" in lines[0] and old._md5sum in lines[0] and lines[0].startswith("analyze_bag: ")

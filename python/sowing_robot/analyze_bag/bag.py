@@ -143,6 +143,8 @@ def load_bag(path):
             chosen = _select_topics(types, path)
             columns = reader.read({name: types[name] for name in chosen.values()})
             bag_start, bag_end = reader.start_time, reader.end_time
+        except _bag.DefinitionMismatch as e:
+            raise BagError("%s: %s: analyze_bag reads the message definitions of this build" % (path, _one_line(e)))
         except _bag.DeserializationError as e:
             raise BagError("%s: corrupt message while reading: %s" % (path, _one_line(e)))
         except _bag.BagError as e:

@@ -20,8 +20,8 @@ TABLE_FIELDS = ("ise", "itse", "iae", "itae", "rise_time", "settling_time", "ove
 
 
 def bag_metrics(data, until=None):
-    """core.MetricsAccumulator over the bag's /tracking_error samples (stamp <= until + 1 ns-ish if given):
-    {axis: {field: value}}. BagError when fewer than 2 samples are usable."""
+    """core.MetricsAccumulator over the bag's /tracking_error samples (those with t <= until + 1e-9 s if until is
+    given): {axis: {field: value}}. BagError when fewer than 2 samples are usable (finite)."""
     t, ex, ey, eth = data.error_arrays()
     if until is not None:
         n = int((t <= until + 1e-9).sum())  # t is sorted: a prefix
