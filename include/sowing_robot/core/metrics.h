@@ -1,5 +1,5 @@
-// Tracking performance indices of Tables 5.5 and 5.6, computed the same way in-process, in the
-// metrics node and in analyze_bag (which re-implements these definitions in Python; README lists them).
+// Tracking performance indices of Tables 5.5 and 5.6, computed by this code in-process, in the
+// metrics node and in analyze_bag (through the Python module sowing_robot.core; README lists them).
 #pragma once
 
 #include <array>
