@@ -4,6 +4,7 @@
 #include "sowing_robot/ros/component_params.h"
 #include "sowing_robot/ros/plant_sim_lockstep.h"
 #include "sowing_robot/ros/plant_sim_realtime.h"
+#include "sowing_robot/ros/urdf_params.h"
 
 namespace sowing_robot {
 
@@ -15,7 +16,13 @@ PlantSim::PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh) {
   const core::RunSettings run = loadRunSettings(nh, p);
   core::PlantSimSettings settings;
   loadTable(p, core::PlantSimSettings::table(), settings);
-  requireValid(p, core::firstError({robot_error, robot_error.empty() ? robot.validate() : "", settings.validate()}));
+  // The body checked for contacts is the URDF's collision footprint (the one source of the robot's shape).
+  core::Footprint footprint;
+  std::string key, xml, footprint_error;
+  if (robot_error.empty() && pnh.searchParam("robot_description", key) && pnh.getParam(key, xml))
+    footprint_error = footprintFromUrdf(xml, footprint);
+  requireValid(p, core::firstError({robot_error, robot_error.empty() ? robot.validate() : "", footprint_error,
+                                    settings.validate()}));
   cfg_.lockstep = run.lockstep;
   cfg_.period_ns = run.periodNs();
   cfg_.duration = run.duration;
@@ -40,7 +47,7 @@ PlantSim::PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh) {
   rates.max_speed = cfg_.max_speed;
   rates.odom_frame = run.odom_frame;
   rates.base_frame = run.base_frame;
-  plant_ = std::make_unique<SimulatedPlant>(nh, robot, disturbance, start, rates);
+  plant_ = std::make_unique<SimulatedPlant>(nh, robot, disturbance, start, rates, footprint);
   const core::Plant& plant = plant_->plant();
   logSettings("plant_sim", core::RunSettings::table(), run, "run/");
   logSettings("plant_sim", core::PlantSimSettings::table(), settings);

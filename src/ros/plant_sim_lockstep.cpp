@@ -61,7 +61,7 @@ void LockstepDriver::torqueCallback(const WheelTorque::ConstPtr& msg) {
   }
 }
 
-void LockstepDriver::reportFinished() const {
+void LockstepDriver::reportFinished() {
   const double wall = ros::WallTime::now().toSec() - protocol_.startedAt();
   const std::string repeats =
       protocol_.repeats() > 0 ? "; " + std::to_string(protocol_.repeats()) + " repeated answers ignored" : "";
@@ -69,6 +69,7 @@ void LockstepDriver::reportFinished() const {
            "%ld late and %ld non-finite torques ignored%s",
            cfg_.duration, wall, wall > 0 ? cfg_.duration / wall : 0.0, protocol_.late(), protocol_.nonFinite(),
            repeats.c_str());
+  plant_.reportContacts();
 }
 
 bool LockstepDriver::loopConnected() const {

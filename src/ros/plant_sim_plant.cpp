@@ -22,7 +22,7 @@ core::State restAt(const core::Pose2D& start) {
 
 SimulatedPlant::SimulatedPlant(ros::NodeHandle nh, const core::RobotParams& robot,
                                const core::PlantDisturbance& disturbance, const core::Pose2D& start,
-                               const Rates& rates)
+                               const Rates& rates, const core::Footprint& footprint)
     : rates_(rates), plant_(robot, disturbance) {
   plant_.reset(restAt(start), 0.0);
   visual_every_ = std::max<std::int64_t>(1, std::llround(1e9 / rates_.publish_rate / rates_.period_ns));
@@ -40,6 +40,22 @@ SimulatedPlant::SimulatedPlant(ros::NodeHandle nh, const core::RobotParams& robo
   joint_msg_.name = {"right_wheel_joint", "left_wheel_joint"};
   joint_msg_.position.resize(2);
   joint_msg_.velocity.resize(2);
+  contacts_ = std::make_unique<PlantContacts>(nh, footprint, rates.odom_frame, rates.base_frame);
+}
+
+SimulatedPlant::~SimulatedPlant() {
+  if (contacts_reported_) return;
+  // stdout, not rosconsole: at shutdown the logger may already be gone.
+  std::printf("plant_sim: %s", contacts_->finish().c_str());  // the report ends with a newline
+  std::fflush(stdout);
+}
+
+void SimulatedPlant::reportContacts() {
+  if (contacts_reported_) return;
+  contacts_reported_ = true;
+  std::string report = contacts_->finish();
+  if (!report.empty() && report.back() == '\n') report.pop_back();
+  ROS_INFO("plant_sim: %s", report.c_str());
 }
 
 ros::Time SimulatedPlant::stampOf(std::int64_t k) const {
@@ -50,7 +66,10 @@ ros::Time SimulatedPlant::stampOf(std::int64_t k) const {
 
 bool SimulatedPlant::step(const core::WheelTorques& torque) {
   plant_.step(torque.right, torque.left, dt());
-  return healthy();
+  if (!healthy()) return false;
+  const core::State& s = plant_.state();
+  contacts_->update(plant_.time(), {s[core::X], s[core::Y], s[core::THETA]});
+  return true;
 }
 
 bool SimulatedPlant::healthy() const {

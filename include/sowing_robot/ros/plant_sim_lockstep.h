@@ -48,7 +48,7 @@ class LockstepDriver : public PlantSimDriver {
   std::string torqueSources() const;
   void report(const core::LockstepProtocol::Supervision& s) const;
   std::string giveUpReason(const core::LockstepProtocol::Supervision& s) const;
-  void reportFinished() const;
+  void reportFinished();
 
   SimulatedPlant& plant_;
   Config cfg_;

@@ -9,12 +9,14 @@
 #include <tf2_ros/transform_broadcaster.h>
 
 #include <cstdint>
+#include <memory>
 #include <string>
 
 #include "sowing_robot/core/plant.h"
 #include "sowing_robot/core/robot_params.h"
 #include "sowing_robot/core/types.h"
 #include "sowing_robot/ros/path_buffer.h"
+#include "sowing_robot/ros/plant_contacts.h"
 
 namespace sowing_robot {
 
@@ -30,7 +32,11 @@ class SimulatedPlant {
 
   /// Starts the plant at rest at `start` and advertises its topics on `nh`.
   SimulatedPlant(ros::NodeHandle nh, const core::RobotParams& robot, const core::PlantDisturbance& disturbance,
-                 const core::Pose2D& start, const Rates& rates);
+                 const core::Pose2D& start, const Rates& rates, const core::Footprint& footprint);
+  /// Prints the contact report if the run did not (a realtime run, or one stopped early).
+  ~SimulatedPlant();
+  /// The contact report (contacts of the body, minimum clearance) as one log line, once.
+  void reportContacts();
 
   /// One control period with `torque`; false when the state is then non-finite or faster than max_speed
   /// (it must not be published: divergence() says what went wrong).
@@ -57,6 +63,8 @@ class SimulatedPlant {
   std::int64_t visual_every_ = 20;  // publish visuals every n steps
   std::int64_t clock_every_ = 1;    // publish /clock every n steps
   ros::Publisher clock_pub_, odom_pub_, joint_pub_, path_pub_;
+  std::unique_ptr<PlantContacts> contacts_;  // the body against the plan's obstacles, every step
+  bool contacts_reported_ = false;
   tf2_ros::TransformBroadcaster tf_;
   nav_msgs::Odometry odom_msg_;
   sensor_msgs::JointState joint_msg_;
