@@ -138,24 +138,21 @@ int main(int argc, char** argv) {
     check("Kanayama::compute", steps, true, [&](long k) {
       cmd = kan.compute(ref, Pose2D{-1.0 + 1e-4 * k, 0.1, 0.05}, 0.9, 0.01);
     });
-    check("SlidingModeController::update (ATSMC, sign)", steps, true, [&](long) {
-      g_sink = g_sink + smc.update(cmd, 0.9, 0.01, dt).torques.right;
-    });
+    check("SlidingModeController::update (ATSMC, sign)", steps, true,
+          [&](long) { g_sink = g_sink + smc.update(cmd, 0.9, 0.01, dt).torques.right; });
     SlidingModeParams tsmc = sc.sliding;
     tsmc.adaptive = false;
     tsmc.switching.type = SwitchType::Tanh;
     SlidingModeController smc2(tsmc, sc.robot);
-    check("SlidingModeController::update (TSMC, tanh)", steps, true, [&](long) {
-      g_sink = g_sink + smc2.update(cmd, 0.9, 0.01, dt).torques.right;
-    });
+    check("SlidingModeController::update (TSMC, tanh)", steps, true,
+          [&](long) { g_sink = g_sink + smc2.update(cmd, 0.9, 0.01, dt).torques.right; });
     g_sink = g_sink + cmd.v;
   }
   {
     PotentialField pf = bench::thesisPotentialField();
     pf.reset();
-    check("PotentialField::next (3 obstacles, 0..25 s, passes (20,3))", 25000, false, [&](long k) {
-      g_sink = g_sink + pf.next(1e-3 * k).pose.y;
-    });
+    check("PotentialField::next (3 obstacles, 0..25 s, passes (20,3))", 25000, false,
+          [&](long k) { g_sink = g_sink + pf.next(1e-3 * k).pose.y; });
   }
   {
     LineReference line = bench::thesisLine();
@@ -168,21 +165,17 @@ int main(int argc, char** argv) {
   }
   {
     LineReference line = bench::thesisLine();
-    checkRun("runClosedLoop(keep_samples=false)", true, [&](const Scenario& s) {
-      g_sink = g_sink + runClosedLoop(s, line, false).metrics[AXIS_Y].itae;
-    });
+    checkRun("runClosedLoop(keep_samples=false)", true,
+             [&](const Scenario& s) { g_sink = g_sink + runClosedLoop(s, line, false).metrics[AXIS_Y].itae; });
     long calls = 0;
     const std::function<void(const LoopSample&)> trace = [&calls](const LoopSample&) { ++calls; };
-    checkRun("runClosedLoop(keep_samples=false, trace)", true, [&](const Scenario& s) {
-      g_sink = g_sink + runClosedLoop(s, line, false, trace).metrics[AXIS_Y].itae;
-    });
-    checkRun("runClosedLoop(keep_samples=true) (reserves up front)", false, [&](const Scenario& s) {
-      g_sink = g_sink + runClosedLoop(s, line, true).metrics[AXIS_Y].itae;
-    });
+    checkRun("runClosedLoop(keep_samples=false, trace)", true,
+             [&](const Scenario& s) { g_sink = g_sink + runClosedLoop(s, line, false, trace).metrics[AXIS_Y].itae; });
+    checkRun("runClosedLoop(keep_samples=true) (reserves up front)", false,
+             [&](const Scenario& s) { g_sink = g_sink + runClosedLoop(s, line, true).metrics[AXIS_Y].itae; });
     PotentialField pf = bench::thesisPotentialField();
-    checkRun("runClosedLoop(keep_samples=false), potential field", false, [&](const Scenario& s) {
-      g_sink = g_sink + runClosedLoop(s, pf, false).metrics[AXIS_Y].itae;
-    });
+    checkRun("runClosedLoop(keep_samples=false), potential field", false,
+             [&](const Scenario& s) { g_sink = g_sink + runClosedLoop(s, pf, false).metrics[AXIS_Y].itae; });
     TuningObjective obj;
     obj.torque_weight = 1e-3;
     obj.chattering_weight = 1e-3;

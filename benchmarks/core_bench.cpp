@@ -104,8 +104,8 @@ void BM_PsoIteration(benchmark::State& state) {
   long evaluations = 0;
   for (auto _ : state) {
     pso.seed = seed++;  // a fresh swarm each time, so no run is special
-    const PsoResult r = psoMinimize(
-        pso, [&problem](const std::vector<double>& x, int t) { return problem.evaluate(x, t).total; });
+    const PsoResult r =
+        psoMinimize(pso, [&problem](const std::vector<double>& x, int t) { return problem.evaluate(x, t).total; });
     evaluations += r.evaluations;
     g_sink = r.best_cost;
   }

@@ -42,12 +42,18 @@ int main(int argc, char** argv) {
         thread_counts.push_back(std::atoi(list.substr(pos, comma - pos).c_str()));
         pos = comma + 1;
       }
-    } else if (a == "--particles") pso.particles = std::atoi(v);
-    else if (a == "--iterations") pso.iterations = std::atoi(v);
-    else if (a == "--duration") sc.duration = std::strtod(v, nullptr);
-    else if (a == "--rate") sc.control_period_ns = static_cast<std::int64_t>(1e9 / std::strtod(v, nullptr) + 0.5);
-    else if (a == "--seed") pso.seed = std::strtoull(v, nullptr, 10);
-    else if (a == "--mode") sc.sliding.adaptive = std::strcmp(v, "tsmc") != 0;
+    } else if (a == "--particles")
+      pso.particles = std::atoi(v);
+    else if (a == "--iterations")
+      pso.iterations = std::atoi(v);
+    else if (a == "--duration")
+      sc.duration = std::strtod(v, nullptr);
+    else if (a == "--rate")
+      sc.control_period_ns = static_cast<std::int64_t>(1e9 / std::strtod(v, nullptr) + 0.5);
+    else if (a == "--seed")
+      pso.seed = std::strtoull(v, nullptr, 10);
+    else if (a == "--mode")
+      sc.sliding.adaptive = std::strcmp(v, "tsmc") != 0;
     else {
       std::fprintf(stderr, "pso_tuning_bench: unknown argument '%s'\n", a.c_str());
       return 2;
@@ -57,14 +63,16 @@ int main(int argc, char** argv) {
   const LineReference reference(1.0, 3.0, 0.0);
   const std::vector<GainBounds> bounds = defaultGainBounds();
   const TuningObjective objective;
-  std::printf("PSO tuning bench: %d particles x (%d + 1) iterations, %s, %.4g s at %.0f Hz per evaluation, "
-              "%u hardware threads\n",
-              pso.particles, pso.iterations, sc.sliding.adaptive ? "ATSMC" : "TSMC", sc.duration,
-              1e9 / static_cast<double>(sc.control_period_ns), std::thread::hardware_concurrency());
+  std::printf(
+      "PSO tuning bench: %d particles x (%d + 1) iterations, %s, %.4g s at %.0f Hz per evaluation, "
+      "%u hardware threads\n",
+      pso.particles, pso.iterations, sc.sliding.adaptive ? "ATSMC" : "TSMC", sc.duration,
+      1e9 / static_cast<double>(sc.control_period_ns), std::thread::hardware_concurrency());
   // Evaluations whose run stopped once it could not beat its particle's personal best ("cut short") are
   // the tuner's bound (tuning.h): the same search as with whole runs, fewer simulated seconds.
-  std::printf("\n| threads | wall [s] | speed-up | evaluations | cut short | ms / evaluation | simulated s | "
-              "sim s / wall s | sim s / wall s / thread | initial best | best cost |\n");
+  std::printf(
+      "\n| threads | wall [s] | speed-up | evaluations | cut short | ms / evaluation | simulated s | "
+      "sim s / wall s | sim s / wall s / thread | initial best | best cost |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
   double first_wall = 0.0, first_best = 0.0;
   bool same = true;
@@ -86,8 +94,8 @@ int main(int argc, char** argv) {
     const double sim = r.simulated_s;
     std::printf("| %d | %.3f | %.2f | %ld | %ld | %.3f | %.0f | %.0f | %.0f | %.6g | %.6g |\n", r.threads, r.wall_s,
                 first_wall / r.wall_s, r.pso.evaluations, r.evaluations_cut,
-                1e3 * r.wall_s / static_cast<double>(r.pso.evaluations), sim, sim / r.wall_s, sim / r.wall_s / r.threads,
-                r.initial_best_cost, r.pso.best_cost);
+                1e3 * r.wall_s / static_cast<double>(r.pso.evaluations), sim, sim / r.wall_s,
+                sim / r.wall_s / r.threads, r.initial_best_cost, r.pso.best_cost);
     std::fflush(stdout);
     if (k + 1 == thread_counts.size()) {
       std::printf("\nbest gains:");

@@ -6,7 +6,8 @@
 namespace sowing_robot {
 namespace core {
 
-ContactMonitor::ContactMonitor(Footprint footprint, std::vector<Obstacle> obstacles) : footprint_(std::move(footprint)) {
+ContactMonitor::ContactMonitor(Footprint footprint, std::vector<Obstacle> obstacles)
+    : footprint_(std::move(footprint)) {
   if (!footprint_.empty()) {
     const std::string e = footprint_.validate();
     if (!e.empty()) throw std::invalid_argument("ContactMonitor: " + e);

@@ -11,9 +11,9 @@ namespace sowing_robot {
 namespace core {
 
 namespace {
-constexpr double kPlanSlack = 1e-3;   ///< the plan keeps this much more than the clearance [m]
-constexpr double kCheckStep = 0.02;   ///< along-row sampling of a detour against other obstacles [m]
-constexpr double kMinRamp = 0.05;     ///< a shorter up ramp (obstacle at the row start) is no ramp [m]
+constexpr double kPlanSlack = 1e-3;  ///< the plan keeps this much more than the clearance [m]
+constexpr double kCheckStep = 0.02;  ///< along-row sampling of a detour against other obstacles [m]
+constexpr double kMinRamp = 0.05;    ///< a shorter up ramp (obstacle at the row start) is no ramp [m]
 
 std::string fmt(const char* f, double a, double b = 0.0, double c = 0.0, double d = 0.0) {
   char buf[256];
@@ -63,7 +63,8 @@ const ParamTable<AvoidanceParams>& avoidanceTable() {
       number("safety_margin", &A::safety_margin, 0.1, Limits::nonNegative(), "m",
              "body clearance the plan keeps from every obstacle"),
       number("max_curvature", &A::max_curvature, 2.0, Limits::positive(), "1/m", "curvature of the detours"),
-      number("max_yaw_rate", &A::max_yaw_rate, 1.5, Limits::positive(), "rad/s", "|omega| of the reference on a detour"),
+      number("max_yaw_rate", &A::max_yaw_rate, 1.5, Limits::positive(), "rad/s",
+             "|omega| of the reference on a detour"),
       number("max_lateral_accel", &A::max_lateral_accel, 1.5, Limits::positive(), "m/s^2",
              "|v omega| of the reference on a detour"),
       number("max_offset", &A::max_offset, 5.0, Limits::positive(), "m",
@@ -179,7 +180,7 @@ RowPlan planRow(int row, const Eigen::Vector2d& p0, double heading, double lengt
       first_a = std::min(first_a, loc[i].a);
       last_a = std::max(last_a, loc[i].a);
     }
-    double in_lo = 0.0, in_hi = std::max(0.0, first_a - lo);  // shift of the plateau start
+    double in_lo = 0.0, in_hi = std::max(0.0, first_a - lo);   // shift of the plateau start
     double out_lo = 0.0, out_hi = std::max(0.0, hi - last_a);  // shift of the plateau end
     for (int it = 0; it < 30; ++it) {
       Detour t = d;
@@ -203,7 +204,8 @@ RowPlan planRow(int row, const Eigen::Vector2d& p0, double heading, double lengt
     for (const auto& g : groups) detours.push_back(build(g));
     std::vector<std::size_t> order(detours.size());
     for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
-    std::sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return detours[x].begin < detours[y].begin; });
+    std::sort(order.begin(), order.end(),
+              [&](std::size_t x, std::size_t y) { return detours[x].begin < detours[y].begin; });
     bool changed = false;
     for (std::size_t k = 0; k + 1 < order.size() && !changed; ++k) {
       if (detours[order[k + 1]].begin < detours[order[k]].end()) {  // overlapping: one group
@@ -256,8 +258,8 @@ RowPlan planRow(int row, const Eigen::Vector2d& p0, double heading, double lengt
         const Eigen::Vector2d q = p0 + stop * u;
         status.code = code;
         status.stop_point = q;
-        status.reason = why + fmt("; stopping on the row at (%.2f, %.2f), %.2f m before the row end", q.x(), q.y(),
-                                  length - stop);
+        status.reason =
+            why + fmt("; stopping on the row at (%.2f, %.2f), %.2f m before the row end", q.x(), q.y(), length - stop);
       }
     };
     const double h = std::fabs(d.offset);
@@ -269,9 +271,10 @@ RowPlan planRow(int row, const Eigen::Vector2d& p0, double heading, double lengt
       break;
     }
     if (d.end() > length) {
-      cutHere(AvoidanceStatus::Code::kStoppedShort,
-              who + fmt(": the row end lies inside or %.2f m behind the inflated obstacles, too close to rejoin the row",
-                        std::max(0.0, length - (d.begin + d.ramp_in + d.plateau))));
+      cutHere(
+          AvoidanceStatus::Code::kStoppedShort,
+          who + fmt(": the row end lies inside or %.2f m behind the inflated obstacles, too close to rejoin the row",
+                    std::max(0.0, length - (d.begin + d.ramp_in + d.plateau))));
       break;
     }
     if (d.begin < 0.0) {  // the group is near the row start: a steeper up ramp, driven slower

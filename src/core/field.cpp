@@ -24,12 +24,6 @@ void rowSpeeds(const FieldParams& p, int i, double& v_in, double& v_out) {
   v_out = i == p.rows - 1 ? 0.0 : p.turn_speed;
 }
 
-std::string formatNumber(double v) {
-  char b[32];
-  std::snprintf(b, sizeof(b), "%.6g", v);
-  return b;
-}
-
 }  // namespace
 
 const ParamTable<FieldParams>& fieldTable() {
@@ -42,13 +36,15 @@ const ParamTable<FieldParams>& fieldTable() {
                "distance between neighbouring rows"),
         number("field/start_x", &F::start_x, 0.0, Limits::any(), "m", "start of the first row, x"),
         number("field/start_y", &F::start_y, 3.0, Limits::any(), "m", "start of the first row, y"),
-        number("field/heading", &F::heading, 0.0, Limits::any(), "rad", "direction of the first row; odd rows run back"),
+        number("field/heading", &F::heading, 0.0, Limits::any(), "rad",
+               "direction of the first row; odd rows run back"),
         flag("field/rows_to_left", &F::rows_to_left, true, "the second row lies left of the first one's direction"),
         number("field/row_speed", &F::row_speed, 1.0, Limits::positive(), "m/s", "v_r on the rows"),
         number("field/turn_speed", &F::turn_speed, 0.5, Limits::positive(), "m/s",
                "speed on the headland turns (above potential/heading_hold_speed, up to field/row_speed)"),
-        number("field/min_turn_radius", &F::min_turn_radius, 0.5, Limits::positive(), "m",
-               "the turns keep |curvature| <= 1/min_turn_radius; row_spacing below ~2 min_turn_radius gives bulb turns"),
+        number(
+            "field/min_turn_radius", &F::min_turn_radius, 0.5, Limits::positive(), "m",
+            "the turns keep |curvature| <= 1/min_turn_radius; row_spacing below ~2 min_turn_radius gives bulb turns"),
         number("field/max_accel", &F::max_accel, 0.5, Limits::positive(), "m/s^2",
                "peak |v_dot| of the half-cosine speed ramps"),
         number("field/max_curvature_rate", &F::max_curvature_rate, 10.0, Limits::positive(), "1/m^2",
@@ -68,11 +64,11 @@ std::string FieldParams::validate() const {
   std::string e = firstError({fieldTable().checkRanges(*this), avoidance.validate()});
   if (!e.empty()) return e;
   if (turn_speed > row_speed)
-    return "field/turn_speed = " + formatNumber(turn_speed) + " m/s must be <= field/row_speed = " +
-           formatNumber(row_speed) + " m/s";
+    return "field/turn_speed = " + formatNumber(turn_speed) +
+           " m/s must be <= field/row_speed = " + formatNumber(row_speed) + " m/s";
   if (turn_speed <= potential.heading_hold_speed)
-    return "field/turn_speed = " + formatNumber(turn_speed) + " m/s must be above potential/heading_hold_speed = " +
-           formatNumber(potential.heading_hold_speed) + " m/s";
+    return "field/turn_speed = " + formatNumber(turn_speed) +
+           " m/s must be above potential/heading_hold_speed = " + formatNumber(potential.heading_hold_speed) + " m/s";
   const double rate_min = 0.5 / (min_turn_radius * min_turn_radius);
   if (max_curvature_rate < rate_min)
     return "field/max_curvature_rate = " + formatNumber(max_curvature_rate) +
@@ -95,10 +91,9 @@ std::string FieldParams::validate() const {
 
 namespace {
 // 5-point Gauss-Legendre on [0, 1].
-constexpr double kGaussX[5] = {0.04691007703066800, 0.23076534494715845, 0.5, 0.76923465505284155,
-                               0.95308992296933200};
-constexpr double kGaussW[5] = {0.11846344252809454, 0.23931433524968324, 0.28444444444444444,
-                               0.23931433524968324, 0.11846344252809454};
+constexpr double kGaussX[5] = {0.04691007703066800, 0.23076534494715845, 0.5, 0.76923465505284155, 0.95308992296933200};
+constexpr double kGaussW[5] = {0.11846344252809454, 0.23931433524968324, 0.28444444444444444, 0.23931433524968324,
+                               0.11846344252809454};
 }  // namespace
 
 void HeadlandTurn::segmentState(const Segment& g, double tau, double& theta, double& kappa, double& dkappa) {
@@ -134,8 +129,8 @@ bool HeadlandTurn::build(double k, double lambda, double away, double rate) {
   struct Piece {
     double k0, k1, length;
   };
-  Piece pieces[7] = {{0.0, ka, rampLength(ka, rate)}, {ka, ka, away}, {ka, k, rampLength(k - ka, rate)},
-                     {k, k, 0.0}, {k, ka, rampLength(k - ka, rate)}, {ka, ka, away}, {ka, 0.0, rampLength(ka, rate)}};
+  Piece pieces[7] = {{0.0, ka, rampLength(ka, rate)},   {ka, ka, away}, {ka, k, rampLength(k - ka, rate)}, {k, k, 0.0},
+                     {k, ka, rampLength(k - ka, rate)}, {ka, ka, away}, {ka, 0.0, rampLength(ka, rate)}};
   double heading = 0.0;
   for (int i = 0; i < 7; ++i)
     if (i != 3) heading += 0.5 * (pieces[i].k0 + pieces[i].k1) * pieces[i].length;
@@ -328,7 +323,8 @@ void FieldPath::addRowPhases(double L, double v_in, double v_out, const Element&
   if (m > 2) {
     // Backward: each window slow enough to brake for the next; forward: no faster than it can speed up
     // to. The row start and end speeds are fixed; where they cannot be met, the bounds do not hold.
-    for (std::size_t j = m - 2; j >= 1; --j) knots[j].w = std::min(knots[j].w, reach(knots[j + 1].w, knots[j + 1].b - knots[j].e));
+    for (std::size_t j = m - 2; j >= 1; --j)
+      knots[j].w = std::min(knots[j].w, reach(knots[j + 1].w, knots[j + 1].b - knots[j].e));
     for (std::size_t j = 0; j + 1 < m; ++j) {
       const double gap = knots[j + 1].b - knots[j].e;
       if (j + 1 < m - 1) knots[j + 1].w = std::min(knots[j + 1].w, reach(knots[j].w, gap));
@@ -381,7 +377,8 @@ TargetState FieldPath::at(double t) const {
   double s, sd, sdd, sddd;
   arcLength(t, s, sd, sdd, sddd);
   s = std::clamp(s, 0.0, total_length_);
-  auto it = std::upper_bound(elements_.begin(), elements_.end(), s, [](double v, const Element& e) { return v < e.s0; });
+  auto it =
+      std::upper_bound(elements_.begin(), elements_.end(), s, [](double v, const Element& e) { return v < e.s0; });
   const Element& el = *(it == elements_.begin() ? it : it - 1);
   const double sigma = std::clamp(s - el.s0, 0.0, el.length);
 
@@ -432,7 +429,8 @@ TargetState FieldPath::at(double t) const {
 bool FieldPath::onTurn(double t) const {
   double s, sd, sdd, sddd;
   arcLength(t, s, sd, sdd, sddd);
-  auto it = std::upper_bound(elements_.begin(), elements_.end(), s, [](double v, const Element& e) { return v < e.s0; });
+  auto it =
+      std::upper_bound(elements_.begin(), elements_.end(), s, [](double v, const Element& e) { return v < e.s0; });
   return (it == elements_.begin() ? it : it - 1)->turn && t < duration_;
 }
 

@@ -37,8 +37,8 @@ PostureError Kanayama::postureError(const Pose2D& r, const Pose2D& a) {
 }
 
 VelocityCommand Kanayama::compute(const Reference& ref, const Pose2D& actual, double v, double omega) const {
-  if (!allFinite(ref.pose.x, ref.pose.y, ref.pose.theta, ref.v, ref.omega, ref.v_dot, ref.omega_dot, actual.x,
-                 actual.y, actual.theta, v, omega))
+  if (!allFinite(ref.pose.x, ref.pose.y, ref.pose.theta, ref.v, ref.omega, ref.v_dot, ref.omega_dot, actual.x, actual.y,
+                 actual.theta, v, omega))
     return VelocityCommand{};
   const PostureError e = postureError(ref.pose, actual);
   const double c = std::cos(e.thetae), s = std::sin(e.thetae);

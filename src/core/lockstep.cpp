@@ -50,12 +50,9 @@ LockstepProtocol::Supervision LockstepProtocol::tick(double now, bool loop_conne
   }
   switch (phase_) {
     case Phase::kConnecting:
-    case Phase::kSettling:
-      return connecting(now, loop_connected);
-    case Phase::kRunning:
-      return running(now);
-    default:
-      return {};
+    case Phase::kSettling: return connecting(now, loop_connected);
+    case Phase::kRunning: return running(now);
+    default: return {};
   }
 }
 

@@ -129,8 +129,7 @@ std::string metricsTable(const std::vector<std::string>& names,
   return s;
 }
 
-bool writeMetricsYaml(const std::string& path, const std::string& label,
-                      const std::array<AxisMetrics, AXIS_COUNT>& m) {
+bool writeMetricsYaml(const std::string& path, const std::string& label, const std::array<AxisMetrics, AXIS_COUNT>& m) {
   std::ofstream f(path);
   if (!f) return false;
   f << std::setprecision(17) << label << ":\n";

@@ -64,7 +64,9 @@ const ParamTable<PlantSimSettings>& PlantSimSettings::table() {
 
 PlantSimSettings::PlantSimSettings() { table().applyDefaults(*this); }
 
-std::string PlantSimSettings::validate() const { return firstError({table().checkRanges(*this), disturbance.validate()}); }
+std::string PlantSimSettings::validate() const {
+  return firstError({table().checkRanges(*this), disturbance.validate()});
+}
 
 const ParamTable<KinematicControllerSettings>& KinematicControllerSettings::table() {
   using S = KinematicControllerSettings;
@@ -156,12 +158,14 @@ const ParamTable<PsoTunerSettings>& PsoTunerSettings::table() {
       integer("particles", &S::particles, 20, Limits::atLeast(1), "", "swarm size (Table 5.4)"),
       integer("iterations", &S::iterations, 30, Limits::atLeast(0), "",
               "update + evaluate rounds after the initial swarm (Table 5.4)"),
-      integer("seed", &S::seed, 1, Limits::atLeast(0), "", "random seed; the same seed gives the same result for any "
+      integer("seed", &S::seed, 1, Limits::atLeast(0), "",
+              "random seed; the same seed gives the same result for any "
               "thread count"),
       integer("threads", &S::threads, 0, Limits::atLeast(0), "", "evaluation threads; 0 = all cores"),
       number("velocity_clamp", &S::velocity_clamp, 0.2, Limits::closed(0.0, 10.0), "",
              "|v_d| <= this x (upper_d - lower_d); 0 = no clamp"),
-      number("w_max", &S::w_max, 0.9, Limits::nonNegative(), "", "inertia weight at the first iteration, eq 4.26 (>= w_min)"),
+      number("w_max", &S::w_max, 0.9, Limits::nonNegative(), "",
+             "inertia weight at the first iteration, eq 4.26 (>= w_min)"),
       number("w_min", &S::w_min, 0.1, Limits::nonNegative(), "", "inertia weight at the last iteration"),
       number("c1", &S::c1, 2.0, Limits::nonNegative(), "", "cognitive acceleration, eq 4.27"),
       number("c2", &S::c2, 2.0, Limits::nonNegative(), "", "social acceleration"),

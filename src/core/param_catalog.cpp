@@ -58,7 +58,8 @@ ParamValue parseScalar(const std::string& text) {
   if (!text.empty() && *end == '\0') return static_cast<int>(i);
   const double d = std::strtod(text.c_str(), &end);
   if (!text.empty() && *end == '\0') return d;
-  if (text == ".nan" || text == ".inf" || text == "-.inf") return text == ".nan" ? NAN : (text[0] == '-' ? -INFINITY : INFINITY);
+  if (text == ".nan" || text == ".inf" || text == "-.inf")
+    return text == ".nan" ? NAN : (text[0] == '-' ? -INFINITY : INFINITY);
   return text;
 }
 
@@ -84,22 +85,37 @@ constexpr std::size_t kCommentColumn = 28;  // where the config files' comments 
 
 const std::vector<CatalogSection>& parameterCatalog() {
   static const std::vector<CatalogSection> catalog = {
-      {"run", "run-wide settings, set once per run (sim.launch) and read by every node; relative to the nodes' namespace",
-       infos(RunSettings::table()), {}},
-      {"plant_sim", "the plant: its two drivers' timing, the start pose, the disturbance and the mismatch; the "
-       "geometry and inertia come from the URDF (robot_description)", infos(PlantSimSettings::table()), {}},
-      {"kinematic_controller", "Kanayama outer loop, eqs 4.1-4.2 (kx, ky, ktheta live-tunable)",
-       infos(KinematicControllerSettings::table()), {}},
-      {"torque_controller", "integral terminal sliding-mode inner loop, eqs 4.7-4.22 (gains live-tunable)",
-       infos(TorqueControllerSettings::table()), {}},
-      {"reference_generator", "the reference: the thesis line, or a field of rows through the potential field "
+      {"run",
+       "run-wide settings, set once per run (sim.launch) and read by every node; relative to the nodes' namespace",
+       infos(RunSettings::table()),
+       {}},
+      {"plant_sim",
+       "the plant: its two drivers' timing, the start pose, the disturbance and the mismatch; the "
+       "geometry and inertia come from the URDF (robot_description)",
+       infos(PlantSimSettings::table()),
+       {}},
+      {"kinematic_controller",
+       "Kanayama outer loop, eqs 4.1-4.2 (kx, ky, ktheta live-tunable)",
+       infos(KinematicControllerSettings::table()),
+       {}},
+      {"torque_controller",
+       "integral terminal sliding-mode inner loop, eqs 4.7-4.22 (gains live-tunable)",
+       infos(TorqueControllerSettings::table()),
+       {}},
+      {"reference_generator",
+       "the reference: the thesis line, or a field of rows through the potential field "
        "(field/ and potential/ keys and obstacles are read only with type field)",
-       concat(ReferenceGeneratorSettings::table(), fieldTable()), {"obstacles"}},
-      {"seed_drill", "the seed drill: spacing and scoring of the seeds against the plan",
-       infos(SeedDrillSettings::table()), {}},
+       concat(ReferenceGeneratorSettings::table(), fieldTable()),
+       {"obstacles"}},
+      {"seed_drill",
+       "the seed drill: spacing and scoring of the seeds against the plan",
+       infos(SeedDrillSettings::table()),
+       {}},
       {"run_monitor", "the metric table at the end of a run", infos(RunMonitorSettings::table()), {}},
-      {"pso_tuner", "offline PSO tuning (eqs 4.26-4.31, Table 5.4); the search box is the gains list",
-       infos(PsoTunerSettings::table()), {"gains"}},
+      {"pso_tuner",
+       "offline PSO tuning (eqs 4.26-4.31, Table 5.4); the search box is the gains list",
+       infos(PsoTunerSettings::table()),
+       {"gains"}},
   };
   return catalog;
 }
@@ -119,7 +135,8 @@ std::string parametersMarkdown() {
         "the node's private namespace, except `run/`, which is relative to the nodes' own namespace. A key that "
         "the chosen configuration does not read is refused like an unknown one.\n";
   for (const CatalogSection& s : parameterCatalog()) {
-    md << "\n## `" << s.ns << "`\n\n" << s.summary << ".\n\n| key | type | default | allowed | unit | meaning |\n"
+    md << "\n## `" << s.ns << "`\n\n"
+       << s.summary << ".\n\n| key | type | default | allowed | unit | meaning |\n"
        << "|---|---|---|---|---|---|\n";
     for (const ParamInfo& p : s.params) {
       std::string allowed;
@@ -140,7 +157,7 @@ std::string syncYamlComments(const std::string& text, const std::string& file, s
   std::istringstream in(text);
   std::ostringstream out;
   std::vector<std::pair<std::size_t, std::string>> path;  // (indent, key) of the open mappings
-  std::size_t continuation = std::string::npos;  // comment column of the parameter line just rewritten
+  std::size_t continuation = std::string::npos;           // comment column of the parameter line just rewritten
   int number = 0;
   for (std::string line; std::getline(in, line);) {
     ++number;
@@ -159,8 +176,8 @@ std::string syncYamlComments(const std::string& text, const std::string& file, s
     const std::string key = body.substr(0, colon);
     while (!path.empty() && path.back().first >= indent) path.pop_back();
     const std::size_t hash = commentColumn(line);
-    const std::string value = trim(line.substr(indent + colon + 1, hash == std::string::npos ? std::string::npos
-                                                                                            : hash - indent - colon - 1));
+    const std::string value = trim(
+        line.substr(indent + colon + 1, hash == std::string::npos ? std::string::npos : hash - indent - colon - 1));
     const CatalogSection* section = path.empty() ? nullptr : findSection(path.front().second);
     std::string rel;
     for (std::size_t i = 1; i < path.size(); ++i) rel += path[i].second + "/";

@@ -1,18 +1,12 @@
 #include "sowing_robot/core/param_table.h"
 
-#include <sstream>
+#include "sowing_robot/core/validation.h"
 
 namespace sowing_robot {
 namespace core {
 
 namespace {
-std::string number(double v) {
-  std::ostringstream s;
-  s.precision(10);
-  s << v;
-  return s.str();
-}
-std::string withUnit(const std::string& unit) { return unit.empty() ? "" : " " + unit; }
+std::string number(double v) { return formatNumber(v); }
 }  // namespace
 
 bool Limits::contains(double v) const {
@@ -44,21 +38,16 @@ std::string formatValue(const ParamValue& v) {
 
 const char* typeName(const ParamValue& v) {
   switch (v.index()) {
-    case 0:
-      return "bool";
-    case 1:
-      return "int";
-    case 2:
-      return "double";
-    default:
-      return "string";
+    case 0: return "bool";
+    case 1: return "int";
+    case 2: return "double";
+    default: return "string";
   }
 }
 
 std::string ParamInfo::check(const ParamValue& v, const std::string& prefix) const {
   const std::string name = prefix + key;
-  if (v.index() != default_value.index())
-    return "parameter " + name + " must be of type " + typeName(default_value);
+  if (v.index() != default_value.index()) return "parameter " + name + " must be of type " + typeName(default_value);
   if (const std::string* s = std::get_if<std::string>(&v)) {
     if (choices.empty()) return "";
     std::string list;

@@ -19,7 +19,7 @@ void rotateHeading(double cos0, double sin0, double delta, double& cos_out, doub
   double cd, sd;
   if (std::fabs(delta) <= 0.05) {
     const double d2 = delta * delta;
-    constexpr double k6 = 1.0 / 6.0, k20 = 1.0 / 20.0, k42 = 1.0 / 42.0;  // 3!, 5!/3!, 7!/5!
+    constexpr double k6 = 1.0 / 6.0, k20 = 1.0 / 20.0, k42 = 1.0 / 42.0;    // 3!, 5!/3!, 7!/5!
     constexpr double k12 = 1.0 / 12.0, k30 = 1.0 / 30.0, k56 = 1.0 / 56.0;  // 4!/2!, 6!/4!, 8!/6!
     sd = delta * (1.0 - d2 * k6 * (1.0 - d2 * k20 * (1.0 - d2 * k42)));
     cd = 1.0 - 0.5 * d2 * (1.0 - d2 * k12 * (1.0 - d2 * k30 * (1.0 - d2 * k56)));

@@ -11,8 +11,8 @@ namespace sowing_robot {
 namespace core {
 
 namespace {
-constexpr double kStopSpeed = 1e-4;     ///< below this speed [m/s] theta is held
-constexpr double kGridSlack = 1e-9;     ///< a call within 1 ns of a grid point is that grid point [s]
+constexpr double kStopSpeed = 1e-4;  ///< below this speed [m/s] theta is held
+constexpr double kGridSlack = 1e-9;  ///< a call within 1 ns of a grid point is that grid point [s]
 
 std::string indexed(const std::string& name, std::size_t i) { return name + "[" + std::to_string(i) + "]"; }
 
@@ -45,7 +45,8 @@ const ParamTable<PotentialFieldParams>& potentialFieldTable() {
              "d: no repulsion beyond this clearance from the obstacle surface (thesis 0.5)"),
       number("gain", &P::gain, 5.0, Limits::nonNegative(), "m^2/s^2",
              "k: radial repulsion -k grad V_a; 0 disables avoidance (not given in the thesis)"),
-      number("tangential_ratio", &P::tangential_ratio, 1.0, Limits::nonNegative(), "", "|tangential| / |radial| repulsion"),
+      number("tangential_ratio", &P::tangential_ratio, 1.0, Limits::nonNegative(), "",
+             "|tangential| / |radial| repulsion"),
       flag("nearest_side", &P::nearest_side, true,
            "pass each obstacle on the side the reference is on when it enters the zone"),
       choice("avoid_side", &P::avoid_side, AvoidSide::kLeft, {{"left", AvoidSide::kLeft}, {"right", AvoidSide::kRight}},
@@ -78,13 +79,14 @@ TargetState LineTarget::at(double t) const {
 }
 
 PotentialField::PotentialField(const PotentialFieldParams& params, const RowLine& row, std::vector<Obstacle> obstacles)
-    : PotentialField(params,
-                     [&row]() -> std::unique_ptr<TargetTrajectory> {
-                       const std::string e = row.validate();
-                       if (!e.empty()) throw std::invalid_argument("RowLine: " + e);
-                       return std::make_unique<LineTarget>(row);
-                     }(),
-                     std::move(obstacles)) {}
+    : PotentialField(
+          params,
+          [&row]() -> std::unique_ptr<TargetTrajectory> {
+            const std::string e = row.validate();
+            if (!e.empty()) throw std::invalid_argument("RowLine: " + e);
+            return std::make_unique<LineTarget>(row);
+          }(),
+          std::move(obstacles)) {}
 
 PotentialField::PotentialField(const PotentialFieldParams& params, std::unique_ptr<TargetTrajectory> target,
                                std::vector<Obstacle> obstacles)

@@ -139,9 +139,9 @@ std::string PsoParams::validate() const {
        checkNonNegative("max_velocity_fraction", max_velocity_fraction),
        threads >= 0 ? "" : "threads = " + std::to_string(threads) + " must be >= 0 (0 = hardware concurrency)",
        !lower.empty() ? "" : "lower/upper bounds are empty (need at least one dimension)",
-       lower.size() == upper.size() ? ""
-                                    : "lower has " + std::to_string(lower.size()) + " entries but upper has " +
-                                          std::to_string(upper.size())});
+       lower.size() == upper.size()
+           ? ""
+           : "lower has " + std::to_string(lower.size()) + " entries but upper has " + std::to_string(upper.size())});
   if (!e.empty()) return e;
   for (std::size_t d = 0; d < lower.size(); ++d) {
     const std::string i = "[" + std::to_string(d) + "]";
@@ -180,14 +180,12 @@ PsoResult psoMinimize(const PsoParams& p, const PsoBoundedFitness& fitness, cons
   // One RNG stream per particle, so the random numbers a particle sees depend only on (seed, index).
   std::vector<std::mt19937_64> rng;
   rng.reserve(n);
-  for (std::size_t j = 0; j < n; ++j)
-    rng.emplace_back(splitmix64(splitmix64(p.seed) ^ splitmix64(0xA5A5A5A5ULL + j)));
+  for (std::size_t j = 0; j < n; ++j) rng.emplace_back(splitmix64(splitmix64(p.seed) ^ splitmix64(0xA5A5A5A5ULL + j)));
 
   // Uniform random start inside the box, zero velocity.
   std::vector<std::vector<double>> x(n, std::vector<double>(dims)), v(n, std::vector<double>(dims, 0.0));
   for (std::size_t j = 0; j < n; ++j)
-    for (std::size_t d = 0; d < dims; ++d)
-      x[j][d] = std::min(p.lower[d] + uniform01(rng[j]) * range[d], p.upper[d]);
+    for (std::size_t d = 0; d < dims; ++d) x[j][d] = std::min(p.lower[d] + uniform01(rng[j]) * range[d], p.upper[d]);
 
   std::vector<std::vector<double>> pbest = x;
   std::vector<double> pbest_cost(n, INF), cost(n, INF);

@@ -35,7 +35,8 @@ const ParamTable<SlidingModeParams>& slidingModeTable() {
         integer("q", &P::q, 3, Limits::atLeast(1), "", "terminal exponent denominator, odd"),
         tunable(number("beta_v", &P::beta_v, 1.0, Limits::positive(), "",
                        "surface gain beta, linear channel (not given in the thesis)")),
-        tunable(number("beta_omega", &P::beta_omega, 1.0, Limits::positive(), "", "surface gain beta, angular channel")),
+        tunable(
+            number("beta_omega", &P::beta_omega, 1.0, Limits::positive(), "", "surface gain beta, angular channel")),
         tunable(number("k1", &P::k1, 1.0, Limits::positive(), "N·m·s/m", "feedback gain K1")),
         tunable(number("k2", &P::k2, 150.0, Limits::positive(), "N·m·s/rad", "feedback gain K2")),
         tunable(number("eta1", &P::eta1, 2.0, Limits::nonNegative(), "N·m", "switching gain eta1")),
@@ -114,7 +115,7 @@ void SlidingModeController::surface(Channel& c, double e, double xd_dot, double 
   // its exponent (p-q)/q lies in (0, 1), so it is finite and equals 0 at int e = 0 (no division, no
   // singularity); only its own derivative would be unbounded there, and that never enters the law.
   double power_p, power_p_minus_q;  // (int e)^(p/q) and (int e)^((p-q)/q)
-  if (params_.q == 3) {              // one cube root serves both powers (same values as realPower)
+  if (params_.q == 3) {             // one cube root serves both powers (same values as realPower)
     const double root = std::cbrt(std::fabs(c.integral));
     power_p = powerOfRoot(root, params_.p, c.integral < 0.0);
     power_p_minus_q = powerOfRoot(root, params_.p - params_.q, c.integral < 0.0);

@@ -9,8 +9,7 @@ namespace core {
 
 double SwitchFunction::operator()(double s) const {
   switch (type) {
-    case SwitchType::Sign:
-      return s > 0.0 ? 1.0 : (s < 0.0 ? -1.0 : 0.0);
+    case SwitchType::Sign: return s > 0.0 ? 1.0 : (s < 0.0 ? -1.0 : 0.0);
     case SwitchType::Saturation: {  // eq 4.47
       const double r = s / width;
       return r > 1.0 ? 1.0 : (r < -1.0 ? -1.0 : r);
@@ -19,8 +18,7 @@ double SwitchFunction::operator()(double s) const {
       return s / (std::fabs(s) + width);
     case SwitchType::Atan:  // eq 4.48, scaled by 2/pi so that eta keeps its meaning as the switching gain
       return M_2_PI * std::atan(s / width);
-    case SwitchType::Tanh:
-      return std::tanh(s / width);
+    case SwitchType::Tanh: return std::tanh(s / width);
   }
   return 0.0;
 }
@@ -46,8 +44,8 @@ SwitchFunction::SwitchFunction() { switchingTable().applyDefaults(*this); }
 std::string SwitchFunction::validate() const { return switchingTable().checkRanges(*this); }
 
 bool SwitchFunction::parse(const std::string& n, SwitchType& t) {
-  for (SwitchType c : {SwitchType::Sign, SwitchType::Saturation, SwitchType::Relay, SwitchType::Atan,
-                       SwitchType::Tanh}) {
+  for (SwitchType c :
+       {SwitchType::Sign, SwitchType::Saturation, SwitchType::Relay, SwitchType::Atan, SwitchType::Tanh}) {
     if (n == name(c)) {
       t = c;
       return true;

@@ -54,11 +54,16 @@ struct TorqueTally {
 }  // namespace
 
 bool parseCostType(const std::string& name, CostType& out) {
-  if (name == "itae") out = CostType::ITAE;
-  else if (name == "ise") out = CostType::ISE;
-  else if (name == "iae") out = CostType::IAE;
-  else if (name == "itse") out = CostType::ITSE;
-  else return false;
+  if (name == "itae")
+    out = CostType::ITAE;
+  else if (name == "ise")
+    out = CostType::ISE;
+  else if (name == "iae")
+    out = CostType::IAE;
+  else if (name == "itse")
+    out = CostType::ITSE;
+  else
+    return false;
   return true;
 }
 
@@ -109,7 +114,7 @@ double getGain(const Scenario& sc, const std::string& name) {
 }
 
 std::vector<GainBounds> defaultGainBounds() {
-  return {{"kx", 0.1, 10.0}, {"ky", 0.1, 10.0},     {"ktheta", 0.1, 10.0}, {"k1", 0.1, 1000.0},
+  return {{"kx", 0.1, 10.0},   {"ky", 0.1, 10.0},   {"ktheta", 0.1, 10.0}, {"k1", 0.1, 1000.0},
           {"k2", 0.1, 1000.0}, {"eta1", 0.1, 10.0}, {"eta2", 0.1, 10.0}};
 }
 
@@ -124,11 +129,11 @@ std::string validateGainBounds(const Scenario& base, const std::vector<GainBound
       return at + ": unknown gain '" + g.name + "' (tunable: " + known + ")";
     }
     for (std::size_t j = 0; j < i; ++j)
-      if (gains[j].name == g.name) return at + ": '" + g.name + "' is listed twice (also gains[" + std::to_string(j) + "])";
+      if (gains[j].name == g.name)
+        return at + ": '" + g.name + "' is listed twice (also gains[" + std::to_string(j) + "])";
     if (!allFinite(g.lower, g.upper))
       return at + ": bounds must be finite numbers, got lower = " + num(g.lower) + ", upper = " + num(g.upper);
-    if (!(g.lower < g.upper))
-      return at + ": lower = " + num(g.lower) + " must be < upper = " + num(g.upper);
+    if (!(g.lower < g.upper)) return at + ": lower = " + num(g.lower) + " must be < upper = " + num(g.upper);
   }
   // Every constraint validate() puts on one of these gains is an interval, so the two corners suffice.
   for (int corner = 0; corner < 2; ++corner) {
@@ -143,7 +148,8 @@ std::string validateGainBounds(const Scenario& base, const std::vector<GainBound
 }
 
 std::string TuningObjective::validate() const {
-  return firstError({checkNonNegative("torque_weight", torque_weight), checkNonNegative("chattering_weight", chattering_weight)});
+  return firstError(
+      {checkNonNegative("torque_weight", torque_weight), checkNonNegative("chattering_weight", chattering_weight)});
 }
 
 TuningProblem::TuningProblem(const Scenario& base, const ReferenceSource& reference, std::vector<GainBounds> gains,
@@ -230,8 +236,7 @@ TuningResult tuneGains(const Scenario& base, const ReferenceSource& reference, c
   // Bounded: a particle's run stops once it cannot beat its personal best (same search, less work).
   std::atomic<long> cut{0};
   std::atomic<std::int64_t> simulated_ns{0};
-  out.pso = psoMinimize(params,
-                        PsoBoundedFitness([&](const std::vector<double>& x, int thread, double bound) {
+  out.pso = psoMinimize(params, PsoBoundedFitness([&](const std::vector<double>& x, int thread, double bound) {
                           const TuningCost c = problem.evaluate(x, thread, bound);
                           if (c.bounded) ++cut;
                           simulated_ns += std::llround(c.simulated * 1e9);

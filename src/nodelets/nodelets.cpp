@@ -10,9 +10,9 @@
 // thread with no hand-over. None of these callbacks blocks, so sharing a thread cannot deadlock; each
 // nodelet's callbacks stay serialised, as with getNodeHandle().
 #include <nodelet/nodelet.h>
-#include <pluginlib/class_list_macros.hpp>
 #include <ros/callback_queue.h>
 #include <ros/spinner.h>
+#include <pluginlib/class_list_macros.hpp>
 
 #include <memory>
 #include <mutex>

@@ -134,9 +134,9 @@ Options readOptions(const ros::NodeHandle& pnh) {
   const std::string unknown = p.unknownKeys();
   if (!unknown.empty()) sowing_robot::refuseToStart(unknown);
   if (o.output.empty() || o.topics.empty() || o.queue < 1) {
-    sowing_robot::refuseToStart("~output (a path) and ~topics (space-separated) are required, ~queue >= 1 (got output '" +
-                                o.output + "', " + std::to_string(o.topics.size()) + " topics, queue " +
-                                std::to_string(o.queue) + ")");
+    sowing_robot::refuseToStart(
+        "~output (a path) and ~topics (space-separated) are required, ~queue >= 1 (got output '" + o.output + "', " +
+        std::to_string(o.topics.size()) + " topics, queue " + std::to_string(o.queue) + ")");
   }
   if (!(o.receive_delay >= 0.0 && o.receive_delay < 1.0))
     sowing_robot::refuseToStart("~receive_delay = " + std::to_string(o.receive_delay) + " must be in [0, 1) s");
@@ -179,9 +179,9 @@ int record(ros::NodeHandle& nh, ros::NodeHandle& pnh, const Options& o) {
     if (o.receive_delay > 0.0) so.callback_queue = &delaying;
     subs.push_back(nh.subscribe(so));
   }
-  ROS_INFO("bag_recorder: recording %zu topics to %s%s", o.topics.size(), o.output.c_str(),
-           o.receive_delay > 0.0 ? (" (receive_delay " + std::to_string(o.receive_delay) + " s per message)").c_str()
-                                 : "");
+  ROS_INFO(
+      "bag_recorder: recording %zu topics to %s%s", o.topics.size(), o.output.c_str(),
+      o.receive_delay > 0.0 ? (" (receive_delay " + std::to_string(o.receive_delay) + " s per message)").c_str() : "");
   while (!g_stop && ros::ok()) q->callAvailable(ros::WallDuration(0.1));
   // Drain: keep writing until nothing has arrived for a second, then close.
   subs.clear();

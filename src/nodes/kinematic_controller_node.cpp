@@ -2,4 +2,6 @@
 #include "sowing_robot/ros/kinematic_controller.h"
 #include "sowing_robot/ros/node_main.h"
 
-int main(int argc, char** argv) { return sowing_robot::runCallbackNode<sowing_robot::KinematicController>(argc, argv, "kinematic_controller"); }
+int main(int argc, char** argv) {
+  return sowing_robot::runCallbackNode<sowing_robot::KinematicController>(argc, argv, "kinematic_controller");
+}

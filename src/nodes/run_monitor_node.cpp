@@ -1,5 +1,7 @@
 // Standalone run_monitor node: the wrapper class does the work.
-#include "sowing_robot/ros/run_monitor.h"
 #include "sowing_robot/ros/node_main.h"
+#include "sowing_robot/ros/run_monitor.h"
 
-int main(int argc, char** argv) { return sowing_robot::runCallbackNode<sowing_robot::RunMonitor>(argc, argv, "run_monitor"); }
+int main(int argc, char** argv) {
+  return sowing_robot::runCallbackNode<sowing_robot::RunMonitor>(argc, argv, "run_monitor");
+}

@@ -47,18 +47,21 @@ int runThesisField(bool potential_only, std::int64_t period_ns) {
   std::printf("thesis field, %s (%.0f ms wall), footprint circumscribed radius %.3f m:\n",
               potential_only ? "potential field only (thesis)" : "planned detours (issue 15)", 1e3 * wall,
               s.footprint.circumscribedRadius());
-  std::printf("| body clearance | contacts | peak yaw rate | peak v*omega | peak yaw rate / v*omega, whole run | "
-              "seeds on rows: count, max, RMS | detour seeds: count, max | end |\n|---|---|---|---|---|---|---|---|\n");
-  std::printf("| %.3f m | %zu | %.2f rad/s | %.2f m/s^2 | %.2f rad/s / %.2f m/s^2 | %zu, %.2f mm, %.2f mm | %zu, %.3f m | "
-              "(%.2f, %.2f) |\n",
-              r.min_clearance, r.contacts, r.peak_yaw_rate, r.peak_lateral, w.peak_yaw_rate, w.peak_lateral,
-              r.rows.count, 1e3 * r.rows.max, 1e3 * r.rows.rms, r.detours.count, r.detours.max, r.end.x(), r.end.y());
+  std::printf(
+      "| body clearance | contacts | peak yaw rate | peak v*omega | peak yaw rate / v*omega, whole run | "
+      "seeds on rows: count, max, RMS | detour seeds: count, max | end |\n|---|---|---|---|---|---|---|---|\n");
+  std::printf(
+      "| %.3f m | %zu | %.2f rad/s | %.2f m/s^2 | %.2f rad/s / %.2f m/s^2 | %zu, %.2f mm, %.2f mm | %zu, %.3f m | "
+      "(%.2f, %.2f) |\n",
+      r.min_clearance, r.contacts, r.peak_yaw_rate, r.peak_lateral, w.peak_yaw_rate, w.peak_lateral, r.rows.count,
+      1e3 * r.rows.max, 1e3 * r.rows.rms, r.detours.count, r.detours.max, r.end.x(), r.end.y());
   for (const ContactEvent& e : r.events)
     std::printf("contact: obstacle %zu, t = %.3f .. %.3f s, max depth %.3f m\n", e.obstacle, e.start, e.end,
                 e.max_depth);
-  std::printf("reference (from t = 12 s): peak yaw rate %.2f rad/s, v*omega %.2f m/s^2, curvature %.2f 1/m; status %s%s%s\n",
-              r.peak_ref_yaw_rate, r.peak_ref_lateral, r.peak_ref_curvature, AvoidanceStatus::name(r.status.code),
-              r.status.reason.empty() ? "" : ": ", r.status.reason.c_str());
+  std::printf(
+      "reference (from t = 12 s): peak yaw rate %.2f rad/s, v*omega %.2f m/s^2, curvature %.2f 1/m; status %s%s%s\n",
+      r.peak_ref_yaw_rate, r.peak_ref_lateral, r.peak_ref_curvature, AvoidanceStatus::name(r.status.code),
+      r.status.reason.empty() ? "" : ": ", r.status.reason.c_str());
   return r.diverged ? 1 : 0;
 }
 }  // namespace
@@ -78,18 +81,30 @@ int main(int argc, char** argv) {
       }
       return std::strtod(argv[++i], nullptr);
     };
-    if (a == "--field") field = true;
-    else if (a == "--potential-only") potential_only = true;
-    else if (a == "--tsmc") modes.push_back(false);
-    else if (a == "--atsmc") modes.push_back(true);
-    else if (a == "--disturbance") sc.disturbance.sinusoidal = true;
-    else if (a == "--mismatch") sc.disturbance.mass_scale = sc.disturbance.inertia_scale = value("--mismatch");
-    else if (a == "--noise") sc.disturbance.noise_std = value("--noise");
-    else if (a == "--duration") sc.duration = value("--duration");
-    else if (a == "--rate") sc.control_period_ns = static_cast<std::int64_t>(1e9 / value("--rate") + 0.5);
-    else if (a == "--width") sc.sliding.switching.width = value("--width");
-    else if (a == "--repeat") repeat = static_cast<int>(value("--repeat"));
-    else if (a == "--yaml" && i + 1 < argc) yaml = argv[++i];
+    if (a == "--field")
+      field = true;
+    else if (a == "--potential-only")
+      potential_only = true;
+    else if (a == "--tsmc")
+      modes.push_back(false);
+    else if (a == "--atsmc")
+      modes.push_back(true);
+    else if (a == "--disturbance")
+      sc.disturbance.sinusoidal = true;
+    else if (a == "--mismatch")
+      sc.disturbance.mass_scale = sc.disturbance.inertia_scale = value("--mismatch");
+    else if (a == "--noise")
+      sc.disturbance.noise_std = value("--noise");
+    else if (a == "--duration")
+      sc.duration = value("--duration");
+    else if (a == "--rate")
+      sc.control_period_ns = static_cast<std::int64_t>(1e9 / value("--rate") + 0.5);
+    else if (a == "--width")
+      sc.sliding.switching.width = value("--width");
+    else if (a == "--repeat")
+      repeat = static_cast<int>(value("--repeat"));
+    else if (a == "--yaml" && i + 1 < argc)
+      yaml = argv[++i];
     else if (a == "--switching" && i + 1 < argc) {
       if (!SwitchFunction::parse(argv[++i], sc.sliding.switching.type)) {
         std::fprintf(stderr, "run_scenario: unknown switching '%s'\n", argv[i]);
@@ -116,11 +131,11 @@ int main(int argc, char** argv) {
     const auto t0 = std::chrono::steady_clock::now();
     for (int k = 0; k < repeat; ++k) r = runClosedLoop(sc, ref);
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() / repeat;
-    std::printf("%s: %.3f ms wall per %.1f s run (%.2f M steps/s), final (x %.4f, y %.4f, theta %.5f), "
-                "%ld saturated periods%s\n",
-                adaptive ? "ATSMC" : "TSMC", 1e3 * s, sc.duration, (sc.steps() + 1) / s / 1e6, r.final_state[X],
-                r.final_state[Y], r.final_state[THETA], static_cast<long>(r.saturated_steps),
-                r.diverged ? ", DIVERGED" : "");
+    std::printf(
+        "%s: %.3f ms wall per %.1f s run (%.2f M steps/s), final (x %.4f, y %.4f, theta %.5f), "
+        "%ld saturated periods%s\n",
+        adaptive ? "ATSMC" : "TSMC", 1e3 * s, sc.duration, (sc.steps() + 1) / s / 1e6, r.final_state[X],
+        r.final_state[Y], r.final_state[THETA], static_cast<long>(r.saturated_steps), r.diverged ? ", DIVERGED" : "");
     names.push_back(adaptive ? "atsmc" : "tsmc");
     results.push_back(r.metrics);
     if (!yaml.empty() && !writeMetricsYaml(yaml, names.back(), r.metrics)) {

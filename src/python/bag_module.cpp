@@ -18,9 +18,9 @@
 #include <pybind11/stl.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <charconv>
 #include <cstdint>
-#include <cerrno>
 #include <cstdio>
 #include <functional>
 #include <map>
@@ -78,48 +78,86 @@ struct Extractor {
 Extractor<sowing_robot::TrackingError> trackingError() {
   return {{"x", "y", "theta", "xe", "ye", "thetae"}, {}, {}, [](const sowing_robot::TrackingError& m, Columns& c) {
             std::size_t i = 0;
-            R(m.x); R(m.y); R(m.theta); R(m.xe); R(m.ye); R(m.thetae);
+            R(m.x);
+            R(m.y);
+            R(m.theta);
+            R(m.xe);
+            R(m.ye);
+            R(m.thetae);
           }};
 }
 Extractor<nav_msgs::Odometry> odometry() {
   return {{"pose.pose.position.x", "pose.pose.position.y", "pose.pose.position.z", "pose.pose.orientation.x",
-           "pose.pose.orientation.y", "pose.pose.orientation.z", "pose.pose.orientation.w",
-           "twist.twist.linear.x", "twist.twist.linear.y", "twist.twist.linear.z", "twist.twist.angular.x",
-           "twist.twist.angular.y", "twist.twist.angular.z"},
-          {}, {}, [](const nav_msgs::Odometry& m, Columns& c) {
+           "pose.pose.orientation.y", "pose.pose.orientation.z", "pose.pose.orientation.w", "twist.twist.linear.x",
+           "twist.twist.linear.y", "twist.twist.linear.z", "twist.twist.angular.x", "twist.twist.angular.y",
+           "twist.twist.angular.z"},
+          {},
+          {},
+          [](const nav_msgs::Odometry& m, Columns& c) {
             std::size_t i = 0;
             const auto& p = m.pose.pose;
             const auto& v = m.twist.twist;
-            R(p.position.x); R(p.position.y); R(p.position.z);
-            R(p.orientation.x); R(p.orientation.y); R(p.orientation.z); R(p.orientation.w);
-            R(v.linear.x); R(v.linear.y); R(v.linear.z); R(v.angular.x); R(v.angular.y); R(v.angular.z);
+            R(p.position.x);
+            R(p.position.y);
+            R(p.position.z);
+            R(p.orientation.x);
+            R(p.orientation.y);
+            R(p.orientation.z);
+            R(p.orientation.w);
+            R(v.linear.x);
+            R(v.linear.y);
+            R(v.linear.z);
+            R(v.angular.x);
+            R(v.angular.y);
+            R(v.angular.z);
           }};
 }
 Extractor<sowing_robot::ReferenceState> referenceState() {
-  return {{"x", "y", "theta", "v", "omega", "v_dot", "omega_dot"}, {"tool_down"}, {},
+  return {{"x", "y", "theta", "v", "omega", "v_dot", "omega_dot"},
+          {"tool_down"},
+          {},
           [](const sowing_robot::ReferenceState& m, Columns& c) {
             std::size_t i = 0;
-            R(m.x); R(m.y); R(m.theta); R(m.v); R(m.omega); R(m.v_dot); R(m.omega_dot);
+            R(m.x);
+            R(m.y);
+            R(m.theta);
+            R(m.v);
+            R(m.omega);
+            R(m.v_dot);
+            R(m.omega_dot);
             c.bools[0].push_back(m.tool_down);
           }};
 }
 Extractor<sowing_robot::DesiredVelocity> desiredVelocity() {
   return {{"v", "omega", "v_dot", "omega_dot"}, {}, {}, [](const sowing_robot::DesiredVelocity& m, Columns& c) {
             std::size_t i = 0;
-            R(m.v); R(m.omega); R(m.v_dot); R(m.omega_dot);
+            R(m.v);
+            R(m.omega);
+            R(m.v_dot);
+            R(m.omega_dot);
           }};
 }
 Extractor<sowing_robot::WheelTorque> wheelTorque() {
   return {{"right", "left"}, {}, {}, [](const sowing_robot::WheelTorque& m, Columns& c) {
             std::size_t i = 0;
-            R(m.right); R(m.left);
+            R(m.right);
+            R(m.left);
           }};
 }
 Extractor<sowing_robot::TorqueControllerState> torqueControllerState() {
-  return {{"e_v", "e_omega", "s_v", "s_omega", "m0_hat", "i0_hat", "u1", "u2"}, {"saturated"}, {"mode"},
+  return {{"e_v", "e_omega", "s_v", "s_omega", "m0_hat", "i0_hat", "u1", "u2"},
+          {"saturated"},
+          {"mode"},
           [](const sowing_robot::TorqueControllerState& m, Columns& c) {
             std::size_t i = 0;
-            R(m.e_v); R(m.e_omega); R(m.s_v); R(m.s_omega); R(m.m0_hat); R(m.i0_hat); R(m.u1); R(m.u2);
+            R(m.e_v);
+            R(m.e_omega);
+            R(m.s_v);
+            R(m.s_omega);
+            R(m.m0_hat);
+            R(m.i0_hat);
+            R(m.u1);
+            R(m.u2);
             c.bools[0].push_back(m.saturated);
             c.strings[0].push_back(m.mode);
           }};
@@ -261,13 +299,15 @@ class MarkerReader : public TopicReader {
 };
 
 std::unique_ptr<TopicReader> readerFor(const std::string& type) {
-  if (type == "sowing_robot/TrackingError") return std::make_unique<TypedReader<sowing_robot::TrackingError>>(trackingError());
+  if (type == "sowing_robot/TrackingError")
+    return std::make_unique<TypedReader<sowing_robot::TrackingError>>(trackingError());
   if (type == "nav_msgs/Odometry") return std::make_unique<TypedReader<nav_msgs::Odometry>>(odometry());
   if (type == "sowing_robot/ReferenceState")
     return std::make_unique<TypedReader<sowing_robot::ReferenceState>>(referenceState());
   if (type == "sowing_robot/DesiredVelocity")
     return std::make_unique<TypedReader<sowing_robot::DesiredVelocity>>(desiredVelocity());
-  if (type == "sowing_robot/WheelTorque") return std::make_unique<TypedReader<sowing_robot::WheelTorque>>(wheelTorque());
+  if (type == "sowing_robot/WheelTorque")
+    return std::make_unique<TypedReader<sowing_robot::WheelTorque>>(wheelTorque());
   if (type == "sowing_robot/TorqueControllerState")
     return std::make_unique<TypedReader<sowing_robot::TorqueControllerState>>(torqueControllerState());
   if (type == "visualization_msgs/MarkerArray" || type == "visualization_msgs/Marker")
@@ -363,7 +403,8 @@ int writeRows(const std::string& path, const std::vector<std::string>& names, co
         case 'f': appendDouble(out, static_cast<const double*>(c.array.data())[i]); break;
         case 'i': {
           char buf[32];
-          out.append(buf, std::to_chars(buf, buf + sizeof buf, static_cast<const std::int64_t*>(c.array.data())[i]).ptr);
+          out.append(buf,
+                     std::to_chars(buf, buf + sizeof buf, static_cast<const std::int64_t*>(c.array.data())[i]).ptr);
           break;
         }
         case 'b': out += static_cast<const bool*>(c.array.data())[i] ? "True" : "False"; break;
@@ -392,10 +433,14 @@ void writeCsv(const std::string& path, const std::vector<std::string>& names, co
       c.array = columns[j].cast<py::array>();
       if (c.array.ndim() != 1) throw py::value_error("column '" + names[j] + "' is not 1-D");
       const char k = c.array.dtype().kind();
-      if (k == 'f') c.array = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(c.array);
-      else if (k == 'i' || k == 'u') c.array = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>::ensure(c.array);
-      else if (k == 'b') c.array = py::array_t<bool, py::array::c_style | py::array::forcecast>::ensure(c.array);
-      else throw py::value_error("column '" + names[j] + "': unsupported dtype");
+      if (k == 'f')
+        c.array = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(c.array);
+      else if (k == 'i' || k == 'u')
+        c.array = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>::ensure(c.array);
+      else if (k == 'b')
+        c.array = py::array_t<bool, py::array::c_style | py::array::forcecast>::ensure(c.array);
+      else
+        throw py::value_error("column '" + names[j] + "': unsupported dtype");
       c.kind = k == 'u' ? 'i' : k;
     } else {
       c.kind = 's';

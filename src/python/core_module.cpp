@@ -61,7 +61,8 @@ Metrics metricsFromDict(const py::dict& d) {
     if (!d.contains(kAxes[a])) throw py::key_error(std::string("metrics without axis '") + kAxes[a] + "'");
     const py::dict axis = d[kAxes[a]].cast<py::dict>();
     for (const auto& f : kFields) {
-      if (axis.contains(f.name)) m[a].*f.member = axis[f.name].cast<double>();
+      if (axis.contains(f.name))
+        m[a].*f.member = axis[f.name].cast<double>();
       else if (std::string(f.name) != "peak")
         throw py::key_error(std::string("metrics of axis '") + kAxes[a] + "' without '" + f.name + "'");
     }
@@ -83,8 +84,7 @@ void checkSameLength(const Array& t, const Array& ex, const Array& ey, const Arr
 }
 
 /// MetricsAccumulator::add over arrays, in order; returns the number accepted.
-std::size_t addSamples(MetricsAccumulator& acc, const Array& t, const Array& ex, const Array& ey,
-                       const Array& eth) {
+std::size_t addSamples(MetricsAccumulator& acc, const Array& t, const Array& ex, const Array& ey, const Array& eth) {
   checkSameLength(t, ex, ey, eth);
   const double *pt = t.data(), *px = ex.data(), *py_ = ey.data(), *pth = eth.data();
   const auto n = static_cast<std::size_t>(t.size());
@@ -96,10 +96,10 @@ std::size_t addSamples(MetricsAccumulator& acc, const Array& t, const Array& ex,
 
 /// Time series of one closed-loop run, one vector per column.
 struct Trace {
-  std::vector<std::string> names = {"t",     "x",      "y",       "theta",     "v",        "omega",
-                                    "x_ref", "y_ref",  "theta_ref", "v_ref",   "omega_ref", "v_d",
-                                    "omega_d", "tau_right", "tau_left", "e_v", "e_omega", "s_v",
-                                    "s_omega", "saturated", "m0_hat", "i0_hat", "ex", "ey", "etheta"};
+  std::vector<std::string> names = {
+      "t",       "x",         "y",      "theta",   "v",         "omega",    "x_ref", "y_ref",   "theta_ref",
+      "v_ref",   "omega_ref", "v_d",    "omega_d", "tau_right", "tau_left", "e_v",   "e_omega", "s_v",
+      "s_omega", "saturated", "m0_hat", "i0_hat",  "ex",        "ey",       "etheta"};
   std::vector<std::vector<double>> columns = std::vector<std::vector<double>>(names.size());
 
   void reserve(std::size_t n) {
@@ -210,8 +210,9 @@ sliding-mode controller on the thesis's line, as the lockstep node pipeline does
            "add() for each element of four equal-length 1-D arrays, in order; returns the number accepted.")
       .def("reserve", &MetricsAccumulator::reserve, py::arg("n"))
       .def("reset", &MetricsAccumulator::reset)
-      .def("result", [](const MetricsAccumulator& a) { return metricsToDict(a.result()); },
-           "The metrics so far, as {axis: {field: value}}.")
+      .def(
+          "result", [](const MetricsAccumulator& a) { return metricsToDict(a.result()); },
+          "The metrics so far, as {axis: {field: value}}.")
       .def_property_readonly("samples", &MetricsAccumulator::samples, "Samples accepted.")
       .def_property_readonly("rejected", &MetricsAccumulator::rejected, "Samples refused (non-finite).");
 

@@ -1,8 +1,8 @@
 #include "sowing_robot/ros/kinematic_controller.h"
 
 #include "sowing_robot/core/runner.h"
-#include "sowing_robot/ros/component_params.h"
 #include "sowing_robot/core/validation.h"
+#include "sowing_robot/ros/component_params.h"
 #include "sowing_robot/ros/msg_checks.h"
 #include "sowing_robot/ros/reconfigure_bridge.h"
 
@@ -39,8 +39,8 @@ void KinematicController::reconfigure(KinematicControllerConfig& config, uint32_
   if (error.empty() && g.kx == old.kx && g.ky == old.ky && g.ktheta == old.ktheta) return;
   if (error.empty()) error = g.validate();
   if (!error.empty()) {
-    ROS_WARN("kinematic_controller: rejected gain change: %s; keeping kx %g, ky %g, ktheta %g", error.c_str(),
-             old.kx, old.ky, old.ktheta);
+    ROS_WARN("kinematic_controller: rejected gain change: %s; keeping kx %g, ky %g, ktheta %g", error.c_str(), old.kx,
+             old.ky, old.ktheta);
     toConfig(core::kanayamaTable(), old, config);  // the server then reports (and stores) the values in force
     return;
   }
@@ -64,8 +64,10 @@ void KinematicController::odomCallback(const nav_msgs::Odometry::ConstPtr& msg) 
   if (!grid_reported_ && inputs_.secondsPassed(msg->header.stamp)) {
     // Once, not throttled: a throttle runs on simulated time, which a stalled lockstep loop never advances.
     grid_reported_ = true;
-    ROS_ERROR("kinematic_controller: no reference stamped t=%.9f s, but newer ones: the reference generator's "
-              "control_rate does not match plant_sim's", msg->header.stamp.toSec());
+    ROS_ERROR(
+        "kinematic_controller: no reference stamped t=%.9f s, but newer ones: the reference generator's "
+        "control_rate does not match plant_sim's",
+        msg->header.stamp.toSec());
   }
   stopIfStale(*msg);
 }
@@ -78,8 +80,8 @@ void KinematicController::stopIfStale(const nav_msgs::Odometry& odom) {
   const double age = (odom.header.stamp - (inputs_.any() ? inputs_.lastStamp() : ros::Time(0))).toSec();
   if (age <= input_timeout_) return;
   // No reference (generator dead or restarting): ask the inner loop to stop the robot.
-  ROS_WARN_THROTTLE(1.0, "kinematic_controller: no reference for %.3f s (input_timeout %.3f s): commanding stop",
-                    age, input_timeout_);
+  ROS_WARN_THROTTLE(1.0, "kinematic_controller: no reference for %.3f s (input_timeout %.3f s): commanding stop", age,
+                    input_timeout_);
   desired_.header.stamp = odom.header.stamp;
   desired_.v = desired_.omega = desired_.v_dot = desired_.omega_dot = 0.0;
   publishShared(desired_pub_, desired_);
@@ -103,8 +105,7 @@ void KinematicController::compute() {
   ref.omega = r.omega;
   ref.v_dot = r.v_dot;
   ref.omega_dot = r.omega_dot;
-  const core::VelocityCommand cmd =
-      kanayama_.compute(ref, pose, odom.twist.twist.linear.x, odom.twist.twist.angular.z);
+  const core::VelocityCommand cmd = kanayama_.compute(ref, pose, odom.twist.twist.linear.x, odom.twist.twist.angular.z);
   desired_.header.stamp = odom.header.stamp;
   desired_.v = cmd.v;
   desired_.omega = cmd.omega;

@@ -46,8 +46,10 @@ void PlantContacts::update(double t, const core::Pose2D& pose) {
     if (!started && !ended) continue;
     publish(e);
     if (started)
-      ROS_WARN("plant_sim: contact with obstacle %zu at t=%.3f s: the body overlaps it (the plant does not stop "
-               "the robot)", e.obstacle, e.start);
+      ROS_WARN(
+          "plant_sim: contact with obstacle %zu at t=%.3f s: the body overlaps it (the plant does not stop "
+          "the robot)",
+          e.obstacle, e.start);
     else
       ROS_WARN("plant_sim: contact with obstacle %zu ended at t=%.3f s, %.3f m deep at most", e.obstacle, e.end,
                e.max_depth);

@@ -16,7 +16,9 @@ std::int64_t lastStep(double duration, std::int64_t period_ns) {
 }  // namespace
 
 LockstepDriver::LockstepDriver(ros::NodeHandle nh, SimulatedPlant& plant, const Config& config)
-    : plant_(plant), cfg_(config), protocol_(plant.periodNs(), lastStep(config.duration, plant.periodNs()), config.timing) {
+    : plant_(plant),
+      cfg_(config),
+      protocol_(plant.periodNs(), lastStep(config.duration, plant.periodNs()), config.timing) {
   torque_sub_ = subscribeTorque(nh, &queue_, [this](const WheelTorque::ConstPtr& m) { torqueCallback(m); });
 }
 
@@ -51,13 +53,12 @@ void LockstepDriver::torqueCallback(const WheelTorque::ConstPtr& msg) {
                         msg->header.stamp.toSec(), 1e-9 * protocol_.stampOf(protocol_.awaited()), protocol_.late());
       return;
     case Answer::kNonFinite:
-      ROS_WARN_THROTTLE(1.0, "plant_sim: rejected non-finite wheel torque (right %f, left %f); %ld so far",
-                        msg->right, msg->left, protocol_.nonFinite());
+      ROS_WARN_THROTTLE(1.0, "plant_sim: rejected non-finite wheel torque (right %f, left %f); %ld so far", msg->right,
+                        msg->left, protocol_.nonFinite());
       return;
     case Answer::kRepeat:  // a re-sent state answered twice: the first answer was used
     case Answer::kAhead:
-    case Answer::kNotRunning:
-      return;
+    case Answer::kNotRunning: return;
   }
 }
 
@@ -65,10 +66,11 @@ void LockstepDriver::reportFinished() {
   const double wall = ros::WallTime::now().toSec() - protocol_.startedAt();
   const std::string repeats =
       protocol_.repeats() > 0 ? "; " + std::to_string(protocol_.repeats()) + " repeated answers ignored" : "";
-  ROS_INFO("plant_sim: lockstep scenario finished: %.3f s simulated in %.3f s wall (real-time factor %.2f); "
-           "%ld late and %ld non-finite torques ignored%s",
-           cfg_.duration, wall, wall > 0 ? cfg_.duration / wall : 0.0, protocol_.late(), protocol_.nonFinite(),
-           repeats.c_str());
+  ROS_INFO(
+      "plant_sim: lockstep scenario finished: %.3f s simulated in %.3f s wall (real-time factor %.2f); "
+      "%ld late and %ld non-finite torques ignored%s",
+      cfg_.duration, wall, wall > 0 ? cfg_.duration / wall : 0.0, protocol_.late(), protocol_.nonFinite(),
+      repeats.c_str());
   plant_.reportContacts();
 }
 
@@ -84,11 +86,15 @@ std::string LockstepDriver::torqueSources() const {
 
 void LockstepDriver::report(const core::LockstepProtocol::Supervision& s) const {
   if (s.step < 0) {
-    ROS_WARN("plant_sim: lockstep waiting for the loop for %.1f s wall: %u/%d odom subscribers, %u wheel_torque "
-             "publishers", s.waited, plant_.odomSubscribers(), cfg_.min_subscribers, torque_sub_.getNumPublishers());
+    ROS_WARN(
+        "plant_sim: lockstep waiting for the loop for %.1f s wall: %u/%d odom subscribers, %u wheel_torque "
+        "publishers",
+        s.waited, plant_.odomSubscribers(), cfg_.min_subscribers, torque_sub_.getNumPublishers());
   } else {
-    ROS_ERROR("plant_sim: lockstep stalled at t=%.6f s: no wheel_torque stamped for it after %.1f s wall (%s); "
-              "waiting", plant_.stampOf(s.step).toSec(), s.waited, torqueSources().c_str());
+    ROS_ERROR(
+        "plant_sim: lockstep stalled at t=%.6f s: no wheel_torque stamped for it after %.1f s wall (%s); "
+        "waiting",
+        plant_.stampOf(s.step).toSec(), s.waited, torqueSources().c_str());
   }
 }
 

@@ -21,8 +21,8 @@ core::State restAt(const core::Pose2D& start) {
 }  // namespace
 
 SimulatedPlant::SimulatedPlant(ros::NodeHandle nh, const core::RobotParams& robot,
-                               const core::PlantDisturbance& disturbance, const core::Pose2D& start,
-                               const Rates& rates, const core::Footprint& footprint)
+                               const core::PlantDisturbance& disturbance, const core::Pose2D& start, const Rates& rates,
+                               const core::Footprint& footprint)
     : rates_(rates), plant_(robot, disturbance) {
   plant_.reset(restAt(start), 0.0);
   visual_every_ = std::max<std::int64_t>(1, std::llround(1e9 / rates_.publish_rate / rates_.period_ns));

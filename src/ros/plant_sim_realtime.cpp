@@ -15,8 +15,8 @@ RealtimeDriver::~RealtimeDriver() { torque_sub_.shutdown(); }
 void RealtimeDriver::torqueCallback(const WheelTorque::ConstPtr& msg) {
   if (!core::allFinite(msg->right, msg->left)) {
     ++rejected_;
-    ROS_WARN_THROTTLE(1.0, "plant_sim: rejected non-finite wheel torque (right %f, left %f); %ld so far",
-                      msg->right, msg->left, rejected_);
+    ROS_WARN_THROTTLE(1.0, "plant_sim: rejected non-finite wheel torque (right %f, left %f); %ld so far", msg->right,
+                      msg->left, rejected_);
     return;
   }
   torque_ = {msg->right, msg->left};
@@ -51,8 +51,8 @@ void RealtimeDriver::run() {
     } else if (remaining < ros::WallDuration(-0.05)) {
       // More than 50 ms behind (an overloaded machine): slip the schedule instead of bursting steps,
       // which would run simulated time ahead of the controllers and trip their timeouts.
-      slipped = k + 1 - static_cast<std::int64_t>((ros::WallTime::now() - wall_start).toSec() *
-                                                   cfg_.realtime_factor / dt);
+      slipped =
+          k + 1 - static_cast<std::int64_t>((ros::WallTime::now() - wall_start).toSec() * cfg_.realtime_factor / dt);
       ROS_WARN_THROTTLE(10.0, "plant_sim: realtime fell behind the wall clock; slipping (machine overloaded?)");
     }
     queue_.callAvailable();  // every torque that came during the step; the newest is held

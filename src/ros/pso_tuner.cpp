@@ -59,9 +59,12 @@ std::string parseGains(const ros::NodeHandle& pnh, std::vector<core::GainBounds>
         b.name = static_cast<std::string>(v);
       } else if (key == "lower" || key == "upper") {
         double x;
-        if (v.getType() == XmlRpc::XmlRpcValue::TypeDouble) x = static_cast<double>(v);
-        else if (v.getType() == XmlRpc::XmlRpcValue::TypeInt) x = static_cast<int>(v);
-        else return at + "/" + key + " must be a number";
+        if (v.getType() == XmlRpc::XmlRpcValue::TypeDouble)
+          x = static_cast<double>(v);
+        else if (v.getType() == XmlRpc::XmlRpcValue::TypeInt)
+          x = static_cast<int>(v);
+        else
+          return at + "/" + key + " must be a number";
         (key == "lower" ? b.lower : b.upper) = x;
       } else {
         return at + ": unknown key '" + key + "' (expected name, lower, upper)";
@@ -84,8 +87,10 @@ std::string yamlFloat(double v) {
   std::string s(b, r.ptr);
   if (s.find('.') == std::string::npos) {  // YAML 1.1 needs the dot: "2" is an int, "1e-05" a string
     const auto e = s.find('e');
-    if (e == std::string::npos) s += ".0";
-    else s.insert(e, ".0");
+    if (e == std::string::npos)
+      s += ".0";
+    else
+      s.insert(e, ".0");
   }
   return s;
 }
@@ -173,9 +178,10 @@ PsoTuner::PsoTuner(ros::NodeHandle nh, ros::NodeHandle pnh) {
   reference_ = core::LineReference(line_v_, line_y_, line_x0_);
 
   const std::string gains_error = parseGains(pnh, gains_);
-  std::string e = core::firstError({plant.error(), kin.error(), torque.error(), refp.error(), robot_error,
-                                    settings.validate(), gains_error});
-  if (e.empty()) e = core::firstError({base_.validate(), core::validateGainBounds(base_, gains_), objective_.validate()});
+  std::string e = core::firstError(
+      {plant.error(), kin.error(), torque.error(), refp.error(), robot_error, settings.validate(), gains_error});
+  if (e.empty())
+    e = core::firstError({base_.validate(), core::validateGainBounds(base_, gains_), objective_.validate()});
   if (e.empty()) {
     for (const auto& b : gains_) {
       pso_.lower.push_back(b.lower);
@@ -188,7 +194,8 @@ PsoTuner::PsoTuner(ros::NodeHandle nh, ros::NodeHandle pnh) {
 
   progress_pub_ = nh.advertise<std_msgs::Float64MultiArray>("pso/progress", 10, true);
   std::string dims;
-  for (const auto& b : gains_) dims += (dims.empty() ? "" : ", ") + b.name + " [" + g(b.lower) + ", " + g(b.upper) + "]";
+  for (const auto& b : gains_)
+    dims += (dims.empty() ? "" : ", ") + b.name + " [" + g(b.lower) + ", " + g(b.upper) + "]";
   logSettings("pso_tuner", core::PsoTunerSettings::table(), settings);
   ROS_INFO("pso_tuner: %d evaluation thread(s)", core::psoThreads(pso_));
   ROS_INFO("pso_tuner: scenario %s", scenarioText().c_str());
@@ -200,8 +207,8 @@ std::string PsoTuner::scenarioText() const {
   const core::PlantDisturbance& d = base_.disturbance;
   std::string s = g(base_.duration) + " s at " + g(1e9 / static_cast<double>(base_.control_period_ns)) + " Hz, " +
                   (base_.sliding.adaptive ? "atsmc" : "tsmc") + ", start (" + g(base_.start.x) + ", " +
-                  g(base_.start.y) + ", " + g(base_.start.theta) + "), line x = " + g(line_x0_) + " + " +
-                  g(line_v_) + " t, y = " + g(line_y_) + ", ";
+                  g(base_.start.y) + ", " + g(base_.start.theta) + "), line x = " + g(line_x0_) + " + " + g(line_v_) +
+                  " t, y = " + g(line_y_) + ", ";
   s += d.sinusoidal ? "sinusoidal disturbance A " + g(d.amplitude) + " N.m w " + g(d.frequency) + " rad/s"
                     : "no sinusoidal disturbance";
   s += ", mismatch mass x" + g(d.mass_scale) + " inertia x" + g(d.inertia_scale);
@@ -216,8 +223,13 @@ void PsoTuner::onProgress(const core::PsoProgress& p) {
            p.iterations, p.best_cost, initial_best_, p.elapsed_s, p.eta_s);
   std_msgs::Float64MultiArray m;
   std::string labels = "iteration,iterations,best_cost,initial_best_cost,elapsed_s,eta_s,evaluations";
-  m.data = {static_cast<double>(p.iteration), static_cast<double>(p.iterations), p.best_cost, initial_best_,
-            p.elapsed_s, p.eta_s, static_cast<double>(pso_.particles) * (p.iteration + 1)};
+  m.data = {static_cast<double>(p.iteration),
+            static_cast<double>(p.iterations),
+            p.best_cost,
+            initial_best_,
+            p.elapsed_s,
+            p.eta_s,
+            static_cast<double>(pso_.particles) * (p.iteration + 1)};
   for (std::size_t d = 0; d < gains_.size(); ++d) {
     labels += "," + gains_[d].name;
     m.data.push_back((*p.best_position)[d]);
@@ -248,7 +260,8 @@ int PsoTuner::run() {
   const std::time_t now = std::time(nullptr);
   std::strftime(date, sizeof date, "%Y-%m-%d %H:%M:%S %z", std::localtime(&now));
   std::string searched;
-  for (const auto& b : gains_) searched += (searched.empty() ? "" : ", ") + b.name + " [" + g(b.lower) + ", " + g(b.upper) + "]";
+  for (const auto& b : gains_)
+    searched += (searched.empty() ? "" : ", ") + b.name + " [" + g(b.lower) + ", " + g(b.upper) + "]";
   std::string h;
   h += "# Controller gains tuned offline by pso_tuner (PSO, thesis eqs 4.26-4.31, Table 5.4).\n";
   h += "# Load with: roslaunch sowing_robot sim.launch gains:=THIS_FILE controller:=" +
@@ -261,8 +274,8 @@ int PsoTuner::run() {
   h += "\n";
   h += "# best_cost: " + yamlFloat(r.pso.best_cost) + "\n";
   h += "# initial_best_cost: " + yamlFloat(r.initial_best_cost) + "   (best of the random initial swarm)\n";
-  h += "# best cost terms: tracking " + g(r.best.tracking) + ", effort " + g(r.best.effort) + " N^2.m^2.s, chattering " +
-       g(r.best.chattering) + " N.m\n";
+  h += "# best cost terms: tracking " + g(r.best.tracking) + ", effort " + g(r.best.effort) +
+       " N^2.m^2.s, chattering " + g(r.best.chattering) + " N.m\n";
   h += "# pso: particles " + std::to_string(pso_.particles) + ", iterations " + std::to_string(pso_.iterations) +
        ", seed " + std::to_string(pso_.seed) + ", w " + g(pso_.w_max) + "..." + g(pso_.w_min) + ", c1 " + g(pso_.c1) +
        ", c2 " + g(pso_.c2) + ", velocity clamp " + g(pso_.max_velocity_fraction) + ", evaluations " +
@@ -278,9 +291,10 @@ int PsoTuner::run() {
   std::string best;
   for (std::size_t d = 0; d < gains_.size(); ++d)
     best += (d ? ", " : "") + gains_[d].name + " " + fmt("%.5g", r.best_gains[d]);
-  ROS_INFO("pso_tuner: done in %.2f s (%ld evaluations, %ld of them stopped once they could not beat their "
-           "particle's best, %d thread(s)): cost %.6g -> %.6g; %s", r.wall_s, r.pso.evaluations, r.evaluations_cut,
-           r.threads, r.initial_best_cost, r.pso.best_cost, best.c_str());
+  ROS_INFO(
+      "pso_tuner: done in %.2f s (%ld evaluations, %ld of them stopped once they could not beat their "
+      "particle's best, %d thread(s)): cost %.6g -> %.6g; %s",
+      r.wall_s, r.pso.evaluations, r.evaluations_cut, r.threads, r.initial_best_cost, r.pso.best_cost, best.c_str());
   ROS_INFO("pso_tuner: wrote %s", output_.c_str());
   if (progress_pub_.getNumSubscribers() > 0) ros::WallDuration(0.3).sleep();  // let the last message go out
   return 0;

@@ -5,13 +5,13 @@
 #include <stdexcept>
 #include <string>
 
+#include "sowing_robot/core/seeding.h"
 #include "sowing_robot/core/validation.h"
 #include "sowing_robot/ros/component_params.h"
-#include "sowing_robot/ros/node_failure.h"
 #include "sowing_robot/ros/msg_checks.h"
+#include "sowing_robot/ros/node_failure.h"
 #include "sowing_robot/ros/reconfigure_bridge.h"
 #include "sowing_robot/ros/urdf_params.h"
-#include "sowing_robot/core/seeding.h"
 
 namespace sowing_robot {
 
@@ -41,8 +41,10 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
   } else {
     for (const char* key : {"field", "potential", "obstacles"})
       if (error.empty() && pnh.hasParam(key))
-        error = pnh.resolveName(key) + " is set but type is 'line': field, potential and obstacles are read only "
-                "with type: field (set " + pnh.resolveName("type") + ": field, or remove them)";
+        error = pnh.resolveName(key) +
+                " is set but type is 'line': field, potential and obstacles are read only "
+                "with type: field (set " +
+                pnh.resolveName("type") + ": field, or remove them)";
   }
   requireValid(p, error);
   odom_frame_ = run.odom_frame;
@@ -64,8 +66,10 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
     obstacles_ = obstacles;
     source_ = std::move(f);
     logSettings("reference_generator", core::fieldTable(), field);
-    ROS_INFO("reference_generator: footprint circumscribed radius %.3f m (URDF collision geometry): obstacles "
-             "are inflated by it + field/avoidance/safety_margin", field.avoidance.footprint_radius);
+    ROS_INFO(
+        "reference_generator: footprint circumscribed radius %.3f m (URDF collision geometry): obstacles "
+        "are inflated by it + field/avoidance/safety_margin",
+        field.avoidance.footprint_radius);
     ROS_INFO("reference_generator: field path %.3f m in %.3f s%s", field_->path().length(), field_->duration(),
              field.rows > 1 ? (field_->path().turn().isBulb() ? ", bulb turns" : ", rounded turns") : "");
     for (std::size_t i = 0; i < obstacles_.size(); ++i)
@@ -97,8 +101,10 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
   }
   publishPlan();
   clock_sub_ = nh.subscribe("/clock", 10, &ReferenceGenerator::clockCallback, this, ros::TransportHints().tcpNoDelay());
-  ROS_INFO("reference_generator: references on a %.6f s grid (run/control_rate), sent %.3f s ahead of /clock "
-           "(lookahead)", core::secondsFromNanos(period_ns_), lookahead_);
+  ROS_INFO(
+      "reference_generator: references on a %.6f s grid (run/control_rate), sent %.3f s ahead of /clock "
+      "(lookahead)",
+      core::secondsFromNanos(period_ns_), lookahead_);
 }
 
 void ReferenceGenerator::obstaclesCallback(const visualization_msgs::MarkerArray::ConstPtr& msg) {
@@ -264,25 +270,29 @@ void ReferenceGenerator::fill(ReferenceState& out, const ros::Time& stamp) {
 void ReferenceGenerator::clockCallback(const rosgraph_msgs::Clock::ConstPtr& msg) {
   const std::int64_t now = static_cast<std::int64_t>(msg->clock.toNSec());
   if (clock_seen_ && now < last_clock_ns_) {
-    ROS_ERROR("reference_generator: simulated time went back from %.6f s to %.6f s: references already sent are "
-              "not sent again (the potential field integrates forward); restart this node with the plant",
-              1e-9 * last_clock_ns_, 1e-9 * now);
+    ROS_ERROR(
+        "reference_generator: simulated time went back from %.6f s to %.6f s: references already sent are "
+        "not sent again (the potential field integrates forward); restart this node with the plant",
+        1e-9 * last_clock_ns_, 1e-9 * now);
     last_clock_ns_ = now;
     return;
   }
   if (now % period_ns_ != 0 && !grid_warned_) {
     grid_warned_ = true;
-    ROS_ERROR("reference_generator: /clock at t=%.9f s is not on the %.6f s grid of control_rate (%.3f Hz): it "
-              "must equal plant_sim's, or the controllers wait for references stamped at times never sent",
-              msg->clock.toSec(), core::secondsFromNanos(period_ns_), 1e9 / period_ns_);
+    ROS_ERROR(
+        "reference_generator: /clock at t=%.9f s is not on the %.6f s grid of control_rate (%.3f Hz): it "
+        "must equal plant_sim's, or the controllers wait for references stamped at times never sent",
+        msg->clock.toSec(), core::secondsFromNanos(period_ns_), 1e9 / period_ns_);
   }
   // The window must outlast the gap to the next /clock, or the loop would wait for a reference that only
   // that /clock (which needs the loop to advance) would release: at least twice the largest gap seen.
   // (Should a gap still exceed it, plant_sim re-sends /clock with the state it is stuck at.)
   if (clock_seen_ && now > last_clock_ns_ && 2 * (now - last_clock_ns_) > window_ns_) {
     window_ns_ = 2 * (now - last_clock_ns_);
-    ROS_WARN("reference_generator: /clock comes every %.3f s of simulated time: references now sent %.3f s ahead "
-             "(lookahead %.3f s)", 1e-9 * (now - last_clock_ns_), 1e-9 * window_ns_, lookahead_);
+    ROS_WARN(
+        "reference_generator: /clock comes every %.3f s of simulated time: references now sent %.3f s ahead "
+        "(lookahead %.3f s)",
+        1e-9 * (now - last_clock_ns_), 1e-9 * window_ns_, lookahead_);
   }
   clock_seen_ = true;
   last_clock_ns_ = now;

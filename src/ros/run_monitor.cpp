@@ -27,14 +27,14 @@ RunMonitor::RunMonitor(ros::NodeHandle nh, ros::NodeHandle pnh) : pnh_(pnh) {
   metrics_ = core::MetricsAccumulator(settings.time_domain);
   metrics_.reserve(static_cast<std::size_t>(duration_ * 1000.0) + 2);
   // Subscribed from the start: the recorder's latched stamp is then already here when the run ends.
-  if (!recorder_topic_.empty())
-    recorder_sub_ = nh.subscribe(recorder_topic_, 10, &RunMonitor::recordedCallback, this);
-  sub_ = nh.subscribe("tracking_error", kLockstepQueue, &RunMonitor::errorCallback, this, ros::TransportHints().tcpNoDelay());
+  if (!recorder_topic_.empty()) recorder_sub_ = nh.subscribe(recorder_topic_, 10, &RunMonitor::recordedCallback, this);
+  sub_ = nh.subscribe("tracking_error", kLockstepQueue, &RunMonitor::errorCallback, this,
+                      ros::TransportHints().tcpNoDelay());
 }
 
 void RunMonitor::errorCallback(const TrackingError::ConstPtr& msg) {
   if (done_) return;
-  if (metrics_.samples() > 0 && msg->header.stamp <= last_) return;  // repeats answer a retried state
+  if (metrics_.samples() > 0 && msg->header.stamp <= last_) return;            // repeats answer a retried state
   if (!metrics_.add(msg->header.stamp.toSec(), msg->x, msg->y, msg->theta)) {  // refuses non-finite errors
     ROS_WARN_THROTTLE(1.0, "run_monitor: non-finite tracking error ignored");
     return;

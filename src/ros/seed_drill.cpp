@@ -118,7 +118,7 @@ void SeedDrillNode::publishReport() {
   r.layout.dim[0].size = 7;
   r.layout.dim[0].stride = 7;
   r.data = {static_cast<double>(rows.count), rows.max, rows.rms, rows.fraction_over,
-            static_cast<double>(det.count), det.max, det.rms};
+            static_cast<double>(det.count),  det.max,  det.rms};
   report_pub_.publish(r);
 }
 

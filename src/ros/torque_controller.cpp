@@ -1,7 +1,7 @@
 #include "sowing_robot/ros/torque_controller.h"
 
-#include "sowing_robot/ros/component_params.h"
 #include "sowing_robot/core/validation.h"
+#include "sowing_robot/ros/component_params.h"
 #include "sowing_robot/ros/msg_checks.h"
 #include "sowing_robot/ros/reconfigure_bridge.h"
 
@@ -36,7 +36,6 @@ TorqueController::TorqueController(ros::NodeHandle nh, ros::NodeHandle pnh) {
   odom_sub_ = nh.subscribe("odom", kLockstepQueue, &TorqueController::odomCallback, this, hints);
   desired_sub_ = nh.subscribe("desired_velocity", kLockstepQueue, &TorqueController::desiredCallback, this, hints);
 }
-
 
 void TorqueController::reconfigure(TorqueControllerConfig& config, uint32_t) {
   // The server's first call repeats the start-up values; applying them again changes nothing.
@@ -73,8 +72,8 @@ bool TorqueController::holdZeroIfStale(const nav_msgs::Odometry& odom) {
   const double age = have ? (odom.header.stamp - inputs_.lastStamp()).toSec() : odom.header.stamp.toSec();
   if (age <= input_timeout_) return false;
   // The kinematic controller is silent (dead or restarting): command zero torque, the robot coasts.
-  ROS_WARN_THROTTLE(1.0, "torque_controller: no desired_velocity for %.3f s (input_timeout %.3f s): zero torque",
-                    age, input_timeout_);
+  ROS_WARN_THROTTLE(1.0, "torque_controller: no desired_velocity for %.3f s (input_timeout %.3f s): zero torque", age,
+                    input_timeout_);
   stale_ = true;
   torque_.header.stamp = odom.header.stamp;
   torque_.right = torque_.left = 0.0;
@@ -103,8 +102,7 @@ void TorqueController::compute() {
     stale_ = false;
     ROS_INFO("torque_controller: desired_velocity is back at t = %.3f s: resuming", odom.header.stamp.toSec());
   }
-  const core::SlidingModeOutput out =
-      smc_->update(cmd, odom.twist.twist.linear.x, odom.twist.twist.angular.z, dt_);
+  const core::SlidingModeOutput out = smc_->update(cmd, odom.twist.twist.linear.x, odom.twist.twist.angular.z, dt_);
   torque_.header.stamp = odom.header.stamp;
   torque_.right = out.torques.right;
   torque_.left = out.torques.left;

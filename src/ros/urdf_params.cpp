@@ -16,7 +16,7 @@ namespace {
 
 const char* const kBaseLink = "base_link";
 const char* const kChassisLink = "chassis";
-const double kGeomTol = 1e-9;     ///< tolerance on lengths and unit vectors [m] / [-]
+const double kGeomTol = 1e-9;      ///< tolerance on lengths and unit vectors [m] / [-]
 const double kInertiaTol = 1e-12;  ///< tolerance on left/right mass and inertia equality
 
 std::string num(double v) {
@@ -47,8 +47,7 @@ Eigen::Matrix3d inertiaInLinkFrame(const urdf::Inertial& in) {
 
 /// Pose of the frame of `link_name`'s parent joint parent link in base_link, walking fixed joints only.
 /// Returns "" or an error naming the offending link/joint.
-std::string parentFrameInBase(const urdf::ModelInterface& model, const std::string& link_name,
-                              Eigen::Isometry3d& out) {
+std::string parentFrameInBase(const urdf::ModelInterface& model, const std::string& link_name, Eigen::Isometry3d& out) {
   Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
   std::string name = link_name;
   for (std::size_t depth = 0; name != kBaseLink; ++depth) {
@@ -69,8 +68,8 @@ std::string parentFrameInBase(const urdf::ModelInterface& model, const std::stri
 }
 
 /// Pose of `link_name`'s own frame in base_link (its parent joint at zero position).
-std::string frameInBase(const urdf::ModelInterface& model, const std::string& link_name,
-                        bool allow_moving_own_joint, Eigen::Isometry3d& out) {
+std::string frameInBase(const urdf::ModelInterface& model, const std::string& link_name, bool allow_moving_own_joint,
+                        Eigen::Isometry3d& out) {
   if (link_name == kBaseLink) {
     out = Eigen::Isometry3d::Identity();
     return "";
@@ -81,8 +80,7 @@ std::string frameInBase(const urdf::ModelInterface& model, const std::string& li
     return "link " + quoted(link_name) + " is not below " + quoted(kBaseLink) + " in the URDF tree";
   const urdf::Joint& j = *link->parent_joint;
   if (!allow_moving_own_joint && j.type != urdf::Joint::FIXED)
-    return "joint " + quoted(j.name) + " between " + quoted(kBaseLink) + " and " + quoted(link_name) +
-           " must be fixed";
+    return "joint " + quoted(j.name) + " between " + quoted(kBaseLink) + " and " + quoted(link_name) + " must be fixed";
   Eigen::Isometry3d parent;
   const std::string err = parentFrameInBase(model, link_name, parent);
   if (!err.empty()) return err;
@@ -96,12 +94,11 @@ struct Wheel {
   double spin_inertia = 0.0;      ///< Iw: about the joint axis [kg·m^2]
   double vertical_inertia = 0.0;  ///< Im: about base_link's vertical through the wheel centre [kg·m^2]
   Eigen::Vector3d origin = Eigen::Vector3d::Zero();  ///< joint origin in base_link [m]
-  double radius = 0.0;            ///< collision cylinder radius [m]
+  double radius = 0.0;                               ///< collision cylinder radius [m]
 };
 
 /// Reads one drive wheel. `side_sign` is -1 for the right wheel (y < 0), +1 for the left.
-std::string readWheel(const urdf::ModelInterface& model, const std::string& joint_name, double side_sign,
-                      Wheel& w) {
+std::string readWheel(const urdf::ModelInterface& model, const std::string& joint_name, double side_sign, Wheel& w) {
   w.joint = joint_name;
   urdf::JointConstSharedPtr joint = model.getJoint(joint_name);
   if (!joint) return "joint " + quoted(joint_name) + " not found";
@@ -161,19 +158,17 @@ std::string readWheel(const urdf::ModelInterface& model, const std::string& join
   if (cyl_axis.cross(axis_local).norm() > kGeomTol)
     return "link " + quoted(w.link) + " collision cylinder axis is not along " + quoted(joint_name) + " axis";
   if (cyl_pose.translation().cross(axis_local).norm() > kGeomTol)
-    return "link " + quoted(w.link) + " collision cylinder is not centred on the " + quoted(joint_name) +
-           " axle";
+    return "link " + quoted(w.link) + " collision cylinder is not centred on the " + quoted(joint_name) + " axle";
   w.radius = cyl->radius;
   if (!(std::isfinite(w.radius) && w.radius > 0.0))
     return "link " + quoted(w.link) + " collision cylinder radius = " + num(w.radius) + " m must be > 0";
   if (std::abs(w.radius - w.origin.z()) > kGeomTol)
-    return "link " + quoted(w.link) + ": wheel radius ≠ axle height (collision cylinder radius " +
-           num(w.radius) + " m, " + quoted(joint_name) + " z " + num(w.origin.z()) + " m)";
+    return "link " + quoted(w.link) + ": wheel radius ≠ axle height (collision cylinder radius " + num(w.radius) +
+           " m, " + quoted(joint_name) + " z " + num(w.origin.z()) + " m)";
   return "";
 }
 
-std::string compare(const std::string& what, double right, double left, double tol, const Wheel& r,
-                    const Wheel& l) {
+std::string compare(const std::string& what, double right, double left, double tol, const Wheel& r, const Wheel& l) {
   if (std::abs(right - left) <= tol) return "";
   return "wheels differ in " + what + ": " + quoted(r.link) + "/" + quoted(r.joint) + " " + num(right) + " vs " +
          quoted(l.link) + "/" + quoted(l.joint) + " " + num(left);
@@ -211,8 +206,7 @@ std::string fromModel(const urdf::ModelInterface& model, core::RobotParams& p) {
   err = core::firstError(
       {compare("mass [kg]", right.mass, left.mass, kInertiaTol, right, left),
        compare("spin inertia Iw [kg·m^2]", right.spin_inertia, left.spin_inertia, kInertiaTol, right, left),
-       compare("vertical inertia Im [kg·m^2]", right.vertical_inertia, left.vertical_inertia, kInertiaTol, right,
-               left),
+       compare("vertical inertia Im [kg·m^2]", right.vertical_inertia, left.vertical_inertia, kInertiaTol, right, left),
        compare("half track |y| [m]", -right.origin.y(), left.origin.y(), kGeomTol, right, left),
        compare("radius [m]", right.radius, left.radius, kGeomTol, right, left)});
   if (!err.empty()) return err;
@@ -227,8 +221,8 @@ std::string fromModel(const urdf::ModelInterface& model, core::RobotParams& p) {
     const std::string& name = kv.first;
     if (name == kChassisLink || name == right.link || name == left.link) continue;
     if (kv.second && kv.second->inertial && kv.second->inertial->mass != 0.0)
-      return "link " + quoted(name) + " has mass " + num(kv.second->inertial->mass) +
-             " kg; lump it into " + quoted(kChassisLink) + " (the model has only chassis and two wheels)";
+      return "link " + quoted(name) + " has mass " + num(kv.second->inertial->mass) + " kg; lump it into " +
+             quoted(kChassisLink) + " (the model has only chassis and two wheels)";
   }
   return "";
 }
@@ -325,7 +319,8 @@ std::string footprintFromUrdf(const std::string& urdf_xml, core::Footprint& out)
   urdf::ModelInterfaceSharedPtr model;
   std::string err = parse(urdf_xml, model);
   if (!err.empty()) return err;
-  if (!model->getLink(kBaseLink)) return "URDF " + quoted(model->getName()) + ": link " + quoted(kBaseLink) + " not found";
+  if (!model->getLink(kBaseLink))
+    return "URDF " + quoted(model->getName()) + ": link " + quoted(kBaseLink) + " not found";
   std::vector<Eigen::Vector2d> pts;
   for (const auto& kv : model->links_) {
     const urdf::LinkConstSharedPtr link = kv.second;
@@ -344,7 +339,8 @@ std::string footprintFromUrdf(const std::string& urdf_xml, core::Footprint& out)
   }
   core::Footprint f = core::Footprint::convexHull(pts);
   err = f.validate();
-  if (!err.empty()) return "URDF " + quoted(model->getName()) + ": collision geometry gives no usable footprint: " + err;
+  if (!err.empty())
+    return "URDF " + quoted(model->getName()) + ": collision geometry gives no usable footprint: " + err;
   out = f;
   return "";
 }

@@ -137,7 +137,7 @@ TEST(HeadlandTurn, EndsOneSpacingAsideWithReversedHeadingWithinLimits) {
 }
 
 TEST(FieldReference, ThreeRowFieldRespectsTurnLimitsAndFinishes) {
-  for (const double spacing : {0.75, 2.0}) {       // bulb turns and rounded semicircles
+  for (const double spacing : {0.75, 2.0}) {  // bulb turns and rounded semicircles
     for (const bool left : {true, false}) {
       FieldParams p = threeRows(spacing);
       p.rows_to_left = left;

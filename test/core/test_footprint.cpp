@@ -14,7 +14,8 @@ using sowing_robot::core::Pose2D;
 namespace {
 /// A 0.6 x 0.4 m rectangle from x = -0.2 to 0.4, y = -0.2 to 0.2, with interior and duplicate points.
 Footprint rectangle() {
-  return Footprint::convexHull({{-0.2, -0.2}, {0.4, -0.2}, {0.4, 0.2}, {-0.2, 0.2}, {0.1, 0.0}, {0.4, 0.2}, {0.4, 0.0}});
+  return Footprint::convexHull(
+      {{-0.2, -0.2}, {0.4, -0.2}, {0.4, 0.2}, {-0.2, 0.2}, {0.1, 0.0}, {0.4, 0.2}, {0.4, 0.0}});
 }
 }  // namespace
 

@@ -22,7 +22,7 @@ TEST(Kanayama, ThesisStartHandComputed) {
   r.pose = {0, 3, 0};
   r.v = 1.0;
   const VelocityCommand c = k.compute(r, {-1, 0, 0}, 0.0, 0.0);
-  EXPECT_NEAR(c.v, 1.0 + 1.0 * 1.0, 1e-12);           // v_r cos 0 + kx xe
+  EXPECT_NEAR(c.v, 1.0 + 1.0 * 1.0, 1e-12);              // v_r cos 0 + kx xe
   EXPECT_NEAR(c.omega, 0.0 + 1.0 * (1.5 * 3.0), 1e-12);  // w_r + v_r (ky ye + ktheta sin 0)
   // With v = w = 0: xe' = v_r = 1, ye' = 0, thetae' = 0 -> v_d' = kx = 1, w_d' = 0.
   EXPECT_NEAR(c.v_dot, 1.0, 1e-12);

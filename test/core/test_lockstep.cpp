@@ -96,7 +96,7 @@ TEST(Lockstep, LostMessageIsReSentAfterRetry) {
   EXPECT_FALSE(s.report);
   EXPECT_FALSE(p.tick(0.99, true).resend);  // every retry, not every tick
   EXPECT_TRUE(p.tick(1.0, true).resend);
-  EXPECT_EQ(answer(p, 0), Answer::kStep);  // the re-sent state is answered
+  EXPECT_EQ(answer(p, 0), Answer::kStep);   // the re-sent state is answered
   EXPECT_FALSE(p.tick(1.01, true).resend);  // a new state: its own wait begins
   EXPECT_FALSE(p.tick(1.5, true).resend);
   const LockstepProtocol::Supervision again = p.tick(1.52, true);
@@ -121,7 +121,7 @@ TEST(Lockstep, LateAndEarlyTorquesAreIgnored) {
   for (int k = 0; k < 5; ++k) ASSERT_EQ(answer(p, k), Answer::kStep);
   EXPECT_EQ(answer(p, 2, 9.0, 9.0), Answer::kLate);  // an old answer (a stray or restarted source)
   EXPECT_EQ(p.late(), 1);
-  EXPECT_EQ(answer(p, 6), Answer::kAhead);  // for a state never published
+  EXPECT_EQ(answer(p, 6), Answer::kAhead);                                 // for a state never published
   EXPECT_EQ(p.onTorque(5 * kPeriod + 1, WheelTorques{}), Answer::kAhead);  // off the grid
   EXPECT_EQ(p.onTorque(5 * kPeriod - 1, WheelTorques{}), Answer::kLate);
   EXPECT_EQ(p.awaited(), 5);

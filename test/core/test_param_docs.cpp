@@ -52,12 +52,14 @@ TEST(ParamDocs, SyncRefusesAnUnknownKeyAndAnOutOfRangeValue) {
 
 TEST(ParamDocs, SyncRewritesTheCommentAndKeepsTheValue) {
   std::vector<std::string> problems;
-  const std::string out = syncYamlComments("torque_controller:\n  k2: 570.0   # old text\n"
-                                           "              # old continuation\n  eta1: 2.0\n",
-                                           "x.yaml", problems);
+  const std::string out = syncYamlComments(
+      "torque_controller:\n  k2: 570.0   # old text\n"
+      "              # old continuation\n  eta1: 2.0\n",
+      "x.yaml", problems);
   EXPECT_TRUE(problems.empty());
-  EXPECT_EQ(out, "torque_controller:\n  k2: 570.0                 # feedback gain K2 [N·m·s/rad] (> 0, default 150.0)\n"
-                 "  eta1: 2.0                 # switching gain eta1 [N·m] (>= 0, default 2.0)\n");
+  EXPECT_EQ(out,
+            "torque_controller:\n  k2: 570.0                 # feedback gain K2 [N·m·s/rad] (> 0, default 150.0)\n"
+            "  eta1: 2.0                 # switching gain eta1 [N·m] (>= 0, default 2.0)\n");
 }
 
 TEST(ParamTable, DefaultsComeFromTheTable) {

@@ -80,8 +80,8 @@ TEST(PotentialField, GradientMatchesCentralDifference) {
         fd[i] = (pf.repulsivePotential(p + dp) - pf.repulsivePotential(p - dp)) / (2.0 * h);
       }
       ASSERT_GT(g.norm(), 0.0);
-      EXPECT_LE((g - fd).norm(), 1e-5 * g.norm()) << "rho " << rho << " angle " << ang << " g " << g.transpose()
-                                                   << " fd " << fd.transpose();
+      EXPECT_LE((g - fd).norm(), 1e-5 * g.norm())
+          << "rho " << rho << " angle " << ang << " g " << g.transpose() << " fd " << fd.transpose();
       ++checked;
     }
   }
@@ -332,7 +332,7 @@ TEST(PotentialField, OutputDependsOnlyOnTheTimes) {
 TEST(PotentialField, CloneIsIndependentAndReproducesTheSequence) {
   PotentialField original({}, RowLine{0.0, 3.0, 0.0, 1.0}, {{5.0, 3.0, 0.3}});
   for (int k = 0; k <= 4000; ++k) original.next(k * 1e-3);  // advance into the manoeuvre
-  auto copy = original.clone();                               // in its reset state
+  auto copy = original.clone();                             // in its reset state
   PotentialField fresh({}, RowLine{0.0, 3.0, 0.0, 1.0}, {{5.0, 3.0, 0.3}});
   original.reset();
   for (int k = 0; k <= 9000; ++k) {

@@ -310,7 +310,8 @@ TEST(PsoMinimize, NonFiniteCostNeverBecomesBest) {
   // NaN / inf everywhere with x[0] > 0: the best must be on the finite side.
   const PsoParams p = boxParams(2, -1.0, 1.0, 20, 30, 4, 2);
   const PsoResult r = psoMinimize(p, [](const std::vector<double>& x, int) {
-    if (x[0] > 0.0) return x[1] > 0.0 ? std::numeric_limits<double>::quiet_NaN() : -std::numeric_limits<double>::infinity();
+    if (x[0] > 0.0)
+      return x[1] > 0.0 ? std::numeric_limits<double>::quiet_NaN() : -std::numeric_limits<double>::infinity();
     return sphere(x) + 1.0;
   });
   EXPECT_LE(r.best_position[0], 0.0);
@@ -386,8 +387,7 @@ TEST(PsoMinimize, MoreThreadsThanParticlesIsFine) {
   });
   EXPECT_LT(max_index.load(), 3);  // thread_index < min(threads, particles)
   p.threads = 1;
-  EXPECT_EQ(psoMinimize(p, [](const std::vector<double>& x, int) { return sphere(x); }).best_position,
-            r.best_position);
+  EXPECT_EQ(psoMinimize(p, [](const std::vector<double>& x, int) { return sphere(x); }).best_position, r.best_position);
 }
 
 TEST(PsoMinimize, BoundedFitnessSearchesExactlyLikeTheExactOne) {

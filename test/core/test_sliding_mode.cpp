@@ -104,8 +104,7 @@ TEST(SlidingMode, AdaptationConvergesTowardsTheTrueParameters) {
   const double dt = 1e-3;
   for (int i = 0; i < 60000; ++i) {
     const double t = i * dt;
-    const VelocityCommand cmd{0.5 * std::sin(t), 0.8 * std::sin(1.3 * t), 0.5 * std::cos(t),
-                              1.04 * std::cos(1.3 * t)};
+    const VelocityCommand cmd{0.5 * std::sin(t), 0.8 * std::sin(1.3 * t), 0.5 * std::cos(t), 1.04 * std::cos(1.3 * t)};
     const SlidingModeOutput o = c.update(cmd, plant.state()[V], plant.state()[OMEGA], dt);
     plant.step(o.torques.right, o.torques.left, dt);
   }
@@ -125,8 +124,8 @@ TEST(SlidingMode, TorqueIsLimitedAndReported) {
 }
 
 TEST(Switching, EachFunctionIsOddBoundedAndTendsToSign) {
-  for (SwitchType t : {SwitchType::Sign, SwitchType::Saturation, SwitchType::Relay, SwitchType::Atan,
-                       SwitchType::Tanh}) {
+  for (SwitchType t :
+       {SwitchType::Sign, SwitchType::Saturation, SwitchType::Relay, SwitchType::Atan, SwitchType::Tanh}) {
     SwitchFunction f{t, 0.01};
     for (double s : {1e-4, 1e-3, 0.005, 0.02, 0.3, 7.0}) {
       EXPECT_NEAR(f(-s), -f(s), 1e-15) << SwitchFunction::name(t);

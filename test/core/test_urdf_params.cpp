@@ -27,8 +27,7 @@ std::string readUrdf() {
 }
 
 /// Replaces the first `from` found after `anchor` (both must exist) by `to`.
-std::string replaceAfter(std::string xml, const std::string& anchor, const std::string& from,
-                         const std::string& to) {
+std::string replaceAfter(std::string xml, const std::string& anchor, const std::string& from, const std::string& to) {
   const std::size_t a = xml.find(anchor);
   if (a == std::string::npos) throw std::runtime_error("anchor not found: " + anchor);
   const std::size_t p = xml.find(from, a);
@@ -103,8 +102,8 @@ TEST_F(UrdfParams, MissingRightWheelJoint) {
 }
 
 TEST_F(UrdfParams, ZeroWheelRadius) {
-  const std::string edited = replaceAfter(xml, "<link name=\"right_wheel\">", "<collision>",
-                                          "<collision><!-- edited -->");
+  const std::string edited =
+      replaceAfter(xml, "<link name=\"right_wheel\">", "<collision>", "<collision><!-- edited -->");
   const std::string zero = replaceAfter(edited, "<!-- edited -->", "radius=\"0.095\"", "radius=\"0.0\"");
   const std::string err = errorFor(zero);
   EXPECT_TRUE(contains(err, "right_wheel")) << err;
@@ -112,8 +111,8 @@ TEST_F(UrdfParams, ZeroWheelRadius) {
 }
 
 TEST_F(UrdfParams, WheelRadiusNotAxleHeight) {
-  const std::string edited = replaceAfter(xml, "<link name=\"left_wheel\">", "<collision>",
-                                          "<collision><!-- edited -->");
+  const std::string edited =
+      replaceAfter(xml, "<link name=\"left_wheel\">", "<collision>", "<collision><!-- edited -->");
   const std::string big = replaceAfter(edited, "<!-- edited -->", "radius=\"0.095\"", "radius=\"0.1\"");
   const std::string err = errorFor(big);
   EXPECT_TRUE(contains(err, "left_wheel")) << err;
@@ -184,5 +183,6 @@ TEST_F(UrdfParams, ToolLinkIsTheSeedDropPointBehindTheAxle) {
   EXPECT_NEAR(x, -0.45, 1e-12);  // on the ground behind the furrow-opener disc
   EXPECT_NEAR(y, 0.0, 1e-12);
   EXPECT_NE(sowing_robot::linkPositionFromUrdf(xml, "no_such_link", x, y).find("no_such_link"), std::string::npos);
-  EXPECT_NE(sowing_robot::linkPositionFromUrdf("<robot", "tool_link", x, y).find("could not be parsed"), std::string::npos);
+  EXPECT_NE(sowing_robot::linkPositionFromUrdf("<robot", "tool_link", x, y).find("could not be parsed"),
+            std::string::npos);
 }

@@ -92,14 +92,16 @@ std::vector<Case> cases() {
     c.push_back(n);
   }
   // wall-clock stamps (a realtime run): large seconds, toSec's rounding matters
-  c.push_back(sampled("wall_clock_stamps", every(1700000000LL * 1000000000LL + 123 * kMs,
-                                                 1700000000LL * 1000000000LL + 1123 * kMs, kMs),
+  c.push_back(sampled("wall_clock_stamps",
+                      every(1700000000LL * 1000000000LL + 123 * kMs, 1700000000LL * 1000000000LL + 1123 * kMs, kMs),
                       exp_, minus2exp, damped));
-  c.push_back(sampled("zero_error", every(0, 50 * kMs, kMs), [](double) { return 0.0; },
-                      [](double) { return 0.0; }, [](double) { return 0.0; }));
+  c.push_back(sampled(
+      "zero_error", every(0, 50 * kMs, kMs), [](double) { return 0.0; }, [](double) { return 0.0; },
+      [](double) { return 0.0; }));
   // peak at the end: never rises, never settles inside the run
-  c.push_back(sampled("peak_at_end", every(0, 500 * kMs, kMs), [](double t) { return 1.0 - std::exp(-t); },
-                      [](double t) { return -t; }, [](double t) { return t * t; }));
+  c.push_back(sampled(
+      "peak_at_end", every(0, 500 * kMs, kMs), [](double t) { return 1.0 - std::exp(-t); }, [](double t) { return -t; },
+      [](double t) { return t * t; }));
   // the negative peak with an overshoot of the time-domain definitions (README)
   c.push_back({"negative_peak_overshoot",
                {{0, 0.5, 0.5, 0.5},

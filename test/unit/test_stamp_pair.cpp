@@ -52,7 +52,7 @@ TEST(StampPair, FindsTheStateStampAmongAReferenceAheadOfIt) {
   for (int k = 0; k < 5; ++k) {
     if (k == 0) EXPECT_FALSE(p.setSecond(at(0.0, 100)));
     EXPECT_FALSE(p.setSecond(at(0.001 * (k + 1), 101 + k)));  // the one ahead: no state yet
-    ASSERT_TRUE(p.setFirst(at(0.001 * k, k))) << k;            // the state for t_k pairs with ref t_k
+    ASSERT_TRUE(p.setFirst(at(0.001 * k, k))) << k;           // the state for t_k pairs with ref t_k
     EXPECT_EQ(p.first().tag, k);
     EXPECT_EQ(p.second().tag, 100 + k);
   }
@@ -89,7 +89,7 @@ TEST(StampPair, CapsEachStreamDroppingTheOldest) {
   StampPair<Msg, Msg, 4, 16> p;
   for (int k = 0; k < 100; ++k) EXPECT_FALSE(p.setFirst(at(0.001 * k, k)));
   EXPECT_EQ(p.heldFirsts(), 4u);
-  EXPECT_TRUE(p.setSecond(at(0.099, 1)));  // the newest state is still there
+  EXPECT_TRUE(p.setSecond(at(0.099, 1)));   // the newest state is still there
   EXPECT_FALSE(p.setSecond(at(0.050, 2)));  // an old one is not
   for (int k = 0; k < 100; ++k) p.setSecond(at(1.0 + 0.001 * k, k));
   EXPECT_EQ(p.heldSeconds(), 16u);

@@ -18,7 +18,7 @@ namespace core {
 /// One contact: the body overlapped obstacle `obstacle` from `start` to `end` (while `ongoing`, `end` is
 /// the last time seen in contact).
 struct ContactEvent {
-  std::size_t obstacle = 0;  ///< index into the obstacle list in force when it started
+  std::size_t obstacle = 0;       ///< index into the obstacle list in force when it started
   double start = 0.0, end = 0.0;  ///< [s]
   double max_depth = 0.0;         ///< deepest penetration [m], > 0
   bool ongoing = true;

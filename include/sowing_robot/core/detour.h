@@ -59,11 +59,11 @@ struct AvoidanceStatus {
     kNoSafeWay,     ///< a group of obstacles cannot be passed within max_offset: stopped before it
   };
   Code code = Code::kOk;
-  std::string reason;        ///< one line for kStoppedShort / kNoSafeWay, else ""
-  bool within_bounds = true; ///< false: somewhere the curvature, yaw-rate or lateral-acceleration bound does not hold
-  std::string bounds_note;   ///< why not (one line), else ""
+  std::string reason;         ///< one line for kStoppedShort / kNoSafeWay, else ""
+  bool within_bounds = true;  ///< false: somewhere the curvature, yaw-rate or lateral-acceleration bound does not hold
+  std::string bounds_note;    ///< why not (one line), else ""
   Eigen::Vector2d stop_point = Eigen::Vector2d::Zero();  ///< where the path ends when it stops short [m]
-  std::size_t detours = 0;   ///< planned detours
+  std::size_t detours = 0;                               ///< planned detours
   static const char* name(Code c);
 };
 
@@ -72,12 +72,12 @@ struct AvoidanceStatus {
 /// continuous and peaks at 2 pi H / ramp^2 mid-ramp.
 struct Detour {
   int row = 0;
-  double begin = 0.0;   ///< along-row position where the up ramp starts [m]
+  double begin = 0.0;                                   ///< along-row position where the up ramp starts [m]
   double ramp_in = 0.0, plateau = 0.0, ramp_out = 0.0;  ///< [m]
-  double offset = 0.0;  ///< lateral offset on the plateau, + to the left of travel [m]
-  double speed = 0.0;   ///< along-row speed over [begin, end()] [m/s]
-  double peak_curvature = 0.0;  ///< [1/m]
-  std::vector<std::size_t> obstacles;  ///< the group passed
+  double offset = 0.0;                                  ///< lateral offset on the plateau, + to the left of travel [m]
+  double speed = 0.0;                                   ///< along-row speed over [begin, end()] [m/s]
+  double peak_curvature = 0.0;                          ///< [1/m]
+  std::vector<std::size_t> obstacles;                   ///< the group passed
   double end() const { return begin + ramp_in + plateau + ramp_out; }
   /// Offset y and dy/ds, d2y/ds2, d3y/ds3 at along-row position s (all 0 outside).
   void lateral(double s, double& y, double& y1, double& y2, double& y3) const;

@@ -33,22 +33,22 @@ namespace core {
 /// Defaults, ranges, units and meanings: fieldTable() (keys field/... and potential/...).
 struct FieldParams {
   FieldParams();
-  int rows;                      ///< number of rows N, >= 1
-  double row_length;             ///< [m], > 0
-  double row_spacing;            ///< distance between neighbouring rows [m], > 0
-  double start_x, start_y;       ///< start of the first row [m] (thesis: (0, 3))
-  double heading;                ///< direction of the first row [rad]
-  bool rows_to_left;             ///< the second row lies left of the first one's direction
-  double row_speed;              ///< v_r [m/s], > 0
-  double turn_speed;             ///< speed on the headland turns [m/s], in (0, row_speed]
-  double min_turn_radius;        ///< the turns keep |kappa| <= 1/min_turn_radius [m], > 0
-  double max_accel;              ///< peak |v_dot| of the speed ramps [m/s^2], > 0
+  int rows;                 ///< number of rows N, >= 1
+  double row_length;        ///< [m], > 0
+  double row_spacing;       ///< distance between neighbouring rows [m], > 0
+  double start_x, start_y;  ///< start of the first row [m] (thesis: (0, 3))
+  double heading;           ///< direction of the first row [rad]
+  bool rows_to_left;        ///< the second row lies left of the first one's direction
+  double row_speed;         ///< v_r [m/s], > 0
+  double turn_speed;        ///< speed on the headland turns [m/s], in (0, row_speed]
+  double min_turn_radius;   ///< the turns keep |kappa| <= 1/min_turn_radius [m], > 0
+  double max_accel;         ///< peak |v_dot| of the speed ramps [m/s^2], > 0
   /// Peak |dkappa/ds| in the turns [1/m^2]; must be >= 1/(2 min_turn_radius^2) so a ramp to the
   /// largest curvature fits in a half turn.
   double max_curvature_rate;
-  bool start_from_rest;          ///< false: the first row starts at row_speed (as the thesis line)
-  PotentialFieldParams potential;    ///< alpha, beta, repulsion (see PotentialField)
-  AvoidanceParams avoidance;         ///< planned detours around the inflated obstacles (detour.h)
+  bool start_from_rest;            ///< false: the first row starts at row_speed (as the thesis line)
+  PotentialFieldParams potential;  ///< alpha, beta, repulsion (see PotentialField)
+  AvoidanceParams avoidance;       ///< planned detours around the inflated obstacles (detour.h)
   std::string validate() const;
 };
 /// field/{rows, row_length, row_spacing, start_x, start_y, heading, rows_to_left, row_speed, turn_speed,
@@ -63,9 +63,9 @@ class HeadlandTurn {
   /// Throws std::invalid_argument if no turn fits (validate FieldParams first).
   HeadlandTurn(double width, double max_curvature, double max_curvature_rate);
 
-  double length() const { return length_; }  ///< arc length [m]
+  double length() const { return length_; }                 ///< arc length [m]
   double peakCurvature() const { return peak_curvature_; }  ///< max |kappa| [1/m]
-  bool isBulb() const { return bulb_; }      ///< true for an Omega turn (swings away first)
+  bool isBulb() const { return bulb_; }                     ///< true for an Omega turn (swings away first)
   /// Position [m], heading [rad], curvature [1/m] and dkappa/ds [1/m^2] at arc length s (clamped).
   void evaluate(double s, Eigen::Vector2d& p, double& theta, double& kappa, double& dkappa) const;
 
@@ -101,7 +101,7 @@ class FieldPath : public TargetTrajectory {
   TargetState at(double t) const override;
   std::unique_ptr<TargetTrajectory> clone() const override { return std::make_unique<FieldPath>(*this); }
 
-  double duration() const { return duration_; }  ///< time at which the target stops [s]
+  double duration() const { return duration_; }    ///< time at which the target stops [s]
   double length() const { return total_length_; }  ///< path length [m]
   const HeadlandTurn& turn() const { return turn_; }
   /// True when the path at time t is on a headland turn (tool up).

@@ -25,8 +25,8 @@ namespace core {
 Footprint sowingRobotFootprint();
 
 struct FieldRunSetup {
-  Scenario scenario;             ///< duration, rate, start, disturbance, gains
-  FieldParams field;             ///< rows, potential and avoidance parameters
+  Scenario scenario;  ///< duration, rate, start, disturbance, gains
+  FieldParams field;  ///< rows, potential and avoidance parameters
   std::vector<Obstacle> obstacles;
   Footprint footprint = sowingRobotFootprint();
   Eigen::Vector2d tool{-0.45, 0.0};  ///< seed-drop point in base_link (the URDF's tool_link) [m]
@@ -44,11 +44,11 @@ struct FieldRunReport {
   double min_clearance = 0.0;  ///< body, over the run [m]
   std::size_t contacts = 0;
   std::vector<ContactEvent> events;
-  double peak_yaw_rate = 0.0;    ///< robot |omega| after peaks_from [rad/s]
-  double peak_lateral = 0.0;     ///< robot |v omega| after peaks_from [m/s^2]
+  double peak_yaw_rate = 0.0;                              ///< robot |omega| after peaks_from [rad/s]
+  double peak_lateral = 0.0;                               ///< robot |v omega| after peaks_from [m/s^2]
   double peak_ref_yaw_rate = 0.0, peak_ref_lateral = 0.0;  ///< the same of the reference
-  double peak_ref_curvature = 0.0;  ///< |omega| / v of the reference where v > 0.05 m/s [1/m]
-  double max_speed = 0.0;           ///< robot [m/s]
+  double peak_ref_curvature = 0.0;                         ///< |omega| / v of the reference where v > 0.05 m/s [1/m]
+  double max_speed = 0.0;                                  ///< robot [m/s]
   SeedStats rows, detours;
   Eigen::Vector2d end = Eigen::Vector2d::Zero();  ///< final axle position [m]
   AvoidanceStatus status;

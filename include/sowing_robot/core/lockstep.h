@@ -36,13 +36,13 @@ class LockstepProtocol {
 
   /// What a received wheel torque means.
   enum class Answer {
-    kStep,       ///< the answer for the awaited state: step the plant with it, then publish awaited()
-    kFinish,     ///< the answer for the final state: the scenario is over (nothing is stepped)
-    kLate,       ///< stamped before the last answered state (a stray or restarted source): ignored, counted
-    kRepeat,     ///< the answer already used, sent again (the state was re-sent): ignored, counted
-    kAhead,      ///< stamped after the awaited state: not an answer to anything published; ignored
-    kNonFinite,  ///< NaN or inf: never reaches the integrator; ignored, counted
-    kNotRunning, ///< before step 0, or after a divergence or the give-up: ignored
+    kStep,        ///< the answer for the awaited state: step the plant with it, then publish awaited()
+    kFinish,      ///< the answer for the final state: the scenario is over (nothing is stepped)
+    kLate,        ///< stamped before the last answered state (a stray or restarted source): ignored, counted
+    kRepeat,      ///< the answer already used, sent again (the state was re-sent): ignored, counted
+    kAhead,       ///< stamped after the awaited state: not an answer to anything published; ignored
+    kNonFinite,   ///< NaN or inf: never reaches the integrator; ignored, counted
+    kNotRunning,  ///< before step 0, or after a divergence or the give-up: ignored
   };
 
   /// What the supervising thread must do after a tick(); several may be asked at once.
@@ -103,7 +103,7 @@ class LockstepProtocol {
   double settle_until_ = 0.0;  // kSettling: when step 0 may go
   double sent_ = 0.0;          // when the awaited state was last sent
   double started_at_ = 0.0;
-  std::int64_t seen_ = -1;     // the awaited state the supervision clocks belong to
+  std::int64_t seen_ = -1;  // the awaited state the supervision clocks belong to
 };
 
 }  // namespace core

@@ -59,8 +59,7 @@ std::string metricsTable(const std::vector<std::string>& names,
 
 /// Writes metrics as YAML at full precision: {label: {x: {ise: .., ...}, y: {...}, theta: {...}}}.
 /// The format run_monitor (metrics_output), run_scenario --yaml and analyze_bag --yaml share.
-bool writeMetricsYaml(const std::string& path, const std::string& label,
-                      const std::array<AxisMetrics, AXIS_COUNT>& m);
+bool writeMetricsYaml(const std::string& path, const std::string& label, const std::array<AxisMetrics, AXIS_COUNT>& m);
 
 }  // namespace core
 }  // namespace sowing_robot

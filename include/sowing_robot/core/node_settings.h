@@ -21,9 +21,9 @@ namespace core {
 /// Run-wide settings, under `run/` relative to each node's namespace (sim.launch sets them once).
 struct RunSettings {
   RunSettings();
-  bool lockstep;          ///< mode: lockstep (headless) or realtime (paced to the wall clock)
-  double control_rate;    ///< plant step and control rate [Hz]
-  double duration;        ///< scenario length [s]; 0 = forever
+  bool lockstep;                       ///< mode: lockstep (headless) or realtime (paced to the wall clock)
+  double control_rate;                 ///< plant step and control rate [Hz]
+  double duration;                     ///< scenario length [s]; 0 = forever
   std::string odom_frame, base_frame;  ///< REP-105 frame ids
   std::string validate() const { return table().checkRanges(*this, "run/"); }
   /// The control period on the ns grid every node stamps its messages on.

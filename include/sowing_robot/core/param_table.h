@@ -44,7 +44,7 @@ struct Limits {
 
 /// Everything said about one parameter, whatever its struct: what docs, error texts and checks need.
 struct ParamInfo {
-  std::string key;      ///< relative to the component's namespace, '/' between levels: "disturbance/amplitude"
+  std::string key;  ///< relative to the component's namespace, '/' between levels: "disturbance/amplitude"
   ParamValue default_value;
   Limits limits;                     ///< numbers only
   std::vector<std::string> choices;  ///< strings: the allowed values (empty: any string)

@@ -22,13 +22,13 @@ using State = Eigen::Matrix<double, STATE_SIZE, 1>;
 /// Defaults, ranges, units and meanings: disturbanceTable().
 struct PlantDisturbance {
   PlantDisturbance();
-  bool sinusoidal;        ///< add td_R = A sin(w t), td_L = A cos(w t) to the wheel torques (Fig 5.9)
-  double amplitude;       ///< A [N·m]
-  double frequency;       ///< w [rad/s]
-  double noise_std;       ///< std of Gaussian wheel-torque noise, held over one step [N·m]; 0 = off
-  std::uint64_t seed;     ///< seed of the noise generator
-  double mass_scale;      ///< true m0 and mc·d are this times the nominal (1 = no mismatch)
-  double inertia_scale;   ///< true I0 is this times the nominal (1 = no mismatch)
+  bool sinusoidal;       ///< add td_R = A sin(w t), td_L = A cos(w t) to the wheel torques (Fig 5.9)
+  double amplitude;      ///< A [N·m]
+  double frequency;      ///< w [rad/s]
+  double noise_std;      ///< std of Gaussian wheel-torque noise, held over one step [N·m]; 0 = off
+  std::uint64_t seed;    ///< seed of the noise generator
+  double mass_scale;     ///< true m0 and mc·d are this times the nominal (1 = no mismatch)
+  double inertia_scale;  ///< true I0 is this times the nominal (1 = no mismatch)
 
   std::string validate() const;
 };

@@ -45,11 +45,11 @@ enum class AvoidSide {
 /// Defaults, ranges, units and meanings: potentialFieldTable().
 struct PotentialFieldParams {
   PotentialFieldParams();
-  double alpha;                ///< position gain alpha [1/s^2] (thesis: 4)
-  double beta;                 ///< damping of the velocity relative to the target, beta [1/s] (thesis: 16)
-  double influence_distance;   ///< d: no repulsion beyond this clearance from the obstacle SURFACE [m]
-  double gain;                 ///< k: mu_radial = -k grad V_a [m^2/s^2], >= 0 (0 disables avoidance)
-  double tangential_ratio;     ///< |tangential| / |radial| repulsion [-], >= 0
+  double alpha;               ///< position gain alpha [1/s^2] (thesis: 4)
+  double beta;                ///< damping of the velocity relative to the target, beta [1/s] (thesis: 16)
+  double influence_distance;  ///< d: no repulsion beyond this clearance from the obstacle SURFACE [m]
+  double gain;                ///< k: mu_radial = -k grad V_a [m^2/s^2], >= 0 (0 disables avoidance)
+  double tangential_ratio;    ///< |tangential| / |radial| repulsion [-], >= 0
   /// true: when the reference enters an obstacle's influence zone it picks the side it is already on
   /// (offset from the centre of the obstacles whose zones it is in, along the left normal of travel,
   /// beyond +-side_band) and keeps it until it leaves the zone; obstacles with overlapping zones share
@@ -57,11 +57,11 @@ struct PotentialFieldParams {
   bool nearest_side;
   /// Forced side (nearest_side = false) and tie-break inside the band: the on-line case goes this way.
   AvoidSide avoid_side;
-  double side_band;           ///< half-width of the tie band [m], >= 0
+  double side_band;  ///< half-width of the tie band [m], >= 0
   /// Below this fraction of d the clearance potential continues linearly (finite force, so a reference
   /// that starts inside an obstacle is pushed out instead of blowing up the integrator) [-], (0, 1).
   double core_fraction;
-  double step;                ///< internal RK4 step h [s], (0, 1e-3]
+  double step;  ///< internal RK4 step h [s], (0, 1e-3]
   /// While both the reference and the target move slower than this [m/s], theta is held and
   /// omega = omega_dot = 0 (stops: a residual sideways creep must not turn the heading), >= 0.
   double heading_hold_speed;
@@ -77,7 +77,7 @@ struct TargetState {
   Eigen::Vector2d v = Eigen::Vector2d::Zero();  ///< [m/s]
   Eigen::Vector2d a = Eigen::Vector2d::Zero();  ///< [m/s^2]
   Eigen::Vector2d j = Eigen::Vector2d::Zero();  ///< jerk [m/s^3]
-  double heading = 0.0;  ///< direction of travel [rad], defined also when the target is at rest
+  double heading = 0.0;                         ///< direction of travel [rad], defined also when the target is at rest
   bool tool_down = true;
 };
 
@@ -196,8 +196,7 @@ class PotentialField : public ReferenceSource {
   ErrorState state_;  ///< error state at the grid time steps_ * h
   long long steps_ = 0;
   double last_theta_ = 0.0;
-  Eigen::Vector2d out_p_ = Eigen::Vector2d::Zero(), out_v_ = Eigen::Vector2d::Zero(),
-                  out_a_ = Eigen::Vector2d::Zero();
+  Eigen::Vector2d out_p_ = Eigen::Vector2d::Zero(), out_v_ = Eigen::Vector2d::Zero(), out_a_ = Eigen::Vector2d::Zero();
 };
 
 }  // namespace core

@@ -17,14 +17,14 @@ namespace core {
 double psoInertia(int i, int i_max, double w_max, double w_min);
 
 struct PsoParams {
-  int particles = 20;   ///< swarm size (Table 5.4)
-  int iterations = 30;  ///< i_max: update+evaluate rounds after the initial evaluation (Table 5.4)
-  double w_max = 0.9, w_min = 0.1;  ///< inertia weight at i = 0 and i = i_max [-] (eq 4.26)
-  double c1 = 2.0, c2 = 2.0;        ///< cognitive and social acceleration coefficients [-] (eq 4.27)
-  std::vector<double> lower, upper;  ///< per-dimension search box, lower < upper [unit of the dimension]
+  int particles = 20;                  ///< swarm size (Table 5.4)
+  int iterations = 30;                 ///< i_max: update+evaluate rounds after the initial evaluation (Table 5.4)
+  double w_max = 0.9, w_min = 0.1;     ///< inertia weight at i = 0 and i = i_max [-] (eq 4.26)
+  double c1 = 2.0, c2 = 2.0;           ///< cognitive and social acceleration coefficients [-] (eq 4.27)
+  std::vector<double> lower, upper;    ///< per-dimension search box, lower < upper [unit of the dimension]
   double max_velocity_fraction = 0.0;  ///< |v_d| <= fraction * (upper_d - lower_d) [-]; 0 = no clamp
   std::uint64_t seed = 1;              ///< same seed -> bit-identical result, whatever `threads` is
-  int threads = 0;  ///< fitness evaluation threads (caller included); 0 = hardware_concurrency()
+  int threads = 0;                     ///< fitness evaluation threads (caller included); 0 = hardware_concurrency()
 
   /// "" if usable, else one line naming the first bad parameter, its value and the allowed range.
   std::string validate() const;
@@ -43,10 +43,10 @@ struct PsoProgress {
 };
 
 struct PsoResult {
-  std::vector<double> best_position;  ///< global best (eq 4.31); particle 0's start if no cost was finite
-  double best_cost;                   ///< its cost; +inf if no evaluation was finite
+  std::vector<double> best_position;            ///< global best (eq 4.31); particle 0's start if no cost was finite
+  double best_cost;                             ///< its cost; +inf if no evaluation was finite
   std::vector<double> best_cost_per_iteration;  ///< global best after iteration 0..iterations (size i_max+1)
-  long evaluations;                   ///< particles * (iterations + 1)
+  long evaluations;                             ///< particles * (iterations + 1)
 };
 
 /// fitness(position, thread_index) -> cost to minimise. thread_index is in [0, min(threads, particles))

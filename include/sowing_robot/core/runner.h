@@ -18,11 +18,11 @@ namespace sowing_robot {
 namespace core {
 
 struct Scenario {
-  double duration = 25.0;                 ///< simulated time [s]
+  double duration = 25.0;                    ///< simulated time [s]
   std::int64_t control_period_ns = 1000000;  ///< plant step and control period [ns] (1 kHz)
-  Pose2D start{-1.0, 0.0, 0.0};           ///< initial posture of the axle midpoint
-  RobotParams robot;                      ///< nominal parameters (the controllers' model)
-  PlantDisturbance disturbance;           ///< what the plant adds (disturbance, noise, mismatch)
+  Pose2D start{-1.0, 0.0, 0.0};              ///< initial posture of the axle midpoint
+  RobotParams robot;                         ///< nominal parameters (the controllers' model)
+  PlantDisturbance disturbance;              ///< what the plant adds (disturbance, noise, mismatch)
   KanayamaGains kanayama;
   SlidingModeParams sliding;
 
@@ -45,8 +45,8 @@ struct LoopSample {
 struct RunResult {
   std::array<AxisMetrics, AXIS_COUNT> metrics{};
   State final_state = State::Zero();
-  bool diverged = false;  ///< state became non-finite; metrics are then +inf
-  bool stopped = false;   ///< ended early by the caller's stop(): the integrals so far (a lower bound)
+  bool diverged = false;     ///< state became non-finite; metrics are then +inf
+  bool stopped = false;      ///< ended early by the caller's stop(): the integrals so far (a lower bound)
   std::int64_t periods = 0;  ///< control periods simulated
   std::int64_t saturated_steps = 0;
 };

@@ -66,8 +66,8 @@ class SeedDrill {
   /// True when p lies in an obstacle's detour zone.
   bool inDetour(const Eigen::Vector2d& p) const;
 
-  const SeedStats& onRows() const { return rows_stats_; }      ///< seeds away from obstacles
-  const SeedStats& detours() const { return detour_stats_; }   ///< seeds in detour zones
+  const SeedStats& onRows() const { return rows_stats_; }     ///< seeds away from obstacles
+  const SeedStats& detours() const { return detour_stats_; }  ///< seeds in detour zones
   std::string report() const;
   std::size_t rejected() const { return rejected_; }
 

@@ -17,14 +17,14 @@ double realPower(double x, int num, int den);
 /// Defaults, ranges, units and meanings: slidingModeTable().
 struct SlidingModeParams {
   SlidingModeParams();
-  bool adaptive;  ///< true: ATSMC (eq 4.22 with projection); false: TSMC (fixed nominal)
-  int p, q;       ///< terminal exponent p/q, both odd, 1 < p/q < 2
-  double beta_v, beta_omega;  ///< surface gains beta per channel (not given in the thesis)
-  double k1, k2;              ///< feedback gains K1 [N·m·s/m], K2 [N·m·s/rad]
-  double eta1, eta2;          ///< switching gains [N·m]
-  double rate_m, rate_i;      ///< adaptation rates of m0_hat and I0_hat (Table 5.3 gamma1/2)
-  double m0_min, m0_max;      ///< projection bounds on m0_hat [kg]
-  double i0_min, i0_max;      ///< projection bounds on I0_hat [kg·m^2]
+  bool adaptive;                  ///< true: ATSMC (eq 4.22 with projection); false: TSMC (fixed nominal)
+  int p, q;                       ///< terminal exponent p/q, both odd, 1 < p/q < 2
+  double beta_v, beta_omega;      ///< surface gains beta per channel (not given in the thesis)
+  double k1, k2;                  ///< feedback gains K1 [N·m·s/m], K2 [N·m·s/rad]
+  double eta1, eta2;              ///< switching gains [N·m]
+  double rate_m, rate_i;          ///< adaptation rates of m0_hat and I0_hat (Table 5.3 gamma1/2)
+  double m0_min, m0_max;          ///< projection bounds on m0_hat [kg]
+  double i0_min, i0_max;          ///< projection bounds on I0_hat [kg·m^2]
   double m0_initial, i0_initial;  ///< initial/nominal estimates; 0 means "from the URDF"
   double max_torque;              ///< per-wheel motor limit [N·m]
   SwitchFunction switching;

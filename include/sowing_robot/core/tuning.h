@@ -64,8 +64,8 @@ struct TuningCost {
   double effort = 0.0;    ///< int (tau_R^2 + tau_L^2) dt
   double chattering = 0.0;
   bool diverged = false;
-  bool bounded = false;   ///< the run was stopped once total reached the bound: total is a lower bound
-  double simulated = 0.0; ///< simulated time actually run [s]
+  bool bounded = false;    ///< the run was stopped once total reached the bound: total is a lower bound
+  double simulated = 0.0;  ///< simulated time actually run [s]
 };
 
 /// Scores gain vectors (in the order of `gains`) on a base scenario. evaluate() may be called from
@@ -97,8 +97,7 @@ class TuningProblem {
   /// The weighted total of the terms, added in one fixed order: the same formula for a partial and a
   /// whole run, so a partial total is never above the whole run's (floating-point sums of non-negative
   /// terms only grow).
-  void total(const std::array<AxisMetrics, AXIS_COUNT>& metrics, double effort, double chattering,
-             TuningCost& c) const;
+  void total(const std::array<AxisMetrics, AXIS_COUNT>& metrics, double effort, double chattering, TuningCost& c) const;
 };
 
 struct TuningResult {
@@ -108,8 +107,8 @@ struct TuningResult {
   double initial_best_cost = 0.0;  ///< best of iteration 0 (the random initial swarm)
   int threads = 1;                 ///< evaluation threads actually used
   double wall_s = 0.0;
-  long evaluations_cut = 0;        ///< evaluations stopped early by their particle's bound
-  double simulated_s = 0.0;        ///< simulated time run over all evaluations [s]
+  long evaluations_cut = 0;  ///< evaluations stopped early by their particle's bound
+  double simulated_s = 0.0;  ///< simulated time run over all evaluations [s]
 };
 
 /// Resolved number of evaluation threads psoMinimize will use for these parameters.
@@ -118,8 +117,7 @@ int psoThreads(const PsoParams& params);
 /// Validate, then minimise the objective over the box with psoMinimize (params.lower/upper are filled
 /// from `gains`). Throws std::invalid_argument with a one-line message on bad input.
 TuningResult tuneGains(const Scenario& base, const ReferenceSource& reference, const std::vector<GainBounds>& gains,
-                       const TuningObjective& objective, PsoParams params,
-                       const PsoProgressCallback& progress = {});
+                       const TuningObjective& objective, PsoParams params, const PsoProgressCallback& progress = {});
 
 }  // namespace core
 }  // namespace sowing_robot

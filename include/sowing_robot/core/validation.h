@@ -6,6 +6,10 @@
 namespace sowing_robot {
 namespace core {
 
+/// v with up to 10 significant digits, as error texts print it.
+std::string formatNumber(double v);
+/// " unit", or "" for no unit.
+std::string withUnit(const std::string& unit);
 /// "" if lo <= value <= hi and finite, else "name = value is outside [lo, hi] unit".
 std::string checkRange(const std::string& name, double value, double lo, double hi, const std::string& unit = "");
 /// "" if value > 0 and finite, else a message naming it.

@@ -2,8 +2,8 @@
 // tracking error for plotting and metrics.
 #pragma once
 
-#include <nav_msgs/Odometry.h>
 #include <dynamic_reconfigure/server.h>
+#include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
 
 #include <memory>
@@ -38,7 +38,7 @@ class KinematicController {
   DesiredVelocity desired_;
   TrackingError error_;
   long rejected_ = 0;
-  bool lockstep_;  // run/mode: wait for the paired reference, never time out
+  bool lockstep_;                // run/mode: wait for the paired reference, never time out
   double input_timeout_ = 0.05;  // [s] sim (shorter than torque_controller's: see config/controllers.yaml)
   std::unique_ptr<dynamic_reconfigure::Server<KinematicControllerConfig>> reconfigure_;
 };

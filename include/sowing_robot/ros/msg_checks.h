@@ -43,8 +43,8 @@ namespace sowing_robot {
 constexpr std::uint32_t kLockstepQueue = 20000;
 }  // namespace sowing_robot
 
-#include <boost/make_shared.hpp>
 #include <ros/publisher.h>
+#include <boost/make_shared.hpp>
 
 namespace sowing_robot {
 /// Publish a copy as a shared pointer: inside a nodelet manager subscribers get the pointer itself

@@ -27,8 +27,7 @@ class PathBuffer {
       const auto& last = path_.poses.back().pose.position;
       if (std::hypot(pose.pose.position.x - last.x, pose.pose.position.y - last.y) < spacing_) return false;
     }
-    if (path_.poses.size() >= kMaxPoses)
-      path_.poses.erase(path_.poses.begin(), path_.poses.begin() + kMaxPoses / 2);
+    if (path_.poses.size() >= kMaxPoses) path_.poses.erase(path_.poses.begin(), path_.poses.begin() + kMaxPoses / 2);
     path_.poses.push_back(pose);
     path_.header.stamp = pose.header.stamp;
     return added_++ % publish_every_ == 0;

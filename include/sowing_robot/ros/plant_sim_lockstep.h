@@ -53,9 +53,9 @@ class LockstepDriver : public PlantSimDriver {
   SimulatedPlant& plant_;
   Config cfg_;
   std::atomic<bool> stop_{false};
-  InlineCallbackQueue queue_;           // its mutex guards plant_ and protocol_
+  InlineCallbackQueue queue_;  // its mutex guards plant_ and protocol_
   core::LockstepProtocol protocol_;
-  ros::Subscriber torque_sub_;          // last: unsubscribed before the members its callback uses go
+  ros::Subscriber torque_sub_;  // last: unsubscribed before the members its callback uses go
 };
 
 }  // namespace sowing_robot

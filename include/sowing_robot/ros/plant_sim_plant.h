@@ -23,10 +23,10 @@ namespace sowing_robot {
 class SimulatedPlant {
  public:
   struct Rates {
-    std::int64_t period_ns = 1000000;  // control period: state k is stamped k * period_ns
-    double publish_rate = 50.0;        // [Hz] sim, tf / joint_states / path
-    double clock_rate = 0.0;           // [Hz] sim, /clock; 0 = every step
-    double max_speed = 20.0;           // [m/s]; beyond it (or NaN) the state has diverged
+    std::int64_t period_ns = 1000000;                           // control period: state k is stamped k * period_ns
+    double publish_rate = 50.0;                                 // [Hz] sim, tf / joint_states / path
+    double clock_rate = 0.0;                                    // [Hz] sim, /clock; 0 = every step
+    double max_speed = 20.0;                                    // [m/s]; beyond it (or NaN) the state has diverged
     std::string odom_frame = "odom", base_frame = "base_link";  // run/odom_frame, run/base_frame (REP-105)
   };
 

@@ -58,17 +58,17 @@ class ReferenceGenerator {
   std::vector<core::Obstacle> obstacles_;  ///< the obstacles in force (type field)
   ros::Subscriber clock_sub_, obstacles_sub_;
   ros::Publisher ref_pub_, path_pub_, marker_pub_, plan_pub_;
-  std::string odom_frame_ = "odom";   ///< run/odom_frame
-  Eigen::Vector2d line_{0.0, 3.0};    ///< type line: (x0, y), where the open-ended row starts
-  std::deque<ReferenceState> sent_;   ///< published, for times not yet passed (replayed to late subscribers)
-  double lookahead_ = 0.05;           ///< [s] send references this far ahead of /clock
-  std::int64_t window_ns_ = 50000000; ///< [ns] lookahead, or twice the largest /clock gap seen if longer
-  std::int64_t next_ns_ = -1;         ///< stamp of the next reference to send [ns]
+  std::string odom_frame_ = "odom";    ///< run/odom_frame
+  Eigen::Vector2d line_{0.0, 3.0};     ///< type line: (x0, y), where the open-ended row starts
+  std::deque<ReferenceState> sent_;    ///< published, for times not yet passed (replayed to late subscribers)
+  double lookahead_ = 0.05;            ///< [s] send references this far ahead of /clock
+  std::int64_t window_ns_ = 50000000;  ///< [ns] lookahead, or twice the largest /clock gap seen if longer
+  std::int64_t next_ns_ = -1;          ///< stamp of the next reference to send [ns]
   std::int64_t last_clock_ns_ = 0;
   bool clock_seen_ = false, grid_warned_ = false;
   std::int64_t period_ns_ = 1000000;  ///< control period (control_rate) [ns]
   std::unique_ptr<PathBuffer> path_;  // reference_path (spacing from the parameters)
-  double path_spacing_ = 0.1;  // [m] between stored reference path points
+  double path_spacing_ = 0.1;         // [m] between stored reference path points
   std::unique_ptr<dynamic_reconfigure::Server<ReferenceGeneratorConfig>> reconfigure_;  // type field only
 };
 

@@ -48,7 +48,7 @@ class RunMonitor {
   // there, where re-scheduling the timer takes that lock again (a deadlock, seen).
   mutable std::mutex wait_mutex_;
   std::condition_variable recorded_;
-  ros::Time recorded_until_;           // under wait_mutex_
+  ros::Time recorded_until_;             // under wait_mutex_
   bool waiting_ = false, stop_ = false;  // under wait_mutex_
   std::optional<NodeFailure> failure_;   // under wait_mutex_
   std::thread waiter_;

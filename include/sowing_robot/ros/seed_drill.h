@@ -35,8 +35,8 @@ class SeedDrillNode {
 
   ros::NodeHandle nh_;
   core::SeedDrillSettings settings_;
-  std::unique_ptr<core::SeedDrill> drill_;  ///< null until the first plan
-  double tool_x_ = 0.0, tool_y_ = 0.0;  // tool point in base_link [m]
+  std::unique_ptr<core::SeedDrill> drill_;                ///< null until the first plan
+  double tool_x_ = 0.0, tool_y_ = 0.0;                    // tool point in base_link [m]
   StampPair<nav_msgs::Odometry, ReferenceState> inputs_;  // the reference is sent ahead of the state
   ros::Subscriber plan_sub_, odom_sub_, ref_sub_;
   ros::Publisher seeds_pub_, report_pub_;

@@ -16,7 +16,6 @@ namespace sowing_robot {
 template <typename A, typename B, std::size_t kMaxFirsts = 8, std::size_t kMaxSeconds = 8192>
 class StampPair {
  public:
-
   /// Store a message; returns true when a stamp present in both streams is newer than the last pair
   /// handed out. first() and second() are then that pair, valid until the next set call.
   bool setFirst(const A& a) {

@@ -2,8 +2,8 @@
 // Publishes its sliding variables and adaptive estimates on ~state.
 #pragma once
 
-#include <nav_msgs/Odometry.h>
 #include <dynamic_reconfigure/server.h>
+#include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
 
 #include <memory>
