@@ -39,12 +39,13 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
     field.avoidance.footprint_radius = footprint.circumscribedRadius();
     if (error.empty() && p.error().empty()) error = field.validate();
   } else {
+    // Said before the unknown-key list (which would only name the key): why it is not read.
     for (const char* key : {"field", "potential", "obstacles"})
-      if (error.empty() && pnh.hasParam(key))
-        error = pnh.resolveName(key) +
-                " is set but type is 'line': field, potential and obstacles are read only "
-                "with type: field (set " +
-                pnh.resolveName("type") + ": field, or remove them)";
+      if (pnh.hasParam(key))
+        p.fail(pnh.resolveName(key) +
+               " is set but type is 'line': field, potential and obstacles are read only "
+               "with type: field (set " +
+               pnh.resolveName("type") + ": field, or remove them)");
   }
   requireValid(p, error);
   odom_frame_ = run.odom_frame;

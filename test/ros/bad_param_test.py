@@ -31,6 +31,11 @@ CASES = [
     ("kinematic_controller", {"kx": -1.0}, "kx"),
     ("kinematic_controller", {"ky": float("inf")}, "ky"),
     ("reference_generator", {"line/v_r": -1.0}, "v_r"),
+    # a key the configuration does not read is refused like an unknown one: field keys with type line
+    ("reference_generator", {"field/rows": 0}, "is set but type is 'line'"),
+    # a run-wide setting is set once (run/): a node's own copy that disagrees names both values
+    ("torque_controller", {"control_rate": 500.0}, "disagrees with /run/control_rate = 1000.0"),
+    ("plant_sim", {"duration": 60.0}, "disagrees with /run/duration = 25.0"),
 ]
 
 

@@ -2,6 +2,7 @@
 """rostest: an obstacles message at run time is re-published on the latched `plan` (rows, obstacles,
 status) and reaches seed_drill, which logs the plan it now scores against."""
 import threading
+import time
 import unittest
 
 import rospy
@@ -30,7 +31,7 @@ class PlanUpdate(unittest.TestCase):
         self.cond = threading.Condition()
         self.plans, self.drill_logs = [], []
         self.subs = [rospy.Subscriber("/plan", FieldPlan, self.on_plan, queue_size=10),
-                     rospy.Subscriber("/rosout_agg", Log, self.on_log, queue_size=100)]
+                     rospy.Subscriber("/rosout", Log, self.on_log, queue_size=100)]
 
     def on_plan(self, msg):
         with self.cond:
@@ -49,6 +50,12 @@ class PlanUpdate(unittest.TestCase):
 
     def test_an_obstacle_added_at_run_time_reaches_the_plan_and_the_drill(self):
         self.wait_for("first plan", lambda: self.plans)
+        # The drill's log reaches us only over our own link to its /rosout: have it before the drill logs.
+        rosout = self.subs[1].impl
+        deadline = time.time() + TIMEOUT
+        while not any((getattr(c, "header", None) or {}).get("callerid") == "/seed_drill" for c in rosout.connections):
+            self.assertLess(time.time(), deadline, "no /rosout link to /seed_drill within %.0f s" % TIMEOUT)
+            time.sleep(0.02)
         first = self.plans[0]
         self.assertEqual(len(first.obstacle_radii), 3)  # config/field_thesis.yaml
         self.assertEqual(first.status, "ok")
