@@ -74,16 +74,23 @@ class HeadlessEnd(unittest.TestCase):
     def test_refusal_of_a_nodelet_ends_the_run_at_once(self):
         self.check_refusal(11674, "nodelets:=true")
 
-    def test_give_up(self):
+    def check_give_up(self, port, *args):
         with tempfile.NamedTemporaryFile("w", suffix=".yaml", delete=False) as f:
             # odom subscribers that never come: the plant waits for the loop to connect, then gives up
             f.write("plant_sim: {lockstep_give_up: 3.0, min_subscribers: 50}\n")
-        code, out, _ = sim(11675, "field:=line", "duration:=3.0", "config:=" + f.name)
+        code, out, _ = sim(port, "field:=line", "duration:=3.0", "config:=" + f.name, *args)
         os.unlink(f.name)
         self.assertEqual(code, 3, out[-4000:])
         last = last_line(out)
         self.assertIn("[FATAL]", last)
         self.assertIn("plant_sim: lockstep gave up", last)
+
+    def test_give_up(self):
+        self.check_give_up(11675)
+
+    def test_give_up_of_a_plant_nodelet_ends_the_run(self):
+        # The plant nodelet stops only its run (the manager lives on); the runner ends the run with 3.
+        self.check_give_up(11677, "nodelets:=true")
 
     def test_plain_roslaunch_refusal_ends_at_once(self):
         code, out, seconds = run(11676, ["roslaunch", "-p", "11676", "sowing_robot", "sim.launch", "headless:=true",
