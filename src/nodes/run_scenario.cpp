@@ -43,7 +43,7 @@ int runThesisField(bool potential_only, bool approach, const Pose2D& start, std:
     std::fprintf(stderr, "run_scenario: %s\n", err.c_str());
     return 2;
   }
-  // The approach makes the path longer than the straight row (thesis: by 2.5 s): the run is longer by as
+  // The approach makes the path longer than the straight row (thesis: by 2.46 s): the run is longer by as
   // much, so it ends at the same point of the row as without it.
   s.scenario.duration += approachExtraTime(s);
   FieldRunSetup whole = s;
