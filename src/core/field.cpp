@@ -298,7 +298,7 @@ FieldPath::FieldPath(const FieldParams& params, const std::vector<Obstacle>& obs
         s = ap.length;
         row.s0 = s;
         row.along0 = approach_.curve.joinAlong();
-        settled_ = row.along0 + params_.approach_settle;
+        row.tool_from = row.along0 + params_.approach_settle;
         row.length -= row.along0;
       }
     }
@@ -469,7 +469,7 @@ TargetState FieldPath::at(double t) const {
       out.a = sdd * tang + (sd * sd * y2) * nl;
       out.j = sddd * tang + (3.0 * sd * sdd * y2) * nl + (sd * sd * sd * y3) * nl;
       out.heading = wrapAngle(el.heading + std::atan(y1));
-      out.tool_down = t < duration_;
+      out.tool_down = t < duration_ && sigma >= el.tool_from;
       return out;
     }
     p = el.p0 + sigma * Eigen::Vector2d(std::cos(el.heading), std::sin(el.heading));
@@ -482,7 +482,7 @@ TargetState FieldPath::at(double t) const {
   out.a = sdd * T + (sd * sd * kappa) * N;
   out.j = sddd * T + (3.0 * sd * sdd * kappa) * N + (sd * sd * sd) * (dkappa * N - kappa * kappa * T);
   out.heading = wrapAngle(theta);
-  out.tool_down = !el.turn && !el.approach && t < duration_ && !(el.along0 > 0.0 && sigma < settled_);
+  out.tool_down = !el.turn && !el.approach && t < duration_ && sigma >= el.tool_from;
   return out;
 }
 

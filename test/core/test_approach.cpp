@@ -152,6 +152,19 @@ TEST(Approach, NoneFromAStartOnTheRowNorWithoutAPlanNorWhenSwitchedOff) {
   for (double t = 0.0; t < b.duration(); t += 0.37) EXPECT_EQ(a.at(t).p, b.at(t).p);
 }
 
+TEST(Approach, StartBehindTheRowOnItsLineDrivesStraightOnAndLowersTheToolAfterTheSettleDistance) {
+  const FieldRunSetup s = thesisField();
+  const FieldPath path(withStart(s.field, Pose2D{-3.0, 3.0, 0.0}), s.obstacles);
+  ASSERT_TRUE(path.hasApproach());
+  EXPECT_NEAR(path.approach().curve.joinAlong(), 0.0, 1e-12);  // joins at the row start
+  EXPECT_NEAR(path.approach().curve.length(), 3.0, 1e-9);
+  for (double t = 0.0; t < 10.0; t += 1e-3) {
+    const TargetState st = path.at(t);
+    EXPECT_NEAR(st.p.y(), 3.0, 1e-12);
+    EXPECT_EQ(st.tool_down, st.p.x() >= s.field.approach_settle) << "t " << t << " x " << st.p.x();
+  }
+}
+
 TEST(Approach, ImpossibleApproachesStartAtTheRowStartAndSaySo) {
   const FieldRunSetup s = thesisField();
   // Facing away from the row, and an obstacle in the way.

@@ -134,6 +134,7 @@ class FieldPath : public TargetTrajectory {
     bool turn = false;
     bool approach = false;  ///< the approach from the start pose (tool up)
     double along0 = 0.0;    ///< along-row position where a row's driven part starts (the join) [m]
+    double tool_from = 0.0;  ///< along-row position from which the tool may go down (join + settle) [m]
     Eigen::Vector2d p0 = Eigen::Vector2d::Zero();
     double heading = 0.0;  ///< direction at the start [rad]
     double side = 1.0;     ///< +1 left turn, -1 right turn
@@ -159,7 +160,6 @@ class FieldPath : public TargetTrajectory {
   AvoidanceStatus status_;
   ApproachPlan approach_;
   bool has_approach_ = false;
-  double settled_ = 0.0;  ///< along the first row: the tool may go down from here (after an approach) [m]
   double duration_ = 0.0, total_length_ = 0.0;
 };
 
