@@ -355,12 +355,12 @@ void FieldPath::planApproach(const Element& row, double v_out, const std::vector
   if (approach_.needed && !approach_.ok) {
     status_.within_bounds = false;
     if (status_.bounds_note.empty())
-      status_.bounds_note = "no approach from the start pose (" + approach_.why + "): the target starts at the row start";
+      status_.bounds_note =
+          "no approach from the start pose (" + approach_.why + "): the target starts at the row start";
   }
 }
 
-void FieldPath::addRowPhases(double L, double v_in, double v_out, const Element& row, double lead,
-                             double lead_speed) {
+void FieldPath::addRowPhases(double L, double v_in, double v_out, const Element& row, double lead, double lead_speed) {
   const double a = params_.max_accel, vr = params_.row_speed;
   // Knots: the row start, each detour's speed window [begin, end], the row end; each with its speed.
   // With an approach of length `lead` first, positions count from the path start: the approach is a

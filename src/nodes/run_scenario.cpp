@@ -103,8 +103,7 @@ int main(int argc, char** argv) {
       start.x = value("--start X");
       start.y = value("--start Y");
       start.theta = value("--start THETA");
-    }
-    else if (a == "--tsmc")
+    } else if (a == "--tsmc")
       modes.push_back(false);
     else if (a == "--atsmc")
       modes.push_back(true);

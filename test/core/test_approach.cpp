@@ -96,8 +96,8 @@ TEST(Approach, ThesisFieldWholeRunWithinTheBoundsWithoutContactAndKeepsTheRowSee
 
 TEST(Approach, StartsAtTheStartPoseAndJoinsTheRowWithContinuousBoundedCurvature) {
   const FieldRunSetup s = thesisField();
-  for (const Pose2D start : {Pose2D{-1.0, 0.0, 0.0}, Pose2D{-1.0, 0.0, 0.6}, Pose2D{-4.0, 6.0, -0.4},
-                             Pose2D{2.0, 2.5, 0.3}}) {
+  for (const Pose2D start :
+       {Pose2D{-1.0, 0.0, 0.0}, Pose2D{-1.0, 0.0, 0.6}, Pose2D{-4.0, 6.0, -0.4}, Pose2D{2.0, 2.5, 0.3}}) {
     SCOPED_TRACE("start (" + std::to_string(start.x) + ", " + std::to_string(start.y) + ", " +
                  std::to_string(start.theta) + ")");
     const FieldParams f = withStart(s.field, start);

@@ -3,8 +3,9 @@
 // that error at once (4.35 rad/s, 3.61 m/s^2). The approach is a lateral offset of the row line,
 // y(x) a septic in the along-row position x from the start (offset l0, slope tan(psi0), y'' = y''' = 0)
 // to the join point (y = y' = y'' = y''' = 0): position, heading, curvature and its rate are continuous
-// at both ends (the curvature is 0 there, as on the row and as for a robot that is not turning). Its length is the shortest for
-// which the curvature and its rate stay within bounds at the speed it is driven at.
+// at both ends (the curvature is 0 there, as on the row and as for a robot that is not turning). Its
+// length is the shortest for which the curvature and its rate stay within bounds at the speed it is
+// driven at; where the row leaves no room for that, a shorter one is driven slower.
 #pragma once
 
 #include <string>
@@ -26,9 +27,9 @@ class ApproachCurve {
   /// (|psi0| < pi/2); joins the row at along-row a0 + span (span > 0).
   ApproachCurve(const Eigen::Vector2d& p0, double heading, double a0, double l0, double psi0, double span);
 
-  double length() const { return length_; }          ///< arc length [m]
-  double joinAlong() const { return a0_ + span_; }   ///< along-row position of the join [m]
-  double peakCurvature() const { return peak_k_; }   ///< max |kappa| [1/m]
+  double length() const { return length_; }              ///< arc length [m]
+  double joinAlong() const { return a0_ + span_; }       ///< along-row position of the join [m]
+  double peakCurvature() const { return peak_k_; }       ///< max |kappa| [1/m]
   double peakCurvatureRate() const { return peak_dk_; }  ///< max |dkappa/ds| [1/m^2]
   /// Position [m], heading [rad], curvature [1/m] and dkappa/ds [1/m^2] at arc length s (clamped).
   void evaluate(double s, Eigen::Vector2d& p, double& theta, double& kappa, double& dkappa) const;
@@ -41,13 +42,13 @@ class ApproachCurve {
   Eigen::Vector2d p0_ = Eigen::Vector2d::Zero(), u_ = Eigen::Vector2d::UnitX(), n_ = Eigen::Vector2d::UnitY();
   double heading_ = 0.0, a0_ = 0.0, l0_ = 0.0, m0_ = 0.0, span_ = 0.0;
   double length_ = 0.0, peak_k_ = 0.0, peak_dk_ = 0.0;
-  double node_step_ = 0.0;     ///< along-row spacing of the arc-length table [m]
-  std::vector<double> arc_;    ///< arc length at x = i node_step_
+  double node_step_ = 0.0;   ///< along-row spacing of the arc-length table [m]
+  std::vector<double> arc_;  ///< arc length at x = i node_step_
 };
 
 /// Bounds and room for planning an approach.
 struct ApproachLimits {
-  double max_curvature = 2.0;       ///< [1/m]
+  double max_curvature = 2.0;        ///< [1/m]
   double max_curvature_rate = 10.0;  ///< [1/m^2]
   double max_yaw_rate = 1.125;       ///< what the reference may use (after the tracking reserve) [rad/s]
   double max_lateral_accel = 1.125;  ///< [m/s^2]

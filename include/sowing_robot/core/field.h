@@ -48,7 +48,7 @@ struct FieldParams {
   /// Peak |dkappa/ds| in the turns [1/m^2]; must be >= 1/(2 min_turn_radius^2) so a ramp to the
   /// largest curvature fits in a half turn.
   double max_curvature_rate;
-  bool start_from_rest;            ///< false: the path starts at row_speed (as the thesis line)
+  bool start_from_rest;  ///< false: the path starts at row_speed (as the thesis line)
   /// With a start_pose and avoidance.plan_detours: the path starts at the robot, on an approach that
   /// joins the first row within the detours' bounds (approach.h); false: it starts at the row start.
   bool approach;
@@ -61,7 +61,8 @@ struct FieldParams {
   std::string validate() const;
 };
 /// field/{rows, row_length, row_spacing, start_x, start_y, heading, rows_to_left, row_speed, turn_speed,
-/// min_turn_radius, max_accel, max_curvature_rate, start_from_rest, approach, approach_settle} and potential/... (potentialFieldTable()).
+/// min_turn_radius, max_accel, max_curvature_rate, start_from_rest, approach, approach_settle} and potential/...
+/// (potentialFieldTable()).
 const ParamTable<FieldParams>& fieldTable();
 
 /// One headland U-turn in a local frame: starts at the origin heading along +x, turns left and ends at
@@ -132,8 +133,8 @@ class FieldPath : public TargetTrajectory {
     double s0 = 0.0, length = 0.0;
     std::size_t detour_first = 0, detour_count = 0;  ///< its detours in detours_ (rows only)
     bool turn = false;
-    bool approach = false;  ///< the approach from the start pose (tool up)
-    double along0 = 0.0;    ///< along-row position where a row's driven part starts (the join) [m]
+    bool approach = false;   ///< the approach from the start pose (tool up)
+    double along0 = 0.0;     ///< along-row position where a row's driven part starts (the join) [m]
     double tool_from = 0.0;  ///< along-row position from which the tool may go down (join + settle) [m]
     Eigen::Vector2d p0 = Eigen::Vector2d::Zero();
     double heading = 0.0;  ///< direction at the start [rad]
