@@ -29,7 +29,10 @@ FieldRunSetup::FieldRunSetup() {
 FieldRunReport runField(const FieldRunSetup& setup) {
   const std::string e = setup.scenario.validate();
   if (!e.empty()) throw std::invalid_argument("Scenario: " + e);
-  FieldReference reference(setup.field, setup.obstacles);
+  // The target starts where the robot does (field/approach), as the node does with plant_sim's start.
+  FieldParams field = setup.field;
+  if (!field.start_pose) field.start_pose = setup.scenario.start;
+  FieldReference reference(field, setup.obstacles);
   ContactMonitor contacts(setup.footprint, setup.obstacles);
   SeedDrill drill(setup.seeding, rowsOf(setup.field),
                   setup.scoring_obstacles.empty() ? setup.obstacles : setup.scoring_obstacles,
@@ -66,6 +69,14 @@ FieldRunReport runField(const FieldRunSetup& setup) {
   rep.status = reference.status();
   rep.diverged = run.diverged;
   return rep;
+}
+
+double approachExtraTime(const FieldRunSetup& setup) {
+  FieldParams with = setup.field;
+  if (!with.start_pose) with.start_pose = setup.scenario.start;
+  FieldParams without = with;
+  without.approach = false;
+  return FieldPath(with, setup.obstacles).duration() - FieldPath(without, setup.obstacles).duration();
 }
 
 std::string FieldRunReport::summary() const {

@@ -1,13 +1,15 @@
 // run_scenario: the thesis closed loop in-process (no ROS), for quick comparisons and benchmarks.
 //   run_scenario [--tsmc] [--atsmc] [--disturbance] [--mismatch S] [--noise STD] [--duration T] [--rate HZ]
 //                [--switching NAME --width W] [--repeat N] [--yaml FILE (metrics of the last mode)]
-//   run_scenario --field [--potential-only] [--rate HZ]
+//   run_scenario --field [--potential-only] [--no-approach] [--start X Y THETA] [--rate HZ]
 // Prints the Table 5.5/5.6 metrics as Markdown and the wall time per run. --field runs the thesis field
 // (config/field_thesis.yaml: a 100 m row at y = 3, obstacles r 0.3 at x = 20, 50, 80; ATSMC, disturbance,
 // 20 % mismatch, 110 s) measured on the body (the URDF's footprint) and prints clearance, contacts, peak
 // yaw rate and v omega (from t = 12 s, after the approach from the start; and over the whole run), and
 // the seeds on the rows and on the detours; --potential-only is the thesis potential field without the
-// planned detours (the figures before issue 15).
+// planned detours (the figures before issue 15). The robot starts at --start (default the thesis's
+// (-1, 0, 0)) and the target starts there too, on an approach to the row (field/approach);
+// --no-approach starts the target at the row start instead (the figures before the approach).
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -22,10 +24,13 @@ using namespace sowing_robot::core;
 
 namespace {
 /// The thesis field on the body; returns the exit code.
-int runThesisField(bool potential_only, std::int64_t period_ns) {
+int runThesisField(bool potential_only, bool approach, const Pose2D& start, std::int64_t period_ns) {
   FieldRunSetup s;
   s.scenario.duration = 110.0;
   if (period_ns > 0) s.scenario.control_period_ns = period_ns;
+  s.scenario.start = start;
+  s.field.approach = approach;
+  s.field.start_pose = start;  // what the node takes from plant_sim's start/{x, y, theta}
   s.field.rows = 1;
   s.field.row_length = 100.0;
   s.field.start_x = 0.0;
@@ -38,15 +43,19 @@ int runThesisField(bool potential_only, std::int64_t period_ns) {
     std::fprintf(stderr, "run_scenario: %s\n", err.c_str());
     return 2;
   }
+  // The approach makes the path longer than the straight row (thesis: by 2.46 s): the run is longer by as
+  // much, so it ends at the same point of the row as without it.
+  s.scenario.duration += approachExtraTime(s);
   FieldRunSetup whole = s;
   s.peaks_from = 12.0;
   const auto t0 = std::chrono::steady_clock::now();
   const FieldRunReport r = runField(s);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const FieldRunReport w = runField(whole);
-  std::printf("thesis field, %s (%.0f ms wall), footprint circumscribed radius %.3f m:\n",
-              potential_only ? "potential field only (thesis)" : "planned detours (issue 15)", 1e3 * wall,
-              s.footprint.circumscribedRadius());
+  std::printf("thesis field, %s%s (%.0f ms wall), start (%.2f, %.2f, %.3f), footprint circumscribed radius %.3f m:\n",
+              potential_only ? "potential field only (thesis)" : "planned detours (issue 15)",
+              potential_only ? "" : (approach ? ", approach from the start" : ", no approach"), 1e3 * wall, start.x,
+              start.y, start.theta, s.footprint.circumscribedRadius());
   std::printf(
       "| body clearance | contacts | peak yaw rate | peak v*omega | peak yaw rate / v*omega, whole run | "
       "seeds on rows: count, max, RMS | detour seeds: count, max | end |\n|---|---|---|---|---|---|---|---|\n");
@@ -59,16 +68,19 @@ int runThesisField(bool potential_only, std::int64_t period_ns) {
     std::printf("contact: obstacle %zu, t = %.3f .. %.3f s, max depth %.3f m\n", e.obstacle, e.start, e.end,
                 e.max_depth);
   std::printf(
-      "reference (from t = 12 s): peak yaw rate %.2f rad/s, v*omega %.2f m/s^2, curvature %.2f 1/m; status %s%s%s\n",
-      r.peak_ref_yaw_rate, r.peak_ref_lateral, r.peak_ref_curvature, AvoidanceStatus::name(r.status.code),
-      r.status.reason.empty() ? "" : ": ", r.status.reason.c_str());
+      "reference (from t = 12 s): peak yaw rate %.2f rad/s, v*omega %.2f m/s^2, curvature %.2f 1/m; whole run: "
+      "%.2f rad/s, %.2f m/s^2, %.2f 1/m; status %s%s%s%s%s\n",
+      r.peak_ref_yaw_rate, r.peak_ref_lateral, r.peak_ref_curvature, w.peak_ref_yaw_rate, w.peak_ref_lateral,
+      w.peak_ref_curvature, AvoidanceStatus::name(r.status.code), r.status.reason.empty() ? "" : ": ",
+      r.status.reason.c_str(), r.status.within_bounds ? "" : "; bounds not held: ", r.status.bounds_note.c_str());
   return r.diverged ? 1 : 0;
 }
 }  // namespace
 
 int main(int argc, char** argv) {
   std::vector<bool> modes;
-  bool field = false, potential_only = false;
+  bool field = false, potential_only = false, approach = true;
+  Pose2D start = Scenario().start;
   Scenario sc;
   int repeat = 1;
   std::string yaml;
@@ -85,7 +97,13 @@ int main(int argc, char** argv) {
       field = true;
     else if (a == "--potential-only")
       potential_only = true;
-    else if (a == "--tsmc")
+    else if (a == "--no-approach")
+      approach = false;
+    else if (a == "--start") {
+      start.x = value("--start X");
+      start.y = value("--start Y");
+      start.theta = value("--start THETA");
+    } else if (a == "--tsmc")
       modes.push_back(false);
     else if (a == "--atsmc")
       modes.push_back(true);
@@ -115,7 +133,7 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
-  if (field) return runThesisField(potential_only, sc.control_period_ns);
+  if (field) return runThesisField(potential_only, approach, start, sc.control_period_ns);
   if (modes.empty()) modes = {true, false};
   std::vector<std::string> names;
   std::vector<std::array<AxisMetrics, AXIS_COUNT>> results;

@@ -14,8 +14,8 @@ using namespace sowing_robot::core;
 namespace {
 
 constexpr double kMargin = 0.1;
-/// The approach from (-1, 0, 0) to the row 3 m away is the Kanayama controller's own transient, not the
-/// reference's: the robot's peaks are taken once it is on the row.
+/// The peaks of the rows and detours are taken once the robot is on the row; the approach from
+/// (-1, 0, 0) to the row 3 m away and the whole-run peaks are test_approach's.
 constexpr double kOnRow = 12.0;
 
 FieldRunSetup thesisField() {
@@ -32,6 +32,7 @@ FieldRunSetup thesisField() {
   s.field.potential.tangential_ratio = 1.0;
   s.obstacles = {{20.0, 3.0, 0.3}, {50.0, 3.0, 0.3}, {80.0, 3.0, 0.3}};
   s.peaks_from = kOnRow;
+  s.scenario.duration += approachExtraTime(s);  // the run ends at the row's end, as without the approach
   return s;
 }
 

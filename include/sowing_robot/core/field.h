@@ -16,12 +16,14 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include <Eigen/Dense>
 
+#include "sowing_robot/core/approach.h"
 #include "sowing_robot/core/detour.h"
 #include "sowing_robot/core/potential_field.h"
 #include "sowing_robot/core/reference.h"
@@ -46,13 +48,21 @@ struct FieldParams {
   /// Peak |dkappa/ds| in the turns [1/m^2]; must be >= 1/(2 min_turn_radius^2) so a ramp to the
   /// largest curvature fits in a half turn.
   double max_curvature_rate;
-  bool start_from_rest;            ///< false: the first row starts at row_speed (as the thesis line)
+  bool start_from_rest;  ///< false: the path starts at row_speed (as the thesis line)
+  /// With a start_pose and avoidance.plan_detours: the path starts at the robot, on an approach that
+  /// joins the first row within the detours' bounds (approach.h); false: it starts at the row start.
+  bool approach;
+  double approach_settle;  ///< the tool stays up this far past the approach's join [m], >= 0
+  /// The robot's start pose [m, m, rad]. Not a parameter: the caller sets it (the node from plant_sim's
+  /// start/{x, y, theta}, as avoidance.footprint_radius from the URDF). Unset: no approach.
+  std::optional<Pose2D> start_pose;
   PotentialFieldParams potential;  ///< alpha, beta, repulsion (see PotentialField)
   AvoidanceParams avoidance;       ///< planned detours around the inflated obstacles (detour.h)
   std::string validate() const;
 };
 /// field/{rows, row_length, row_spacing, start_x, start_y, heading, rows_to_left, row_speed, turn_speed,
-/// min_turn_radius, max_accel, max_curvature_rate, start_from_rest} and potential/... (potentialFieldTable()).
+/// min_turn_radius, max_accel, max_curvature_rate, start_from_rest, approach, approach_settle} and potential/...
+/// (potentialFieldTable()).
 const ParamTable<FieldParams>& fieldTable();
 
 /// One headland U-turn in a local frame: starts at the origin heading along +x, turns left and ends at
@@ -93,7 +103,9 @@ class HeadlandTurn {
 
 /// The whole field as a target trajectory (rows, turns and the speed profile); a pure function of t.
 /// With obstacles and avoidance.plan_detours, the rows carry planned detours (detour.h) driven at their
-/// detour speed, and the path ends early, at rest, before a group it cannot pass.
+/// detour speed, and the path ends early, at rest, before a group it cannot pass. With a plan, approach
+/// and a start_pose off the row start, the path begins at that pose on an approach (tool up) that joins
+/// the first row; the part of the row before the join is not driven.
 class FieldPath : public TargetTrajectory {
  public:
   /// Throws std::invalid_argument on invalid parameters or obstacles.
@@ -111,12 +123,19 @@ class FieldPath : public TargetTrajectory {
   /// The plan: its status and its detours (empty without obstacles or with plan_detours false).
   const AvoidanceStatus& status() const { return status_; }
   const std::vector<Detour>& detours() const { return detours_; }
+  /// True when the path starts on an approach; approach().why says why a needed one did not fit (the
+  /// path then starts at the row start and status().within_bounds is false).
+  bool hasApproach() const { return has_approach_; }
+  const ApproachPlan& approach() const { return approach_; }
 
  private:
   struct Element {
     double s0 = 0.0, length = 0.0;
     std::size_t detour_first = 0, detour_count = 0;  ///< its detours in detours_ (rows only)
     bool turn = false;
+    bool approach = false;   ///< the approach from the start pose (tool up)
+    double along0 = 0.0;     ///< along-row position where a row's driven part starts (the join) [m]
+    double tool_from = 0.0;  ///< along-row position from which the tool may go down (join + settle) [m]
     Eigen::Vector2d p0 = Eigen::Vector2d::Zero();
     double heading = 0.0;  ///< direction at the start [rad]
     double side = 1.0;     ///< +1 left turn, -1 right turn
@@ -126,8 +145,12 @@ class FieldPath : public TargetTrajectory {
     double t0 = 0.0, s0 = 0.0, duration = 0.0, v0 = 0.0, v1 = 0.0;
   };
   void addPhase(double distance, double v0, double v1);
+  /// Plans approach_ from params_.start_pose to `row` (the first, planned); v_out: its end speed.
+  void planApproach(const Element& row, double v_out, const std::vector<Obstacle>& obstacles);
   /// Speed phases of one row of `length` from v_in to v_out through its detours' speed windows.
-  void addRowPhases(double length, double v_in, double v_out, const Element& row);
+  /// An approach of length `lead` (driven at lead_speed after its start ramp) comes first when lead > 0.
+  void addRowPhases(double length, double v_in, double v_out, const Element& row, double lead = 0.0,
+                    double lead_speed = 0.0);
   void arcLength(double t, double& s, double& sd, double& sdd, double& sddd) const;
 
   FieldParams params_;
@@ -136,6 +159,8 @@ class FieldPath : public TargetTrajectory {
   std::vector<Phase> phases_;
   std::vector<Detour> detours_;
   AvoidanceStatus status_;
+  ApproachPlan approach_;
+  bool has_approach_ = false;
   double duration_ = 0.0, total_length_ = 0.0;
 };
 

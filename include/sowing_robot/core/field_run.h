@@ -26,7 +26,9 @@ Footprint sowingRobotFootprint();
 
 struct FieldRunSetup {
   Scenario scenario;  ///< duration, rate, start, disturbance, gains
-  FieldParams field;  ///< rows, potential and avoidance parameters
+  /// Rows, potential and avoidance parameters; an unset field.start_pose is taken from scenario.start
+  /// (so with field.approach the target starts at the robot).
+  FieldParams field;
   std::vector<Obstacle> obstacles;
   Footprint footprint = sowingRobotFootprint();
   Eigen::Vector2d tool{-0.45, 0.0};  ///< seed-drop point in base_link (the URDF's tool_link) [m]
@@ -58,6 +60,10 @@ struct FieldRunReport {
 
 /// Throws std::invalid_argument on invalid parameters.
 FieldRunReport runField(const FieldRunSetup& setup);
+
+/// How much longer the path is with the approach from the start pose than without it [s] (0 without
+/// one): a run of fixed duration lengthened by this ends at the same point of the rows.
+double approachExtraTime(const FieldRunSetup& setup);
 
 }  // namespace core
 }  // namespace sowing_robot
