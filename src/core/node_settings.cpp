@@ -19,6 +19,10 @@ const ParamTable<RunSettings>& RunSettings::table() {
              "scenario length: lockstep stops there and run_monitor reports; 0 = forever"),
       text("odom_frame", &S::odom_frame, "odom", "world-fixed frame of odom, paths and markers (REP-105)"),
       text("base_frame", &S::base_frame, "base_link", "the robot's frame: the axle midpoint (REP-105)"),
+      number("start/x", &S::start_x, -1.0, Limits::any(), "m",
+             "initial x of the axle midpoint (thesis 5.3); the field's approach starts here too"),
+      number("start/y", &S::start_y, 0.0, Limits::any(), "m", "initial y of the axle midpoint"),
+      number("start/theta", &S::start_theta, 0.0, Limits::any(), "rad", "initial heading"),
   });
   return table;
 }
@@ -53,9 +57,6 @@ const ParamTable<PlantSimSettings>& PlantSimSettings::table() {
         number("max_speed", &S::max_speed, 20.0, Limits::positive(), "m/s",
                "|v| beyond this (or a non-finite state) stops the run as diverged (exit 2)"),
         flag("exit_at_end", &S::exit_at_end, false, "lockstep: exit when the scenario ends"),
-        number("start/x", &S::start_x, -1.0, Limits::any(), "m", "initial x of the axle midpoint (thesis 5.3)"),
-        number("start/y", &S::start_y, 0.0, Limits::any(), "m", "initial y of the axle midpoint"),
-        number("start/theta", &S::start_theta, 0.0, Limits::any(), "rad", "initial heading"),
     });
     return t.nest("", &S::disturbance, disturbanceTable());
   }();

@@ -100,7 +100,7 @@ std::string loadPipelineScenario(core::Scenario& sc, double& duration) {
   if (!e.empty()) return e;
   sc.control_period_ns = run.periodNs();
   sc.disturbance = plant_settings.disturbance;
-  sc.start = plant_settings.start();
+  sc.start = run.start();
   duration = run.duration;
   sc.duration = duration;
   sc.kanayama = kin_settings.gains;

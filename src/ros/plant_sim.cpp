@@ -37,7 +37,7 @@ PlantSim::PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh) {
   cfg_.startup_delay = settings.startup_delay;
   cfg_.max_speed = settings.max_speed;
   cfg_.exit_at_end = settings.exit_at_end;
-  const core::Pose2D start = settings.start();
+  const core::Pose2D start = run.start();
   const core::PlantDisturbance& disturbance = settings.disturbance;
 
   SimulatedPlant::Rates rates;

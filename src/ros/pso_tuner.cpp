@@ -155,7 +155,10 @@ PsoTuner::PsoTuner(ros::NodeHandle nh, ros::NodeHandle pnh) {
   // The base scenario, read with the nodes' own tables from the nodes' namespaces; duration and rate are
   // the tuner's own (an evaluation need not be as long as the run).
   ParamReader plant(ros::NodeHandle("/plant_sim")), kin(ros::NodeHandle("/kinematic_controller")),
-      torque(ros::NodeHandle("/torque_controller")), refp(ros::NodeHandle("/reference_generator"));
+      torque(ros::NodeHandle("/torque_controller")), refp(ros::NodeHandle("/reference_generator")),
+      runp(ros::NodeHandle("/run"));  // the start pose (the tuner's own duration and rate are its own keys)
+  core::RunSettings run;
+  loadTable(runp, core::RunSettings::table(), run);
   const std::string robot_error = loadRobotParams(pnh, base_.robot);
   core::PlantSimSettings plant_settings;
   core::KinematicControllerSettings kin_settings;
@@ -167,7 +170,7 @@ PsoTuner::PsoTuner(ros::NodeHandle nh, ros::NodeHandle pnh) {
   loadTable(refp, core::ReferenceGeneratorSettings::table(), ref_settings);
   base_.duration = settings.duration;
   base_.control_period_ns = static_cast<std::int64_t>(std::llround(1e9 / settings.control_rate));
-  base_.start = plant_settings.start();
+  base_.start = run.start();
   base_.disturbance = plant_settings.disturbance;
   base_.kanayama = kin_settings.gains;
   base_.sliding = torque_settings.sliding;
@@ -178,8 +181,8 @@ PsoTuner::PsoTuner(ros::NodeHandle nh, ros::NodeHandle pnh) {
   reference_ = core::LineReference(line_v_, line_y_, line_x0_);
 
   const std::string gains_error = parseGains(pnh, gains_);
-  std::string e = core::firstError(
-      {plant.error(), kin.error(), torque.error(), refp.error(), robot_error, settings.validate(), gains_error});
+  std::string e = core::firstError({runp.error(), plant.error(), kin.error(), torque.error(), refp.error(), robot_error,
+                                    settings.validate(), gains_error});
   if (e.empty())
     e = core::firstError({base_.validate(), core::validateGainBounds(base_, gains_), objective_.validate()});
   if (e.empty()) {

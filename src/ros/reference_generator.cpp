@@ -37,6 +37,8 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
       error = "parameter robot_description (the URDF) is not set";
     if (error.empty()) error = footprintFromUrdf(xml, footprint);
     field.avoidance.footprint_radius = footprint.circumscribedRadius();
+    // The reference starts where the robot does (run/start) and joins the first row on a bounded approach.
+    field.start_pose = run.start();
     if (error.empty() && p.error().empty()) error = field.validate();
   } else {
     // Said before the unknown-key list (which would only name the key): why it is not read.

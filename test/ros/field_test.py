@@ -1,15 +1,43 @@
 #!/usr/bin/env python3
-"""rostest (lockstep field run): follows the robot to the end of the scenario and checks its smallest
-clearance from every obstacle surface (axle midpoint; obstacles from /reference_generator/obstacles),
-that it ends near (end_x, end_y), and the seed drill's cross-track report for seeds away from obstacles."""
+"""rostest (lockstep field run): follows the robot to the end of the scenario and checks, on the BODY
+(plant_sim's latched `footprint`, the URDF's collision outline, placed at every odom pose; obstacles from
+the generator's latched `plan`), its smallest clearance from every obstacle surface and that plant_sim
+reported no contact; optionally (~max_yaw_rate, ~max_lateral_accel) that the robot's |omega| and
+|v omega| stayed within bounds over the whole run; that it ends near (end_x, end_y); and the seed
+drill's cross-track report for seeds away from obstacles."""
 import math
 import time
 import unittest
 
 import rospy
 import rostest
+from geometry_msgs.msg import PolygonStamped
 from nav_msgs.msg import Odometry
+from sowing_robot.msg import Contact, FieldPlan
 from std_msgs.msg import Float64MultiArray
+
+TIMEOUT = 60.0  # [s wall] for the latched footprint and plan
+
+
+def segment_distance(px, py, ax, ay, bx, by):
+    dx, dy = bx - ax, by - ay
+    t = max(0.0, min(1.0, ((px - ax) * dx + (py - ay) * dy) / (dx * dx + dy * dy))) if dx or dy else 0.0
+    return math.hypot(px - ax - t * dx, py - ay - t * dy)
+
+
+def body_clearance(polygon, x, y, theta, cx, cy, radius):
+    """Signed distance from the polygon (base_link) placed at (x, y, theta) to a disc: < 0 overlaps."""
+    c, s = math.cos(theta), math.sin(theta)
+    # the disc's centre in base_link
+    qx, qy = c * (cx - x) + s * (cy - y), -s * (cx - x) + c * (cy - y)
+    n = len(polygon)
+    edge = min(segment_distance(qx, qy, *polygon[i], *polygon[(i + 1) % n]) for i in range(n))
+    inside = False
+    for i in range(n):
+        (ax, ay), (bx, by) = polygon[i], polygon[(i + 1) % n]
+        if (ay > qy) != (by > qy) and qx < (bx - ax) * (qy - ay) / (by - ay) + ax:
+            inside = not inside
+    return (-edge if inside else edge) - radius
 
 
 class FieldRun(unittest.TestCase):
@@ -17,17 +45,27 @@ class FieldRun(unittest.TestCase):
         rospy.init_node("field_test")
         duration = rospy.get_param("~duration")
         margin = rospy.get_param("~safety_margin")
-        obstacles = rospy.get_param("/reference_generator/obstacles", [])
-        state = {"min_clear": float("inf"), "last": None, "report": None}
+        max_yaw_rate = rospy.get_param("~max_yaw_rate", float("inf"))
+        max_lateral = rospy.get_param("~max_lateral_accel", float("inf"))
+        footprint = rospy.wait_for_message("footprint", PolygonStamped, timeout=TIMEOUT)
+        plan = rospy.wait_for_message("plan", FieldPlan, timeout=TIMEOUT)
+        polygon = [(q.x, q.y) for q in footprint.polygon.points]
+        obstacles = [(c.x, c.y, r) for c, r in zip(plan.obstacle_centres, plan.obstacle_radii)]
+        self.assertGreater(len(polygon), 2, "no footprint from plant_sim")
+        state = {"min_clear": float("inf"), "last": None, "report": None, "yaw": 0.0, "lateral": 0.0, "contacts": []}
 
         def on_odom(m):
-            p = m.pose.pose.position
-            for o in obstacles:
-                c = math.hypot(p.x - o["x"], p.y - o["y"]) - o.get("radius", 0.3)
-                state["min_clear"] = min(state["min_clear"], c)
+            p, q = m.pose.pose.position, m.pose.pose.orientation
+            theta = 2.0 * math.atan2(q.z, q.w)
+            for cx, cy, r in obstacles:
+                state["min_clear"] = min(state["min_clear"], body_clearance(polygon, p.x, p.y, theta, cx, cy, r))
+            v, w = m.twist.twist.linear.x, m.twist.twist.angular.z
+            state["yaw"] = max(state["yaw"], abs(w))
+            state["lateral"] = max(state["lateral"], abs(v * w))
             state["last"] = m
 
         rospy.Subscriber("odom", Odometry, on_odom, queue_size=100000)
+        rospy.Subscriber("contacts", Contact, lambda m: state["contacts"].append(m), queue_size=100)
         rospy.Subscriber("seed_report", Float64MultiArray, lambda m: state.update(report=m.data), queue_size=10)
         t0 = time.time()
         while not rospy.is_shutdown():
@@ -39,11 +77,16 @@ class FieldRun(unittest.TestCase):
         time.sleep(1.0)  # the drill's last report
         p = state["last"].pose.pose.position
         rows_count, rows_max, rows_rms, rows_over, det_count, det_max, det_rms = state["report"]
-        print("field: min clearance %.3f m, end (%.3f, %.3f), seeds on rows %d (max %.4f m, RMS %.4f m, "
-              "%.1f %% over tolerance), detour seeds %d (max %.3f m)" %
-              (state["min_clear"], p.x, p.y, rows_count, rows_max, rows_rms, 100 * rows_over, det_count, det_max))
+        print("field: min body clearance %.3f m, %d contact message(s), peak |omega| %.3f rad/s, peak |v omega| "
+              "%.3f m/s^2, end (%.3f, %.3f), seeds on rows %d (max %.4f m, RMS %.4f m, %.1f %% over tolerance), "
+              "detour seeds %d (max %.3f m)" %
+              (state["min_clear"], len(state["contacts"]), state["yaw"], state["lateral"], p.x, p.y, rows_count,
+               rows_max, rows_rms, 100 * rows_over, det_count, det_max))
         if obstacles:
-            self.assertGreater(state["min_clear"], margin)
+            self.assertGreaterEqual(state["min_clear"], margin, "body clearance below the safety margin")
+        self.assertEqual(state["contacts"], [], "plant_sim reported a contact")
+        self.assertLessEqual(state["yaw"], max_yaw_rate, "peak yaw rate over its bound")
+        self.assertLessEqual(state["lateral"], max_lateral, "peak lateral acceleration over its bound")
         self.assertLess(math.hypot(p.x - rospy.get_param("~end_x"), p.y - rospy.get_param("~end_y")), 1.0)
         self.assertGreaterEqual(rows_count, rospy.get_param("~min_row_seeds"))
         self.assertLess(rows_max, rospy.get_param("~max_row_error"))

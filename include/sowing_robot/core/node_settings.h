@@ -21,10 +21,12 @@ namespace core {
 /// Run-wide settings, under `run/` relative to each node's namespace (sim.launch sets them once).
 struct RunSettings {
   RunSettings();
-  bool lockstep;                       ///< mode: lockstep (headless) or realtime (paced to the wall clock)
-  double control_rate;                 ///< plant step and control rate [Hz]
-  double duration;                     ///< scenario length [s]; 0 = forever
-  std::string odom_frame, base_frame;  ///< REP-105 frame ids
+  bool lockstep;                         ///< mode: lockstep (headless) or realtime (paced to the wall clock)
+  double control_rate;                   ///< plant step and control rate [Hz]
+  double duration;                       ///< scenario length [s]; 0 = forever
+  std::string odom_frame, base_frame;    ///< REP-105 frame ids
+  double start_x, start_y, start_theta;  ///< where the robot starts (the plant) and the approach begins (the field)
+  Pose2D start() const { return {start_x, start_y, start_theta}; }
   std::string validate() const { return table().checkRanges(*this, "run/"); }
   /// The control period on the ns grid every node stamps its messages on.
   std::int64_t periodNs() const;
@@ -38,9 +40,7 @@ struct PlantSimSettings {
   double lockstep_retry, lockstep_timeout, lockstep_give_up, startup_delay, max_speed;
   int min_subscribers;
   bool exit_at_end;
-  double start_x, start_y, start_theta;
   PlantDisturbance disturbance;
-  Pose2D start() const { return {start_x, start_y, start_theta}; }
   std::string validate() const;
   static const ParamTable<PlantSimSettings>& table();
 };
