@@ -6,6 +6,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
+#include <sstream>
 #include <limits>
 #include <vector>
 
@@ -113,6 +115,42 @@ TEST(Traction, StaticNormalLoadsBalanceWeightAndMoment) {
   EXPECT_NEAR(n.right, 74.39, 0.01);
   p.d = -0.05;  // COM behind the axle: the caster would have to pull; clamped (no tipping modelled)
   EXPECT_EQ(staticNormalLoads(p, 1.0, 0.30).caster, 0.0);
+}
+
+// traction/caster_x is a parameter (the core does not read URDFs); its default must be the URDF's
+// caster_joint x, read here from the file's text.
+TEST(Traction, CasterDefaultIsTheUrdfsCasterJoint) {
+  std::ifstream f(SOWING_URDF_PATH);
+  std::stringstream text;
+  text << f.rdbuf();
+  const std::string xml = text.str();
+  const std::size_t joint = xml.find("<joint name=\"caster_joint\"");
+  ASSERT_NE(joint, std::string::npos);
+  const std::size_t xyz = xml.find("xyz=\"", xml.find("<origin", joint));
+  ASSERT_NE(xyz, std::string::npos);
+  EXPECT_DOUBLE_EQ(std::stod(xml.substr(xyz + 5)), TractionParams().caster_x);
+}
+
+// The thesis loop on real soil: its 100 N·m start spins the wheels and the sliding mode then saturates
+// almost every period. The run must stay finite, end, and report the saturation (not diverge silently).
+TEST(Traction, ThesisLoopOnSoilAndIceStaysFiniteAndReportsSaturation) {
+  Scenario sc;
+  sc.disturbance.sinusoidal = true;
+  sc.disturbance.mass_scale = sc.disturbance.inertia_scale = 1.2;
+  LineReference line;
+  for (const double mu : {0.0, 0.2, 0.6}) {
+    TractionParams t;
+    t.mu_peak = mu;
+    t.mu_slide = 0.75 * mu;
+    const TractionRunResult r = runTractionClosedLoop(sc, t, line, false);
+    EXPECT_FALSE(r.run.diverged) << mu;
+    EXPECT_TRUE(r.run.final_state.allFinite()) << mu;
+    EXPECT_EQ(r.run.periods, sc.steps()) << mu;
+    EXPECT_GT(r.run.saturated_steps, sc.steps() / 2) << mu;
+    std::printf("mu %.2f: saturated %lld of %lld periods, final y %.3f m, max slip %.2f\n", mu,
+                static_cast<long long>(r.run.saturated_steps), static_cast<long long>(sc.steps()),
+                r.run.final_state[Y], r.max_abs_slip);
+  }
 }
 
 TEST(Traction, RejectsBadInputWithoutChangingTheState) {
