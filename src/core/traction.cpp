@@ -153,23 +153,47 @@ bool TractionPlant::step(double tau_right, double tau_left, double dt) {
     dist_c = std::cos(angle);
   }
   const double amplitude = disturbance_.sinusoidal ? disturbance_.amplitude : 0.0;
+  double rr_force, rr_moment;
+  rollingResistance(rr_force, rr_moment);
   for (int j = 0; j < n; ++j) {
-    substep(tau_right + noise_r + amplitude * dist_s, tau_left + noise_l + amplitude * dist_c, h, cos_th, sin_th);
+    substep(tau_right + noise_r + amplitude * dist_s, tau_left + noise_l + amplitude * dist_c, rr_force, rr_moment, h,
+            cos_th, sin_th);
     if (disturbance_.sinusoidal) rotate(dist_c, dist_s, dist_step, dist_c, dist_s);
   }
   time_ += dt;
   return true;
 }
 
-void TractionPlant::substep(double tau_r, double tau_l, double h, double& cos_th, double& sin_th) {
+void TractionPlant::rollingResistance(double& force, double& moment) const {
+  // Non-stiff (rate c N / (floor m) of a few 1/s): once per step, from the step's start.
+  force = moment = 0.0;
+  const double c_rr = traction_.rolling_resistance;
+  if (c_rr <= 0.0) return;
+  const double v = state_[V], w = state_[OMEGA], L = nominal_.L;
+  const double f_r = -c_rr * loads_.right * std::clamp((v + L * w) * inv_floor_, -1.0, 1.0);
+  const double f_l = -c_rr * loads_.left * std::clamp((v - L * w) * inv_floor_, -1.0, 1.0);
+  force = f_r + f_l;
+  moment = L * (f_r - f_l);
+  // Caster: against its travel (v, caster_x w); the sideways part goes into the axle's nonholonomic
+  // reaction, its moment about the axle stays.
+  if (loads_.caster > 0.0) {
+    const double xc = traction_.caster_x, lateral = xc * w;
+    const double speed = std::sqrt(v * v + lateral * lateral);
+    const double scale = c_rr * loads_.caster / std::max(speed, traction_.slip_speed_floor);
+    force -= scale * v;
+    moment -= scale * lateral * xc;
+  }
+}
+
+void TractionPlant::substep(double tau_r, double tau_l, double rr_force, double rr_moment, double h, double& cos_th,
+                            double& sin_th) {
   const FrictionCurve& curve = curve_;
   const double R = nominal_.R, L = nominal_.L, floor = traction_.slip_speed_floor;
-  const double c_rr = traction_.rolling_resistance;
   const double v = state_[V], w = state_[OMEGA];
   const double u[2] = {v + L * w, v - L * w};
   const double n_load[2] = {loads_.right, loads_.left};
   const double tau[2] = {tau_r, tau_l};
-  double f0[2], k[2], f_rr[2];
+  double f0[2], k[2];
   for (int i = 0; i < 2; ++i) {
     const double rim = R * wheel_rate_[i], s = rim - u[i];
     const double den = std::max({std::fabs(u[i]), std::fabs(rim), floor});
@@ -184,23 +208,12 @@ void TractionPlant::substep(double tau_r, double tau_l, double h, double& cos_th
     f0[i] = kappa < 0.0 ? -n_load[i] * mu : n_load[i] * mu;
     k[i] = n_load[i] * jac * inv_den;
     slip_[i] = kappa;
-    f_rr[i] = -c_rr * n_load[i] * std::clamp(u[i] * inv_floor_, -1.0, 1.0);
-  }
-  // Caster: rolling resistance against its travel (v, caster_x w); the sideways part goes into the
-  // axle's nonholonomic reaction, its moment about the axle stays.
-  double fc_x = 0.0, mc_z = 0.0;
-  if (c_rr > 0.0 && loads_.caster > 0.0) {
-    const double xc = traction_.caster_x, lateral = xc * w;
-    const double speed = std::sqrt(v * v + lateral * lateral);
-    const double scale = c_rr * loads_.caster / std::max(speed, floor);
-    fc_x = -scale * v;
-    mc_z = -scale * lateral * xc;
   }
   const double inv_m = inv_m_, inv_i = inv_i_, inv_iw = inv_iw_;
   // Body accelerations of the contact forces; the COM coupling (mc d w², −mc d w v) comes after, as a
   // rotation that does no work.
-  const double av0 = (f0[RIGHT] + f0[LEFT] + f_rr[RIGHT] + f_rr[LEFT] + fc_x) * inv_m;
-  const double aw0 = (L * (f0[RIGHT] + f_rr[RIGHT] - f0[LEFT] - f_rr[LEFT]) + mc_z) * inv_i;
+  const double av0 = (f0[RIGHT] + f0[LEFT] + rr_force) * inv_m;
+  const double aw0 = (L * (f0[RIGHT] - f0[LEFT]) + rr_moment) * inv_i;
   // Explicit change of each slip velocity over the sub-step, then the implicit correction:
   // (1 + h A k_i) ds_i + h B k_j ds_j = b_i, A = R²/Iw + 1/m + L²/I, B = 1/m - L²/I (wheel j's force
   // change reaches wheel i's slip through the body's translation and yaw).

@@ -16,7 +16,8 @@
 // caster reaction give N_caster = mc g d / caster_x and N_R = N_L = (m g − N_caster) / 2 (clamped to
 // [0, m g]: this plant does not tip over). No load transfer under acceleration (no COM height in the
 // robot's parameters). Rolling resistance: rolling_resistance × N at each wheel and at the caster,
-// against the contact point's motion (regularised linearly below slip_speed_floor).
+// against the contact point's motion (regularised linearly below slip_speed_floor), evaluated once per
+// step (it is not stiff).
 //
 // Integration: `substeps` sub-steps per step(). Each sub-step is linearly implicit (Rosenbrock–Euler)
 // in the two slip velocities: the friction forces are linearised in s_i at the sub-step's start and
@@ -153,7 +154,9 @@ class TractionPlant {
   double bodyYawInertia() const { return i_b_; }
 
  private:
-  void substep(double tau_r, double tau_l, double h, double& cos_th, double& sin_th);
+  void rollingResistance(double& force, double& moment) const;
+  void substep(double tau_r, double tau_l, double rr_force, double rr_moment, double h, double& cos_th,
+               double& sin_th);
 
   RobotParams nominal_;
   PlantDisturbance disturbance_;
