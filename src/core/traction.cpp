@@ -45,8 +45,9 @@ const ParamTable<TractionParams>& tractionTable() {
              "longitudinal slip ratio at which the friction peaks"),
       number("traction/slip_stiffness", &T::slip_stiffness, 8.0, Limits::above(0.0, 1e6), "",
              "slope of friction coefficient over slip ratio at zero slip; >= mu_peak / slip_peak"),
-      number("traction/rolling_resistance", &T::rolling_resistance, 0.05, Limits::closed(0.0, 1.0), "",
-             "rolling-resistance force / normal load, at each wheel and the caster (0.02 hard track .. 0.15 soft soil)"),
+      number(
+          "traction/rolling_resistance", &T::rolling_resistance, 0.05, Limits::closed(0.0, 1.0), "",
+          "rolling-resistance force / normal load, at each wheel and the caster (0.02 hard track .. 0.15 soft soil)"),
       number("traction/slip_speed_floor", &T::slip_speed_floor, 0.05, Limits::above(0.0, 1.0), "m/s",
              "smallest speed the slip ratio is divided by (regularises slip at standstill)"),
       number("traction/caster_x", &T::caster_x, 0.30, Limits::above(0.0, 5.0), "m",
@@ -229,7 +230,8 @@ void TractionPlant::substep(double tau_r, double tau_l, double rr_force, double 
   const double ds_r = (m22 * b_r - m12 * b_l) * inv_det, ds_l = (m11 * b_l - m21 * b_r) * inv_det;
   // Forces at the sub-step's end, capped by the peak grip (the linearisation may overshoot the peak).
   double f[2];
-  f[RIGHT] = std::clamp(f0[RIGHT] + k[RIGHT] * ds_r, -traction_.mu_peak * n_load[RIGHT], traction_.mu_peak * n_load[RIGHT]);
+  f[RIGHT] =
+      std::clamp(f0[RIGHT] + k[RIGHT] * ds_r, -traction_.mu_peak * n_load[RIGHT], traction_.mu_peak * n_load[RIGHT]);
   f[LEFT] = std::clamp(f0[LEFT] + k[LEFT] * ds_l, -traction_.mu_peak * n_load[LEFT], traction_.mu_peak * n_load[LEFT]);
   force_[RIGHT] = f[RIGHT];
   force_[LEFT] = f[LEFT];

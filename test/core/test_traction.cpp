@@ -7,8 +7,8 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
-#include <sstream>
 #include <limits>
+#include <sstream>
 #include <vector>
 
 #include "sowing_robot/core/plant.h"
@@ -72,7 +72,7 @@ TEST(Traction, FrictionCurveHasItsSlopePeakAndSlide) {
     const double mu = tractionFriction(p, k);
     ASSERT_LE(mu, p.mu_peak + 1e-12) << k;  // capped by mu_peak
     ASSERT_GE(mu, 0.0) << k;
-    if (k <= p.slip_peak) ASSERT_GE(mu, prev) << k;  // rises to the peak
+    if (k <= p.slip_peak) ASSERT_GE(mu, prev) << k;         // rises to the peak
     if (k > p.slip_peak) ASSERT_LE(mu, prev + 1e-15) << k;  // then falls to the slide value
     prev = mu;
   }
@@ -148,8 +148,8 @@ TEST(Traction, ThesisLoopOnSoilAndIceStaysFiniteAndReportsSaturation) {
     EXPECT_EQ(r.run.periods, sc.steps()) << mu;
     EXPECT_GT(r.run.saturated_steps, sc.steps() / 2) << mu;
     std::printf("mu %.2f: saturated %lld of %lld periods, final y %.3f m, max slip %.2f\n", mu,
-                static_cast<long long>(r.run.saturated_steps), static_cast<long long>(sc.steps()),
-                r.run.final_state[Y], r.max_abs_slip);
+                static_cast<long long>(r.run.saturated_steps), static_cast<long long>(sc.steps()), r.run.final_state[Y],
+                r.max_abs_slip);
   }
 }
 
@@ -190,7 +190,7 @@ TEST(Traction, HighGripConvergesToTheNoSlipPlantOpenLoop) {
   EXPECT_LT(errors.back(), 1e-3);
   EXPECT_LT(e_fine, 0.1 * errors.back());
   std::printf("  (Plant's pose after 10 s: x %.2f m, y %.2f m, theta %.2f rad)\n", ref[X], ref[Y], ref[THETA]);
-  EXPECT_GT(ref[X], 2.0);  // it really drove
+  EXPECT_GT(ref[X], 2.0);                 // it really drove
   EXPECT_GT(std::fabs(ref[THETA]), 0.5);  // and turned
 }
 
@@ -208,9 +208,9 @@ TEST(Traction, ThesisLineMetricsApproachTodaysAsGripGrows) {
   };
   // The thesis start saturates the torques at 100 N·m (1050 N per wheel, mu ~14 on these loads): only an
   // unphysical grip carries that without spinning the wheels, hence the last rows.
-  const Soil soils[] = {{"wet grass", 0.2, 8.0},   {"dirt track", 0.35, 8.0}, {"loose moist soil", 0.6, 8.0},
-                        {"grip 2", 2.0, 80.0},     {"grip 20", 20.0, 800.0},  {"grip 200", 200.0, 8000.0},
-                        {"grip 200, K 8e4", 200.0, 80000.0}};
+  const Soil soils[] = {
+      {"wet grass", 0.2, 8.0},  {"dirt track", 0.35, 8.0},   {"loose moist soil", 0.6, 8.0},     {"grip 2", 2.0, 80.0},
+      {"grip 20", 20.0, 800.0}, {"grip 200", 200.0, 8000.0}, {"grip 200, K 8e4", 200.0, 80000.0}};
   std::printf("| soil | mu_peak | slip stiffness | ISE y | ITAE y | ISE theta | max slip | |dISE y|/ISE y |\n");
   std::printf("| no-slip Plant | | | %.6g | %.6g | %.6g | 0 | |\n", today.metrics[AXIS_Y].ise,
               today.metrics[AXIS_Y].itae, today.metrics[AXIS_THETA].ise);
@@ -257,7 +257,7 @@ TEST(Traction, IntegrationErrorAgainstAFineStepReference) {
   };
   double slip_ref;
   const auto ref = run(1000, &slip_ref);  // h = 1 µs
-  EXPECT_GT(slip_ref, soil.slip_peak);      // the wheel went past the friction peak
+  EXPECT_GT(slip_ref, soil.slip_peak);    // the wheel went past the friction peak
   std::printf("5 s open loop, dirt track (mu 0.35), max slip %.2f; error against h = 1 us:\n", slip_ref);
   std::vector<double> e;
   for (const int n : {1, 2, 4, 8, 16}) {
@@ -265,8 +265,8 @@ TEST(Traction, IntegrationErrorAgainstAFineStepReference) {
     const auto r = run(n, &slip);
     const double pose = poseError(r.first, ref.first), vel = std::fabs(r.first[V] - ref.first[V]),
                  spin = std::fabs(r.second - ref.second);
-    std::printf("  substeps %2d (h %6.1f us): pose %.2e m+rad, v %.2e m/s, wheel rate %.2e rad/s\n", n, 1e3 / n,
-                pose, vel, spin);
+    std::printf("  substeps %2d (h %6.1f us): pose %.2e m+rad, v %.2e m/s, wheel rate %.2e rad/s\n", n, 1e3 / n, pose,
+                vel, spin);
     e.push_back(pose);
     EXPECT_TRUE(r.first.allFinite());
   }

@@ -155,8 +155,7 @@ class TractionPlant {
 
  private:
   void rollingResistance(double& force, double& moment) const;
-  void substep(double tau_r, double tau_l, double rr_force, double rr_moment, double h, double& cos_th,
-               double& sin_th);
+  void substep(double tau_r, double tau_l, double rr_force, double rr_moment, double h, double& cos_th, double& sin_th);
 
   RobotParams nominal_;
   PlantDisturbance disturbance_;
