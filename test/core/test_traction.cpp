@@ -251,6 +251,9 @@ TEST(Traction, IntegrationErrorAgainstAFineStepReference) {
       const double time = i * kDt;
       plant.step(2.6 + 1.5 * std::sin(3.0 * time), 2.0 * std::cos(2.0 * time), kDt);
       *max_slip = std::max(*max_slip, std::fabs(plant.slipRatio(RIGHT)));
+      for (const Wheel w : {RIGHT, LEFT})  // the ground force never exceeds mu_peak N
+        EXPECT_LE(std::fabs(plant.groundForce(w)),
+                  t.mu_peak * (w == RIGHT ? plant.normalLoads().right : plant.normalLoads().left) * (1.0 + 1e-12));
     }
     State s = plant.state();
     return std::make_pair(s, plant.wheelRate(RIGHT));
