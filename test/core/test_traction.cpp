@@ -148,8 +148,8 @@ TEST(Traction, ThesisLoopOnSoilAndIceStaysFiniteAndReportsSaturation) {
     EXPECT_EQ(r.run.periods, sc.steps()) << mu;
     EXPECT_GT(r.run.saturated_steps, sc.steps() / 2) << mu;
     std::printf("mu %.2f: saturated %lld of %lld periods, final y %.3f m, max slip %.2f\n", mu,
-                static_cast<long long>(r.run.saturated_steps), static_cast<long long>(sc.steps()), r.run.final_state[Y],
-                r.max_abs_slip);
+                static_cast<long long>(r.run.saturated_steps), static_cast<long long>(sc.steps() + 1),
+                r.run.final_state[Y], r.max_abs_slip);
   }
 }
 
