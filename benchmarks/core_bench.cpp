@@ -4,6 +4,7 @@
 // BM_ControlStep             one period of runClosedLoop's loop: reference next + Kanayama + SMC + plant
 // BM_ThesisRun25s            runClosedLoop of the 25 s thesis scenario at 1 kHz (keep_samples = false);
 //                            items/s = control steps/s
+// BM_ThesisRun25sTraction    same with the traction plant (TractionParams defaults), issue 16's cost case
 // BM_ThesisRunPotentialField same with the potential-field reference (obstacles (20,3), (50,3), (80,3))
 // BM_PsoIteration/threads:N  one PSO iteration: 20 particles evaluated on the thesis scenario (ITAE,
 //                            default gain box), N evaluation threads; wall time (UseRealTime)
@@ -14,6 +15,7 @@
 #include "sowing_robot/core/plant.h"
 #include "sowing_robot/core/pso.h"
 #include "sowing_robot/core/runner.h"
+#include "sowing_robot/core/traction_run.h"
 #include "sowing_robot/core/tuning.h"
 #include "thesis_scenario.h"
 
@@ -79,6 +81,22 @@ void BM_ThesisRun25s(benchmark::State& state) {
   thesisRun(state, ref);
 }
 BENCHMARK(BM_ThesisRun25s)->Unit(benchmark::kMillisecond);
+
+// The same run with the traction plant (issue 16: at most 2x BM_ThesisRun25s). Default soil (loose moist
+// soil, mu 0.6, 4 sub-steps, rolling resistance 0.05): the thesis start's 100 N·m spins the wheels.
+void BM_ThesisRun25sTraction(benchmark::State& state) {
+  const Scenario sc = bench::thesisScenario();
+  LineReference ref = bench::thesisLine();
+  const TractionParams traction;
+  volatile double itae = 0.0;
+  for (auto _ : state) {
+    const TractionRunResult r = runTractionClosedLoop(sc, traction, ref, false);
+    itae = r.run.metrics[AXIS_Y].itae;
+  }
+  state.SetItemsProcessed(state.iterations() * sc.steps());
+  state.counters["itae_y"] = benchmark::Counter(itae, benchmark::Counter::kDefaults);
+}
+BENCHMARK(BM_ThesisRun25sTraction)->Unit(benchmark::kMillisecond);
 
 void BM_ThesisRunPotentialField(benchmark::State& state) {
   PotentialField ref = bench::thesisPotentialField();

@@ -1,6 +1,7 @@
 // run_scenario: the thesis closed loop in-process (no ROS), for quick comparisons and benchmarks.
 //   run_scenario [--tsmc] [--atsmc] [--disturbance] [--mismatch S] [--noise STD] [--duration T] [--rate HZ]
 //                [--switching NAME --width W] [--repeat N] [--yaml FILE (metrics of the last mode)]
+//                [--traction MU [--slip-stiffness K] [--rolling-resistance C]]
 //   run_scenario --field [--potential-only] [--no-approach] [--start X Y THETA] [--rate HZ]
 // Prints the Table 5.5/5.6 metrics as Markdown and the wall time per run. --field runs the thesis field
 // (config/field_thesis.yaml: a 100 m row at y = 3, obstacles r 0.3 at x = 20, 50, 80; ATSMC, disturbance,
@@ -10,6 +11,8 @@
 // planned detours (the figures before issue 15). The robot starts at --start (default the thesis's
 // (-1, 0, 0)) and the target starts there too, on an approach to the row (field/approach);
 // --no-approach starts the target at the row start instead (the figures before the approach).
+// --traction runs the line with the traction plant (traction.h: peak friction MU, sliding 0.75 MU, the
+// other traction/* defaults) instead of the no-slip one.
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -19,6 +22,8 @@
 
 #include "sowing_robot/core/field_run.h"
 #include "sowing_robot/core/runner.h"
+#include "sowing_robot/core/traction_run.h"
+#include "sowing_robot/core/validation.h"
 
 using namespace sowing_robot::core;
 
@@ -84,6 +89,7 @@ int main(int argc, char** argv) {
   Scenario sc;
   int repeat = 1;
   std::string yaml;
+  TractionParams traction;  // enabled by --traction
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto value = [&](const char* what) {
@@ -121,6 +127,14 @@ int main(int argc, char** argv) {
       sc.sliding.switching.width = value("--width");
     else if (a == "--repeat")
       repeat = static_cast<int>(value("--repeat"));
+    else if (a == "--traction") {
+      traction.enabled = true;
+      traction.mu_peak = value("--traction");
+      traction.mu_slide = 0.75 * traction.mu_peak;
+    } else if (a == "--slip-stiffness")
+      traction.slip_stiffness = value("--slip-stiffness");
+    else if (a == "--rolling-resistance")
+      traction.rolling_resistance = value("--rolling-resistance");
     else if (a == "--yaml" && i + 1 < argc)
       yaml = argv[++i];
     else if (a == "--switching" && i + 1 < argc) {
@@ -139,21 +153,31 @@ int main(int argc, char** argv) {
   std::vector<std::array<AxisMetrics, AXIS_COUNT>> results;
   for (bool adaptive : modes) {
     sc.sliding.adaptive = adaptive;
-    const std::string err = sc.validate();
+    const std::string err = firstError({sc.validate(), traction.enabled ? traction.validate() : ""});
     if (!err.empty()) {
       std::fprintf(stderr, "run_scenario: %s\n", err.c_str());
       return 2;
     }
     LineReference ref;
     RunResult r;
+    double max_slip = 0.0;
     const auto t0 = std::chrono::steady_clock::now();
-    for (int k = 0; k < repeat; ++k) r = runClosedLoop(sc, ref);
+    for (int k = 0; k < repeat; ++k) {
+      if (traction.enabled) {
+        const TractionRunResult tr = runTractionClosedLoop(sc, traction, ref);
+        r = tr.run;
+        max_slip = tr.max_abs_slip;
+      } else {
+        r = runClosedLoop(sc, ref);
+      }
+    }
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() / repeat;
     std::printf(
         "%s: %.3f ms wall per %.1f s run (%.2f M steps/s), final (x %.4f, y %.4f, theta %.5f), "
         "%ld saturated periods%s\n",
         adaptive ? "ATSMC" : "TSMC", 1e3 * s, sc.duration, (sc.steps() + 1) / s / 1e6, r.final_state[X],
         r.final_state[Y], r.final_state[THETA], static_cast<long>(r.saturated_steps), r.diverged ? ", DIVERGED" : "");
+    if (traction.enabled) std::printf("  traction: mu_peak %g, max |slip ratio| %.3f\n", traction.mu_peak, max_slip);
     names.push_back(adaptive ? "atsmc" : "tsmc");
     results.push_back(r.metrics);
     if (!yaml.empty() && !writeMetricsYaml(yaml, names.back(), r.metrics)) {
