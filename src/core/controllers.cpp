@@ -5,12 +5,9 @@ namespace core {
 
 const char* outerName(OuterKind k) {
   switch (k) {
-    case OuterKind::kanayama:
-      return "kanayama";
-    case OuterKind::pure_pursuit:
-      return "pure_pursuit";
-    case OuterKind::rpp:
-      return "rpp";
+    case OuterKind::kanayama: return "kanayama";
+    case OuterKind::pure_pursuit: return "pure_pursuit";
+    case OuterKind::rpp: return "rpp";
   }
   return "?";
 }

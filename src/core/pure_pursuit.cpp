@@ -42,9 +42,7 @@ std::string PurePursuitParams::validate() const {
                     "m (min/max_lookahead_dist)");
 }
 
-PurePursuit::PurePursuit(const PurePursuitParams& params, bool regulated) : regulated_(regulated) {
-  setParams(params);
-}
+PurePursuit::PurePursuit(const PurePursuitParams& params, bool regulated) : regulated_(regulated) { setParams(params); }
 
 void PurePursuit::setParams(const PurePursuitParams& p) {
   const std::string error = p.validate();
@@ -100,8 +98,8 @@ VelocityCommand PurePursuit::compute(const Reference& ref, const Pose2D& actual,
     if (abs_kappa * params_.min_radius > 1.0) {  // radius 1/|kappa| below min_radius
       const double scaled = speed / (abs_kappa * params_.min_radius);
       if (scaled >= params_.min_speed) {
-        speed_dot = speed_dot / (abs_kappa * params_.min_radius) -
-                    scaled * (kappa > 0.0 ? kappa_dot : -kappa_dot) / abs_kappa;
+        speed_dot =
+            speed_dot / (abs_kappa * params_.min_radius) - scaled * (kappa > 0.0 ? kappa_dot : -kappa_dot) / abs_kappa;
         speed = scaled;
       } else if (speed > params_.min_speed) {  // held at the floor
         speed = params_.min_speed;

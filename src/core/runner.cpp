@@ -9,12 +9,12 @@ namespace sowing_robot {
 namespace core {
 
 std::string Scenario::validate() const {
-  std::string e =
-      firstError({checkPositive("duration", duration, "s"), control_period_ns > 0 ? "" : "control_period must be > 0",
-                  allFinite(start.x, start.y, start.theta) ? "" : "start pose must be finite", robot.validate(),
-                  disturbance.validate(), kanayama.validate(), sliding.validate(),
-                  outer == OuterKind::kanayama ? "" : pure_pursuit.validate(),
-                  inner == InnerKind::pid ? pid.validate() : ""});
+  std::string e = firstError(
+      {checkPositive("duration", duration, "s"), control_period_ns > 0 ? "" : "control_period must be > 0",
+       allFinite(start.x, start.y, start.theta) ? "" : "start pose must be finite",
+       std::isfinite(disturbance_phase) ? "" : "disturbance_phase must be finite", robot.validate(),
+       disturbance.validate(), kanayama.validate(), sliding.validate(),
+       outer == OuterKind::kanayama ? "" : pure_pursuit.validate(), inner == InnerKind::pid ? pid.validate() : ""});
   return e;
 }
 
@@ -39,7 +39,8 @@ RunResult loop(const Scenario& sc, ReferenceSource& reference, Outer& outer, Inn
   x0[X] = sc.start.x;
   x0[Y] = sc.start.y;
   x0[THETA] = sc.start.theta;
-  plant.reset(x0, 0.0);
+  const bool phased = sc.disturbance_phase != 0.0 && sc.disturbance.frequency > 0.0;
+  plant.reset(x0, phased ? sc.disturbance_phase / sc.disturbance.frequency : 0.0);
   reference.reset();
   const std::int64_t n = sc.steps();
   const double dt = secondsFromNanos(sc.control_period_ns);
@@ -103,9 +104,8 @@ RunResult runClosedLoop(const Scenario& sc, ReferenceSource& reference, bool kee
   return withInner(sc, reference, pursuit, keep_samples, trace, stop);
 }
 
-RunResult runClosedLoop(const Scenario& sc, ReferenceSource& reference, OuterController& outer,
-                        InnerController& inner, bool keep_samples, const std::function<void(const LoopSample&)>& trace,
-                        const RunStop& stop) {
+RunResult runClosedLoop(const Scenario& sc, ReferenceSource& reference, OuterController& outer, InnerController& inner,
+                        bool keep_samples, const std::function<void(const LoopSample&)>& trace, const RunStop& stop) {
   outer.reset();
   inner.reset();
   return loop(sc, reference, outer, inner, keep_samples, trace, stop);

@@ -74,7 +74,7 @@ WheelPidOutput WheelPid::update(const VelocityCommand& desired, double v, double
     held.rejected = true;
     return held;
   }
-  const double sum = params_.feedforward * m0_ * R_ * desired.v_dot;             // tau_r + tau_l
+  const double sum = params_.feedforward * m0_ * R_ * desired.v_dot;            // tau_r + tau_l
   const double diff = params_.feedforward * i0_ * R_ / L_ * desired.omega_dot;  // tau_r - tau_l
   WheelPidOutput out;
   out.u_right = wheel(right_, (desired.v + L_ * desired.omega) / R_, (v + L_ * omega) / R_, 0.5 * (sum + diff), dt,

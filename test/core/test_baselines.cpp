@@ -90,7 +90,8 @@ TEST(Baselines, PairNamesParseAndUnknownNamesAreNamed) {
 // pursuit with nav2's constant speed (k_along 0) keeps the along-track lag it started with (it tracks
 // the path, not the time); k_along closes it.
 TEST(Baselines, EachPairTracksTheThesisLineUnderDisturbanceAndMismatch) {
-  for (const char* pair : {"kanayama+pid", "pure_pursuit+atsmc", "pure_pursuit+pid", "rpp+atsmc", "rpp+tsmc", "rpp+pid"}) {
+  for (const char* pair :
+       {"kanayama+pid", "pure_pursuit+atsmc", "pure_pursuit+pid", "rpp+atsmc", "rpp+tsmc", "rpp+pid"}) {
     for (double k_along : {0.0, 1.0}) {
       Scenario sc = thesisDisturbed(pair);
       sc.pure_pursuit.k_along = k_along;
@@ -240,7 +241,7 @@ TEST(PurePursuit, NonFiniteInputGivesTheStopCommand) {
       Pose2D pose{0.0, 0.0, 0.1};
       double v = 0.5, omega = 0.1;
       double* slots[] = {&ref.pose.x, &ref.pose.y, &ref.pose.theta, &ref.v, &ref.omega,
-                         &ref.v_dot, &pose.x, &pose.y, &v, &omega};
+                         &ref.v_dot,  &pose.x,     &pose.y,         &v,     &omega};
       *slots[field] = bad;
       const VelocityCommand c = rpp.compute(ref, pose, v, omega);
       EXPECT_EQ(c.v, 0.0) << field;

@@ -8,9 +8,8 @@
 #include <array>
 #include <cstdint>
 #include <functional>
-#include <string>
-
 #include <memory>
+#include <string>
 
 #include "sowing_robot/core/controllers.h"
 #include "sowing_robot/core/kanayama.h"
@@ -28,9 +27,12 @@ struct Scenario {
   Pose2D start{-1.0, 0.0, 0.0};              ///< initial posture of the axle midpoint
   RobotParams robot;                         ///< nominal parameters (the controllers' model)
   PlantDisturbance disturbance;              ///< what the plant adds (disturbance, noise, mismatch)
+  /// Phase of the sinusoidal disturbance [rad]: the plant's clock starts at phase / frequency (the
+  /// disturbance is its only user). 0: the thesis's (and the nodes') zero phase.
+  double disturbance_phase = 0.0;
   KanayamaGains kanayama;
   SlidingModeParams sliding;
-  OuterKind outer = OuterKind::kanayama;     ///< which outer controller runClosedLoop builds
+  OuterKind outer = OuterKind::kanayama;      ///< which outer controller runClosedLoop builds
   InnerKind inner = InnerKind::sliding_mode;  ///< which inner controller (atsmc/tsmc: sliding.adaptive)
   PurePursuitParams pure_pursuit;             ///< outer = pure_pursuit or rpp
   WheelPidParams pid;                         ///< inner = pid
@@ -51,7 +53,7 @@ struct LoopSample {
   const VelocityCommand* desired;
   const InnerOutput* control;  ///< for a PID inner: see InnerOutput (s_v = s_omega = 0)
   double m0_hat, i0_hat;       ///< a non-adaptive inner reports its fixed model values
-  double ex, ey, etheta;  ///< world-frame errors
+  double ex, ey, etheta;       ///< world-frame errors
 };
 
 struct RunResult {
