@@ -236,12 +236,12 @@ TEST(PurePursuit, NonFiniteInputGivesTheStopCommand) {
   good.pose = {1.0, 3.0, 0.0};
   good.v = 1.0;
   for (double bad : {kNaN, kInf, -kInf}) {
-    for (int field = 0; field < 10; ++field) {
+    for (int field = 0; field < 12; ++field) {
       Reference ref = good;
       Pose2D pose{0.0, 0.0, 0.1};
       double v = 0.5, omega = 0.1;
-      double* slots[] = {&ref.pose.x, &ref.pose.y, &ref.pose.theta, &ref.v, &ref.omega,
-                         &ref.v_dot,  &pose.x,     &pose.y,         &v,     &omega};
+      double* slots[] = {&ref.pose.x,    &ref.pose.y, &ref.pose.theta, &ref.v,      &ref.omega, &ref.v_dot,
+                         &ref.omega_dot, &pose.x,     &pose.y,         &pose.theta, &v,         &omega};
       *slots[field] = bad;
       const VelocityCommand c = rpp.compute(ref, pose, v, omega);
       EXPECT_EQ(c.v, 0.0) << field;
