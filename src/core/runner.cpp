@@ -9,27 +9,38 @@ namespace sowing_robot {
 namespace core {
 
 std::string Scenario::validate() const {
-  std::string e =
-      firstError({checkPositive("duration", duration, "s"), control_period_ns > 0 ? "" : "control_period must be > 0",
-                  allFinite(start.x, start.y, start.theta) ? "" : "start pose must be finite", robot.validate(),
-                  disturbance.validate(), kanayama.validate(), sliding.validate()});
+  std::string e = firstError(
+      {checkPositive("duration", duration, "s"), control_period_ns > 0 ? "" : "control_period must be > 0",
+       allFinite(start.x, start.y, start.theta) ? "" : "start pose must be finite",
+       std::isfinite(disturbance_phase) ? "" : "disturbance_phase must be finite", robot.validate(),
+       disturbance.validate(), kanayama.validate(), sliding.validate(),
+       outer == OuterKind::kanayama ? "" : pure_pursuit.validate(), inner == InnerKind::pid ? pid.validate() : ""});
   return e;
+}
+
+std::string Scenario::controllerName() const {
+  return std::string(outerName(outer)) + "+" + innerName(inner, sliding.adaptive);
 }
 
 std::int64_t Scenario::steps() const {
   return static_cast<std::int64_t>(std::llround(duration * 1e9 / static_cast<double>(control_period_ns)));
 }
 
-RunResult runClosedLoop(const Scenario& sc, ReferenceSource& reference, bool keep_samples,
-                        const std::function<void(const LoopSample&)>& trace, const RunStop& stop) {
+namespace {
+
+// The loop body, over concrete controller types (no virtual call when they are final or plain
+// classes): Outer::compute(ref, pose, v, omega) -> VelocityCommand; Inner::update(cmd, v, omega, dt) ->
+// InnerOutput, m0Hat(), i0Hat().
+template <typename Outer, typename Inner>
+RunResult loop(const Scenario& sc, ReferenceSource& reference, Outer& outer, Inner& inner, bool keep_samples,
+               const std::function<void(const LoopSample&)>& trace, const RunStop& stop) {
   Plant plant(sc.robot, sc.disturbance);
   State x0 = State::Zero();
   x0[X] = sc.start.x;
   x0[Y] = sc.start.y;
   x0[THETA] = sc.start.theta;
-  plant.reset(x0, 0.0);
-  Kanayama kanayama(sc.kanayama);
-  SlidingModeController smc(sc.sliding, sc.robot);
+  const bool phased = sc.disturbance_phase != 0.0 && sc.disturbance.frequency > 0.0;
+  plant.reset(x0, phased ? sc.disturbance_phase / sc.disturbance.frequency : 0.0);
   reference.reset();
   const std::int64_t n = sc.steps();
   const double dt = secondsFromNanos(sc.control_period_ns);
@@ -50,10 +61,10 @@ RunResult runClosedLoop(const Scenario& sc, ReferenceSource& reference, bool kee
     double ex, ey, eth;
     worldErrors(ref, pose, ex, ey, eth);
     metrics.add(t, ex, ey, eth);
-    const VelocityCommand cmd = kanayama.compute(ref, pose, s[V], s[OMEGA]);
-    const SlidingModeOutput u = smc.update(cmd, s[V], s[OMEGA], dt);
+    const VelocityCommand cmd = outer.compute(ref, pose, s[V], s[OMEGA]);
+    const InnerOutput u = inner.update(cmd, s[V], s[OMEGA], dt);
     if (u.saturated) ++result.saturated_steps;
-    if (trace) trace({t, &s, &ref, &cmd, &u, smc.m0Hat(), smc.i0Hat(), ex, ey, eth});
+    if (trace) trace({t, &s, &ref, &cmd, &u, inner.m0Hat(), inner.i0Hat(), ex, ey, eth});
     result.periods = k;
     if (stop && k % kStopCheckEvery == kStopCheckEvery - 1 && k < n && stop(metrics)) {
       result.stopped = true;
@@ -68,6 +79,46 @@ RunResult runClosedLoop(const Scenario& sc, ReferenceSource& reference, bool kee
     for (auto& m : result.metrics) m.ise = m.itse = m.iae = m.itae = inf;
   }
   return result;
+}
+
+template <typename Outer>
+RunResult withInner(const Scenario& sc, ReferenceSource& reference, Outer& outer, bool keep_samples,
+                    const std::function<void(const LoopSample&)>& trace, const RunStop& stop) {
+  if (sc.inner == InnerKind::pid) {
+    InnerAdapter<WheelPid> pid{WheelPid(sc.pid, sc.robot)};
+    return loop(sc, reference, outer, pid, keep_samples, trace, stop);
+  }
+  SlidingModeController smc(sc.sliding, sc.robot);
+  return loop(sc, reference, outer, smc, keep_samples, trace, stop);
+}
+
+}  // namespace
+
+RunResult runClosedLoop(const Scenario& sc, ReferenceSource& reference, bool keep_samples,
+                        const std::function<void(const LoopSample&)>& trace, const RunStop& stop) {
+  if (sc.outer == OuterKind::kanayama) {
+    Kanayama kanayama(sc.kanayama);
+    return withInner(sc, reference, kanayama, keep_samples, trace, stop);
+  }
+  PurePursuit pursuit(sc.pure_pursuit, sc.outer == OuterKind::rpp);
+  return withInner(sc, reference, pursuit, keep_samples, trace, stop);
+}
+
+RunResult runClosedLoop(const Scenario& sc, ReferenceSource& reference, OuterController& outer, InnerController& inner,
+                        bool keep_samples, const std::function<void(const LoopSample&)>& trace, const RunStop& stop) {
+  outer.reset();
+  inner.reset();
+  return loop(sc, reference, outer, inner, keep_samples, trace, stop);
+}
+
+std::unique_ptr<OuterController> makeOuterController(const Scenario& sc) {
+  if (sc.outer == OuterKind::kanayama) return std::make_unique<OuterAdapter<Kanayama>>(Kanayama(sc.kanayama));
+  return std::make_unique<OuterAdapter<PurePursuit>>(PurePursuit(sc.pure_pursuit, sc.outer == OuterKind::rpp));
+}
+
+std::unique_ptr<InnerController> makeInnerController(const Scenario& sc) {
+  if (sc.inner == InnerKind::pid) return std::make_unique<InnerAdapter<WheelPid>>(WheelPid(sc.pid, sc.robot));
+  return std::make_unique<InnerAdapter<SlidingModeController>>(SlidingModeController(sc.sliding, sc.robot));
 }
 
 }  // namespace core

@@ -1,13 +1,17 @@
-// In-process closed loop: plant + Kanayama + sliding-mode controller + reference, stepped exactly as
-// the node pipeline steps them in lockstep (same order, same times, same yaw round trip), so the two
-// give the same numbers. Used by tests, the metrics tool and the PSO tuner.
+// In-process closed loop: plant + outer controller (Kanayama by default) + inner controller (the
+// sliding-mode controller by default) + reference, stepped exactly as the node pipeline steps them in
+// lockstep (same order, same times, same yaw round trip), so the two give the same numbers. Used by
+// tests, the metrics tool and the PSO tuner. The baselines (pure pursuit, RPP, wheel PID) are chosen by
+// Scenario::outer / inner (controllers.h).
 #pragma once
 
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 
+#include "sowing_robot/core/controllers.h"
 #include "sowing_robot/core/kanayama.h"
 #include "sowing_robot/core/metrics.h"
 #include "sowing_robot/core/plant.h"
@@ -23,8 +27,18 @@ struct Scenario {
   Pose2D start{-1.0, 0.0, 0.0};              ///< initial posture of the axle midpoint
   RobotParams robot;                         ///< nominal parameters (the controllers' model)
   PlantDisturbance disturbance;              ///< what the plant adds (disturbance, noise, mismatch)
+  /// Phase of the sinusoidal disturbance [rad]: the plant's clock starts at phase / frequency (the
+  /// disturbance is its only user). 0: the thesis's (and the nodes') zero phase.
+  double disturbance_phase = 0.0;
   KanayamaGains kanayama;
   SlidingModeParams sliding;
+  OuterKind outer = OuterKind::kanayama;      ///< which outer controller runClosedLoop builds
+  InnerKind inner = InnerKind::sliding_mode;  ///< which inner controller (atsmc/tsmc: sliding.adaptive)
+  PurePursuitParams pure_pursuit;             ///< outer = pure_pursuit or rpp
+  WheelPidParams pid;                         ///< inner = pid
+
+  /// "kanayama+atsmc", "rpp+pid", ...
+  std::string controllerName() const;
 
   std::string validate() const;
   /// Number of control periods; states are evaluated at k = 0..steps() inclusive.
@@ -37,9 +51,9 @@ struct LoopSample {
   const State* state;
   const Reference* reference;
   const VelocityCommand* desired;
-  const SlidingModeOutput* control;
-  double m0_hat, i0_hat;
-  double ex, ey, etheta;  ///< world-frame errors
+  const InnerOutput* control;  ///< for a PID inner: see InnerOutput (s_v = s_omega = 0)
+  double m0_hat, i0_hat;       ///< a non-adaptive inner reports its fixed model values
+  double ex, ey, etheta;       ///< world-frame errors
 };
 
 struct RunResult {
@@ -61,6 +75,17 @@ constexpr std::int64_t kStopCheckEvery = 256;
 /// on the time-domain figures (rise/settling/overshoot).
 RunResult runClosedLoop(const Scenario& scenario, ReferenceSource& reference, bool keep_samples = true,
                         const std::function<void(const LoopSample&)>& trace = {}, const RunStop& stop = {});
+
+/// The same loop with caller-built controllers behind the run-time interfaces (virtual calls; the
+/// Scenario's outer/inner choice and gains are then ignored, its plant, timing and start are used).
+RunResult runClosedLoop(const Scenario& scenario, ReferenceSource& reference, OuterController& outer,
+                        InnerController& inner, bool keep_samples = true,
+                        const std::function<void(const LoopSample&)>& trace = {}, const RunStop& stop = {});
+
+/// The scenario's outer / inner controller behind the run-time interfaces. Throws std::invalid_argument
+/// when its parameters do not validate.
+std::unique_ptr<OuterController> makeOuterController(const Scenario& scenario);
+std::unique_ptr<InnerController> makeInnerController(const Scenario& scenario);
 
 /// World-frame errors (reference minus actual, theta wrapped).
 inline void worldErrors(const Reference& r, const Pose2D& a, double& ex, double& ey, double& eth) {

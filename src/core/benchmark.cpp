@@ -1,0 +1,274 @@
+#include "sowing_robot/core/benchmark.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <memory>
+#include <mutex>
+#include <stdexcept>
+#include <thread>
+
+#include "sowing_robot/core/validation.h"
+
+namespace sowing_robot {
+namespace core {
+
+namespace {
+
+std::uint64_t splitmix64(std::uint64_t x) {
+  x += 0x9e3779b97f4a7c15ULL;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
+  return x ^ (x >> 31);
+}
+
+/// Draw k of run `index`, in [0, 1) with 53 bits.
+double unit(std::uint64_t base_seed, std::int64_t index, int k) {
+  const std::uint64_t run = splitmix64(splitmix64(base_seed) + static_cast<std::uint64_t>(index));
+  return static_cast<double>(splitmix64(run + static_cast<std::uint64_t>(k)) >> 11) * 0x1.0p-53;
+}
+
+std::string checkUniform(const char* name, const Uniform& u) {
+  if (!allFinite(u.lo, u.hi)) return std::string(name) + " bounds must be finite";
+  if (u.lo > u.hi) return std::string(name) + ": lo " + formatNumber(u.lo) + " > hi " + formatNumber(u.hi);
+  return "";
+}
+
+std::string number(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+std::string shortNumber(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.4g", v);
+  return buf;
+}
+
+/// Lateral error in the reference's frame (cross-track for a line or a row).
+double crossTrack(const LoopSample& s) {
+  const double th = s.reference->pose.theta;
+  return -std::sin(th) * s.ex + std::cos(th) * s.ey;
+}
+
+RunRow runOne(const Scenario& base, ReferenceSource& reference, const MonteCarloSpec& spec, std::int64_t index) {
+  RunRow row;
+  row.draw = drawRun(spec, base, index);
+  const Scenario sc = applyDraw(base, spec, row.draw);
+  const double dt = secondsFromNanos(sc.control_period_ns);
+  std::int64_t count = 0;
+  WheelTorques prev, prev2;
+  double worst = 0.0, last = 0.0;
+  const RunResult r = runClosedLoop(sc, reference, true, [&](const LoopSample& s) {
+    // A period's torque is applied over the next dt: count it when the next sample arrives, so the
+    // last one (never applied) is left out of the effort and of the total variation.
+    if (count >= 1) row.effort += dt * (prev.right * prev.right + prev.left * prev.left);
+    if (count >= 2) row.chattering += std::fabs(prev.right - prev2.right) + std::fabs(prev.left - prev2.left);
+    prev2 = prev;
+    prev = s.control->torques;
+    ++count;
+    last = std::fabs(crossTrack(s));
+    if (s.t >= spec.settle_time) worst = std::max(worst, last);
+  });
+  row.metrics = r.metrics;
+  row.time_at_limit = dt * static_cast<double>(r.saturated_steps);
+  row.worst_cross_track = worst;
+  row.final_cross_track = last;
+  row.diverged = r.diverged;
+  if (r.diverged) {
+    const double inf = std::numeric_limits<double>::infinity();
+    row.effort = row.chattering = row.worst_cross_track = row.final_cross_track = inf;
+    row.failure = "diverged";
+  } else if (!(worst < spec.cross_track_threshold)) {
+    row.failure = "cross-track";
+  }
+  row.success = row.failure.empty();
+  return row;
+}
+
+}  // namespace
+
+std::string MonteCarloSpec::validate() const {
+  std::string e = firstError(
+      {checkUniform("mass_scale", mass_scale), checkUniform("inertia_scale", inertia_scale),
+       checkUniform("amplitude", amplitude), checkUniform("phase", phase), checkUniform("start_dx", start_dx),
+       checkUniform("start_dy", start_dy), checkUniform("start_dtheta", start_dtheta),
+       checkNonNegative("noise_std", noise_std, "N·m"), checkNonNegative("settle_time", settle_time, "s"),
+       checkPositive("cross_track_threshold", cross_track_threshold, "m")});
+  if (e.empty() && !(mass_scale.lo > 0.0 && inertia_scale.lo > 0.0)) e = "mass_scale and inertia_scale must be > 0";
+  if (e.empty() && amplitude.lo < 0.0) e = "amplitude must be >= 0";
+  return e;
+}
+
+RunDraw drawRun(const MonteCarloSpec& spec, const Scenario& base, std::int64_t index) {
+  const std::uint64_t s = spec.base_seed;
+  RunDraw d;
+  d.index = index;
+  d.mass_scale = spec.mass_scale.at(unit(s, index, 0));
+  d.inertia_scale = spec.inertia_scale.at(unit(s, index, 1));
+  d.amplitude = spec.amplitude.at(unit(s, index, 2));
+  d.phase = spec.phase.at(unit(s, index, 3));
+  d.noise_seed = splitmix64(splitmix64(splitmix64(s) + static_cast<std::uint64_t>(index)) + 4) >>
+                 33;  // noise/seed is an int parameter
+  d.start_x = base.start.x + spec.start_dx.at(unit(s, index, 5));
+  d.start_y = base.start.y + spec.start_dy.at(unit(s, index, 6));
+  d.start_theta = wrapAngle(base.start.theta + spec.start_dtheta.at(unit(s, index, 7)));
+  return d;
+}
+
+Scenario applyDraw(const Scenario& base, const MonteCarloSpec& spec, const RunDraw& d) {
+  Scenario sc = base;
+  sc.disturbance.mass_scale = d.mass_scale;
+  sc.disturbance.inertia_scale = d.inertia_scale;
+  sc.disturbance.sinusoidal = d.amplitude > 0.0;
+  sc.disturbance.amplitude = d.amplitude;
+  sc.disturbance_phase = d.phase;
+  sc.disturbance.noise_std = spec.noise_std;
+  sc.disturbance.seed = d.noise_seed;
+  sc.start = {d.start_x, d.start_y, d.start_theta};
+  return sc;
+}
+
+std::vector<RunRow> runMonteCarlo(const Scenario& base, const ReferenceSource& reference, const MonteCarloSpec& spec,
+                                  std::int64_t runs, int threads, const std::function<void(std::int64_t)>& progress) {
+  if (runs < 1) throw std::invalid_argument("the number of runs (seeds) must be >= 1, not " + std::to_string(runs));
+  std::string e = firstError({spec.validate(), base.validate()});
+  if (!e.empty()) throw std::invalid_argument(e);
+  // Every drawn scenario must validate too (e.g. a mismatch outside the plant's range).
+  for (std::int64_t i = 0; i < runs && e.empty(); ++i) e = applyDraw(base, spec, drawRun(spec, base, i)).validate();
+  if (!e.empty()) throw std::invalid_argument("a drawn run does not validate: " + e);
+  if (threads <= 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  threads = static_cast<int>(std::min<std::int64_t>(threads, runs));
+
+  std::vector<RunRow> rows(static_cast<std::size_t>(runs));
+  std::atomic<std::int64_t> next{0};
+  std::int64_t done = 0;
+  std::mutex progress_mutex;
+  std::exception_ptr failure;
+  std::mutex failure_mutex;
+  auto worker = [&]() {
+    try {
+      std::unique_ptr<ReferenceSource> ref = reference.clone();
+      for (std::int64_t i = next++; i < runs; i = next++) {
+        rows[static_cast<std::size_t>(i)] = runOne(base, *ref, spec, i);
+        if (progress) {
+          std::lock_guard<std::mutex> lock(progress_mutex);
+          progress(++done);
+        }
+      }
+    } catch (...) {
+      std::lock_guard<std::mutex> lock(failure_mutex);
+      if (!failure) failure = std::current_exception();
+      next = runs;  // the others stop after their current run
+    }
+  };
+  if (threads == 1) {
+    worker();
+  } else {
+    std::vector<std::thread> pool;
+    for (int t = 0; t < threads; ++t) pool.emplace_back(worker);
+    for (auto& t : pool) t.join();
+  }
+  if (failure) std::rethrow_exception(failure);
+  return rows;
+}
+
+Statistic statistic(std::vector<double> v) {
+  Statistic s;
+  v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return std::isnan(x); }), v.end());
+  if (v.empty()) {
+    s.mean = s.std = s.p95 = s.worst = std::numeric_limits<double>::quiet_NaN();
+    return s;
+  }
+  const double inf = std::numeric_limits<double>::infinity();
+  std::sort(v.begin(), v.end());
+  s.worst = v.back();
+  s.p95 = v[static_cast<std::size_t>(std::ceil(0.95 * static_cast<double>(v.size()))) - 1];  // nearest rank
+  for (double x : v)
+    if (!std::isfinite(x)) {
+      s.mean = s.std = inf;
+      return s;
+    }
+  double sum = 0.0;
+  for (double x : v) sum += x;
+  s.mean = sum / static_cast<double>(v.size());
+  double sq = 0.0;
+  for (double x : v) sq += (x - s.mean) * (x - s.mean);
+  s.std = v.size() > 1 ? std::sqrt(sq / static_cast<double>(v.size() - 1)) : 0.0;
+  return s;
+}
+
+const std::vector<std::string>& metricColumns() {
+  static const std::vector<std::string> columns = [] {
+    std::vector<std::string> c;
+    for (const char* axis : {"x", "y", "theta"})
+      for (const char* m : {"ise", "itse", "iae", "itae", "rise_time", "settling_time", "overshoot"})
+        c.push_back(std::string(m) + "_" + axis);
+    for (const char* m : {"effort", "chattering", "time_at_limit", "worst_cross_track", "final_cross_track"})
+      c.push_back(m);
+    return c;
+  }();
+  return columns;
+}
+
+std::vector<double> metricValues(const RunRow& r) {
+  std::vector<double> v;
+  v.reserve(metricColumns().size());
+  for (const AxisMetrics& m : r.metrics)
+    for (double x : {m.ise, m.itse, m.iae, m.itae, m.rise_time, m.settling_time, m.overshoot}) v.push_back(x);
+  for (double x : {r.effort, r.chattering, r.time_at_limit, r.worst_cross_track, r.final_cross_track}) v.push_back(x);
+  return v;
+}
+
+std::string runsCsvHeader() {
+  std::string h =
+      "scenario,controller,seed,mass_scale,inertia_scale,amplitude,phase,noise_seed,start_x,start_y,start_theta";
+  for (const auto& c : metricColumns()) h += "," + c;
+  return h + ",diverged,success,failure\n";
+}
+
+std::string runsCsvLines(const std::string& scenario, const std::string& controller, const std::vector<RunRow>& rows) {
+  std::string out;
+  for (const RunRow& r : rows) {
+    const RunDraw& d = r.draw;
+    out += scenario + "," + controller + "," + std::to_string(d.index) + "," + number(d.mass_scale) + "," +
+           number(d.inertia_scale) + "," + number(d.amplitude) + "," + number(d.phase) + "," +
+           std::to_string(d.noise_seed) + "," + number(d.start_x) + "," + number(d.start_y) + "," +
+           number(d.start_theta);
+    for (double x : metricValues(r)) out += "," + number(x);
+    out += std::string(",") + (r.diverged ? "1" : "0") + "," + (r.success ? "1" : "0") + "," + r.failure + "\n";
+  }
+  return out;
+}
+
+std::string reportSection(const std::string& scenario, const std::string& controller, const std::vector<RunRow>& rows) {
+  std::int64_t ok = 0, diverged = 0, cross = 0;
+  for (const RunRow& r : rows) {
+    ok += r.success;
+    diverged += r.failure == "diverged";
+    cross += r.failure == "cross-track";
+  }
+  std::string out = "## " + scenario + " / " + controller + "\n\n";
+  out += "runs " + std::to_string(rows.size()) + ", success " + std::to_string(ok) + " (" +
+         shortNumber(rows.empty() ? 0.0 : 100.0 * static_cast<double>(ok) / static_cast<double>(rows.size())) +
+         " %); failures: diverged " + std::to_string(diverged) + ", cross-track " + std::to_string(cross) + "\n\n";
+  out += "| metric | mean | std | p95 | worst |\n|---|---:|---:|---:|---:|\n";
+  const auto& cols = metricColumns();
+  std::vector<std::vector<double>> values(cols.size());
+  for (const RunRow& r : rows) {
+    const std::vector<double> v = metricValues(r);
+    for (std::size_t c = 0; c < cols.size(); ++c) values[c].push_back(v[c]);
+  }
+  for (std::size_t c = 0; c < cols.size(); ++c) {
+    const Statistic s = statistic(values[c]);
+    out += "| " + cols[c] + " | " + shortNumber(s.mean) + " | " + shortNumber(s.std) + " | " + shortNumber(s.p95) +
+           " | " + shortNumber(s.worst) + " |\n";
+  }
+  return out + "\n";
+}
+
+}  // namespace core
+}  // namespace sowing_robot

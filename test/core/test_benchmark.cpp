@@ -1,0 +1,133 @@
+// Monte-Carlo runner (core/benchmark.h): seed-indexed draws, rows independent of the thread count,
+// failures counted with their reason, statistics.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <vector>
+
+#include "sowing_robot/core/benchmark.h"
+
+using namespace sowing_robot::core;
+
+namespace {
+Scenario shortLine(const char* pair) {
+  Scenario sc;
+  sc.duration = 4.0;
+  EXPECT_EQ(parseControllerPair(pair, sc.outer, sc.inner, sc.sliding.adaptive), "");
+  return sc;
+}
+MonteCarloSpec shortSpec() {
+  MonteCarloSpec spec;
+  spec.settle_time = 3.0;
+  spec.cross_track_threshold = 10.0;  // judged on divergence only here
+  return spec;
+}
+void expectSameRows(const std::vector<RunRow>& a, const std::vector<RunRow>& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].draw.mass_scale, b[i].draw.mass_scale) << i;
+    EXPECT_EQ(a[i].draw.noise_seed, b[i].draw.noise_seed) << i;
+    EXPECT_EQ(a[i].draw.start_theta, b[i].draw.start_theta) << i;
+    const std::vector<double> va = metricValues(a[i]), vb = metricValues(b[i]);
+    ASSERT_EQ(va.size(), vb.size());
+    for (std::size_t c = 0; c < va.size(); ++c)
+      if (!(std::isnan(va[c]) && std::isnan(vb[c]))) EXPECT_EQ(va[c], vb[c]) << i << " " << metricColumns()[c];
+    EXPECT_EQ(a[i].success, b[i].success) << i;
+  }
+}
+}  // namespace
+
+TEST(Benchmark, OneAndTwoThreadsGiveIdenticalRows) {
+  for (const char* pair : {"kanayama+atsmc", "rpp+pid"}) {
+    const Scenario sc = shortLine(pair);
+    LineReference line;
+    const std::vector<RunRow> one = runMonteCarlo(sc, line, shortSpec(), 6, 1);
+    const std::vector<RunRow> two = runMonteCarlo(sc, line, shortSpec(), 6, 2);
+    expectSameRows(one, two);
+    EXPECT_EQ(runsCsvLines("thesis_line", pair, one), runsCsvLines("thesis_line", pair, two));
+  }
+}
+
+TEST(Benchmark, ARunDependsOnItsSeedOnlyAndCanBeRepeatedAlone) {
+  const Scenario sc = shortLine("kanayama+atsmc");
+  LineReference line;
+  const std::vector<RunRow> rows = runMonteCarlo(sc, line, shortSpec(), 4, 2);
+  // Run 3 again, alone, from its draw.
+  const Scenario again = applyDraw(sc, shortSpec(), rows[3].draw);
+  const RunResult r = runClosedLoop(again, line);
+  EXPECT_EQ(r.metrics[AXIS_Y].itae, rows[3].metrics[AXIS_Y].itae);
+  // Different seeds draw differently, within the stated bounds.
+  EXPECT_NE(rows[0].draw.mass_scale, rows[1].draw.mass_scale);
+  const MonteCarloSpec spec = shortSpec();
+  for (const RunRow& row : rows) {
+    EXPECT_GE(row.draw.mass_scale, spec.mass_scale.lo);
+    EXPECT_LE(row.draw.mass_scale, spec.mass_scale.hi);
+    EXPECT_GE(row.draw.amplitude, spec.amplitude.lo);
+    EXPECT_LE(row.draw.amplitude, spec.amplitude.hi);
+    EXPECT_GE(row.draw.start_x, sc.start.x + spec.start_dx.lo);
+    EXPECT_LE(row.draw.start_x, sc.start.x + spec.start_dx.hi);
+    EXPECT_GT(row.effort, 0.0);
+    EXPECT_GT(row.chattering, 0.0);
+  }
+  // The draws do not depend on how many runs are asked for.
+  EXPECT_EQ(drawRun(spec, sc, 3).phase, rows[3].draw.phase);
+}
+
+TEST(Benchmark, AFailedRunIsCountedWithItsReason) {
+  Scenario sc = shortLine("kanayama+atsmc");
+  LineReference line;
+  MonteCarloSpec spec = shortSpec();
+  spec.cross_track_threshold = 1e-9;  // nobody is that good
+  const std::vector<RunRow> rows = runMonteCarlo(sc, line, spec, 3, 1);
+  for (const RunRow& r : rows) {
+    EXPECT_FALSE(r.success);
+    EXPECT_EQ(r.failure, "cross-track");
+  }
+  EXPECT_NE(reportSection("thesis_line", "kanayama+atsmc", rows).find("success 0 (0 %)"), std::string::npos);
+}
+
+TEST(Benchmark, TheDisturbancePhaseShiftsThePlantsClock) {
+  Scenario sc = shortLine("kanayama+atsmc");
+  sc.disturbance.sinusoidal = true;
+  LineReference line;
+  const RunResult zero = runClosedLoop(sc, line, false);
+  sc.disturbance_phase = 1.0;
+  const RunResult shifted = runClosedLoop(sc, line, false);
+  EXPECT_NE(zero.final_state, shifted.final_state);
+  sc.disturbance_phase = 2.0 * M_PI;  // a whole period: the same disturbance up to rounding
+  const RunResult whole = runClosedLoop(sc, line, false);
+  EXPECT_NEAR(whole.final_state[Y], zero.final_state[Y], 1e-6);
+}
+
+TEST(Benchmark, BadRequestsAreRefusedNamingWhy) {
+  const Scenario sc = shortLine("kanayama+atsmc");
+  LineReference line;
+  EXPECT_THROW(runMonteCarlo(sc, line, shortSpec(), 0, 1), std::invalid_argument);
+  MonteCarloSpec spec = shortSpec();
+  spec.mass_scale = {1.5, 0.8};
+  try {
+    runMonteCarlo(sc, line, spec, 2, 1);
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("mass_scale"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Benchmark, StatisticsCountDivergedRunsAndSkipMissingFigures) {
+  const double inf = std::numeric_limits<double>::infinity(), nan = std::numeric_limits<double>::quiet_NaN();
+  Statistic s = statistic({1.0, 2.0, 3.0, 4.0});
+  EXPECT_DOUBLE_EQ(s.mean, 2.5);
+  EXPECT_DOUBLE_EQ(s.std, std::sqrt(5.0 / 3.0));
+  EXPECT_DOUBLE_EQ(s.p95, 4.0);
+  EXPECT_DOUBLE_EQ(s.worst, 4.0);
+  s = statistic({1.0, inf});
+  EXPECT_EQ(s.mean, inf);
+  EXPECT_EQ(s.worst, inf);
+  s = statistic({1.0, nan, 3.0});
+  EXPECT_DOUBLE_EQ(s.mean, 2.0);
+  std::vector<double> hundred;
+  for (int i = 1; i <= 100; ++i) hundred.push_back(i);
+  EXPECT_DOUBLE_EQ(statistic(hundred).p95, 95.0);
+}
