@@ -16,7 +16,7 @@ namespace {
 constexpr std::size_t kChunk = 1000;  // seeds per marker: rviz keeps every chunk, we resend only the last
 }
 
-SeedDrillNode::SeedDrillNode(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh) {
+SeedDrillNode::SeedDrillNode(ros::NodeHandle nh, ros::NodeHandle pnh) {
   ParamReader p(pnh);
   const core::RunSettings run = loadRunSettings(nh, p);
   loadTable(p, core::SeedDrillSettings::table(), settings_);
@@ -46,8 +46,13 @@ SeedDrillNode::SeedDrillNode(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh) 
   chunk_.color.a = 1.0f;
   seeds_pub_ = nh.advertise<visualization_msgs::MarkerArray>("seeds", 10);
   report_pub_ = nh.advertise<std_msgs::Float64MultiArray>("seed_report", 1, true);
-  // The state is followed only once there is a plan to score it against (latched: it comes at once).
+  // Subscribed here, not from the plan's callback: a subscription made from a callback of the shared
+  // nodelet thread while the plant publishes odom hung a nodelet run (1 in ~10 under load). States that
+  // come before the first plan (latched: it comes at once) are not scored (the robot is still at rest).
   plan_sub_ = nh.subscribe("plan", 1, &SeedDrillNode::planCallback, this);
+  const auto hints = ros::TransportHints().tcpNoDelay();
+  odom_sub_ = nh.subscribe("odom", kLockstepQueue, &SeedDrillNode::odomCallback, this, hints);
+  ref_sub_ = nh.subscribe("reference", kLockstepQueue, &SeedDrillNode::referenceCallback, this, hints);
 }
 
 void SeedDrillNode::planCallback(const FieldPlan::ConstPtr& msg) {
@@ -67,9 +72,6 @@ void SeedDrillNode::planCallback(const FieldPlan::ConstPtr& msg) {
   drill_ = std::make_unique<core::SeedDrill>(settings_.seeding, std::move(rows), std::move(obstacles),
                                              msg->influence_distance);
   ROS_INFO("seed_drill: plan of %zu row(s), %zu obstacle(s): sowing", n, msg->obstacle_radii.size());
-  const auto hints = ros::TransportHints().tcpNoDelay();
-  odom_sub_ = nh_.subscribe("odom", kLockstepQueue, &SeedDrillNode::odomCallback, this, hints);
-  ref_sub_ = nh_.subscribe("reference", kLockstepQueue, &SeedDrillNode::referenceCallback, this, hints);
   publishReport();
 }
 
@@ -80,11 +82,12 @@ SeedDrillNode::~SeedDrillNode() {
 }
 
 void SeedDrillNode::odomCallback(const nav_msgs::Odometry::ConstPtr& msg) {
-  if (!odomIsFinite(*msg)) return;
+  if (!drill_ || !odomIsFinite(*msg)) return;
   if (inputs_.setFirst(*msg)) update(inputs_.first(), inputs_.second().tool_down);
 }
 
 void SeedDrillNode::referenceCallback(const ReferenceState::ConstPtr& msg) {
+  if (!drill_) return;
   if (inputs_.setSecond(*msg)) update(inputs_.first(), inputs_.second().tool_down);
 }
 

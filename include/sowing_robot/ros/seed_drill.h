@@ -33,7 +33,6 @@ class SeedDrillNode {
   void update(const nav_msgs::Odometry& odom, bool tool_down);
   void publishReport();
 
-  ros::NodeHandle nh_;
   core::SeedDrillSettings settings_;
   std::unique_ptr<core::SeedDrill> drill_;                ///< null until the first plan
   double tool_x_ = 0.0, tool_y_ = 0.0;                    // tool point in base_link [m]
