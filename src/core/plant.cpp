@@ -4,34 +4,12 @@
 #include <limits>
 #include <stdexcept>
 
+#include "sowing_robot/core/rotation.h"
 #include "sowing_robot/core/types.h"
 #include "sowing_robot/core/validation.h"
 
 namespace sowing_robot {
 namespace core {
-namespace {
-
-// cos and sin of (theta + delta) from cos0 = cos(theta), sin0 = sin(theta) by the angle-sum identity.
-// RK4's heading increments are small (delta = h w / 2 or h w: 1e-3 rad at 1 kHz and 2 rad/s), where the
-// Taylor series below are exact to double rounding (first dropped terms delta^9/9! and delta^10/10!,
-// about 1e-16 of the kept ones at |delta| = 0.05); larger increments fall back to the library.
-void rotateHeading(double cos0, double sin0, double delta, double& cos_out, double& sin_out) {
-  double cd, sd;
-  if (std::fabs(delta) <= 0.05) {
-    const double d2 = delta * delta;
-    constexpr double k6 = 1.0 / 6.0, k20 = 1.0 / 20.0, k42 = 1.0 / 42.0;    // 3!, 5!/3!, 7!/5!
-    constexpr double k12 = 1.0 / 12.0, k30 = 1.0 / 30.0, k56 = 1.0 / 56.0;  // 4!/2!, 6!/4!, 8!/6!
-    sd = delta * (1.0 - d2 * k6 * (1.0 - d2 * k20 * (1.0 - d2 * k42)));
-    cd = 1.0 - 0.5 * d2 * (1.0 - d2 * k12 * (1.0 - d2 * k30 * (1.0 - d2 * k56)));
-  } else {
-    cd = std::cos(delta);
-    sd = std::sin(delta);
-  }
-  cos_out = cos0 * cd - sin0 * sd;
-  sin_out = sin0 * cd + cos0 * sd;
-}
-
-}  // namespace
 
 const ParamTable<PlantDisturbance>& disturbanceTable() {
   using D = PlantDisturbance;

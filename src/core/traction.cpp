@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "sowing_robot/core/rotation.h"
 #include "sowing_robot/core/types.h"
 #include "sowing_robot/core/validation.h"
 
@@ -12,22 +13,6 @@ namespace core {
 namespace {
 
 constexpr double kGravity = 9.81;  // [m/s^2]
-
-// cos and sin of (a + delta) from cos(a), sin(a); small increments by their Taylor series (as Plant does:
-// a sub-step turns the heading by ~1e-4 rad), larger ones by the library.
-inline void rotate(double c0, double s0, double delta, double& c_out, double& s_out) {
-  double cd, sd;
-  if (std::fabs(delta) <= 0.05) {
-    const double d2 = delta * delta;
-    sd = delta * (1.0 - d2 / 6.0 * (1.0 - d2 / 20.0 * (1.0 - d2 / 42.0)));
-    cd = 1.0 - 0.5 * d2 * (1.0 - d2 / 12.0 * (1.0 - d2 / 30.0 * (1.0 - d2 / 56.0)));
-  } else {
-    cd = std::cos(delta);
-    sd = std::sin(delta);
-  }
-  c_out = c0 * cd - s0 * sd;
-  s_out = s0 * cd + c0 * sd;
-}
 
 }  // namespace
 
@@ -159,7 +144,7 @@ bool TractionPlant::step(double tau_right, double tau_left, double dt) {
   for (int j = 0; j < n; ++j) {
     substep(tau_right + noise_r + amplitude * dist_s, tau_left + noise_l + amplitude * dist_c, rr_force, rr_moment, h,
             cos_th, sin_th);
-    if (disturbance_.sinusoidal) rotate(dist_c, dist_s, dist_step, dist_c, dist_s);
+    if (disturbance_.sinusoidal) rotateHeading(dist_c, dist_s, dist_step, dist_c, dist_s);
   }
   time_ += dt;
   return true;
@@ -243,7 +228,7 @@ void TractionPlant::substep(double tau_r, double tau_l, double rr_force, double 
   // exact rotation (rate frozen at the sub-step's start) conserves the kinetic energy as the ODE does.
   if (mcd_ != 0.0) {
     double c, sn;
-    rotate(1.0, 0.0, mcd_ * w * h * inv_sqrt_mi_, c, sn);
+    rotateHeading(1.0, 0.0, mcd_ * w * h * inv_sqrt_mi_, c, sn);
     const double a = sqrt_m_ * v1, b = sqrt_i_ * w1;
     v1 = (a * c + b * sn) * inv_sqrt_m_;
     w1 = (b * c - a * sn) * inv_sqrt_i_;
@@ -253,12 +238,12 @@ void TractionPlant::substep(double tau_r, double tau_l, double rr_force, double 
   // Kinematics (eq 3.13) with the mean velocities, heading at the sub-step's midpoint.
   const double dtheta = 0.5 * h * (w + w1);
   double cm, sm;
-  rotate(cos_th, sin_th, 0.5 * dtheta, cm, sm);
+  rotateHeading(cos_th, sin_th, 0.5 * dtheta, cm, sm);
   const double ds = 0.5 * h * (v + v1);
   state_[X] += ds * cm;
   state_[Y] += ds * sm;
   state_[THETA] += dtheta;
-  rotate(cos_th, sin_th, dtheta, cos_th, sin_th);
+  rotateHeading(cos_th, sin_th, dtheta, cos_th, sin_th);
   state_[V] = v1;
   state_[OMEGA] = w1;
   state_[PHI_R] += 0.5 * h * (wheel_rate_[RIGHT] + rate1[RIGHT]);
