@@ -14,6 +14,7 @@
 #include "sowing_robot/WheelTorque.h"
 #include "sowing_robot/core/sliding_mode.h"
 #include "sowing_robot/ros/stamp_pair.h"
+#include "sowing_robot/ros/ready_roster.h"
 
 namespace sowing_robot {
 
@@ -42,6 +43,7 @@ class TorqueController {
   WheelTorque torque_;
   TorqueControllerState state_;
   long rejected_ = 0, saturated_ = 0;
+  ReadyAnnouncer ready_;  // plant_sim waits for it before step 0
 };
 
 }  // namespace sowing_robot
