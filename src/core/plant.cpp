@@ -1,6 +1,7 @@
 #include "sowing_robot/core/plant.h"
 
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <stdexcept>
 
@@ -110,6 +111,18 @@ inline void Plant::disturbanceAt(double t, double& right, double& left) {
 }
 
 bool Plant::step(double tau_right, double tau_left, double dt) {
+  return stepWithHeading(tau_right, tau_left, dt, std::cos(state_[THETA]), std::sin(state_[THETA]));
+}
+
+bool Plant::step(double tau_right, double tau_left, double dt, double theta, double cos_theta, double sin_theta) {
+  // Bit pattern, not ==: -0.0 == 0.0, but their sines differ in sign.
+  if (std::memcmp(&theta, &state_[THETA], sizeof theta) == 0)
+    return stepWithHeading(tau_right, tau_left, dt, cos_theta, sin_theta);
+  return step(tau_right, tau_left, dt);
+}
+
+// cos0, sin0: cos and sin of state_[THETA].
+bool Plant::stepWithHeading(double tau_right, double tau_left, double dt, double cos0, double sin0) {
   if (!allFinite(tau_right, tau_left, dt) || !(dt > 0.0)) return false;
   double noise_r = 0.0, noise_l = 0.0;
   if (disturbance_.noise_std > 0.0) {
@@ -120,7 +133,6 @@ bool Plant::step(double tau_right, double tau_left, double dt) {
   // Stages 2 and 3 share t + h/2, and stage 4's t + h is the next step's stage 1.
   // The heading's cos/sin come from one sincos at the start of the step, turned by each stage's small
   // heading increment (rotateHeading), instead of a sincos per stage.
-  const double cos0 = std::cos(state_[THETA]), sin0 = std::sin(state_[THETA]);
   const double t = time_, h = dt;
   // Each stage's derivative (eq 3.13, 3.54) on plain scalars: the same operations, in the same order, as
   // derivativeWithHeading() on the Eigen state (the RK4 below is Eigen's element-wise evaluation of
