@@ -66,15 +66,17 @@ RunResult loop(const Scenario& sc, ReferenceSource& reference, Outer& outer, Inn
       cos_yaw = std::cos(pose.theta);
       sin_yaw = std::sin(pose.theta);
     }
-    const Reference ref = reference.next(t);
+    const Reference& ref = reference.next(t);  // the source's copy, valid until the next call
     double ex, ey, eth;
     worldErrors(ref, pose, ex, ey, eth);
     metrics.add(t, ex, ey, eth);
-    VelocityCommand cmd;
-    if constexpr (kanayama)
-      cmd = outer.compute(ref, pose, cos_yaw, sin_yaw, s[V], s[OMEGA]);
-    else
-      cmd = outer.compute(ref, pose, s[V], s[OMEGA]);
+    // Initialised from the call (not assigned): the controller writes the command in place.
+    const VelocityCommand cmd = [&] {
+      if constexpr (kanayama)
+        return outer.compute(ref, pose, cos_yaw, sin_yaw, s[V], s[OMEGA]);
+      else
+        return outer.compute(ref, pose, s[V], s[OMEGA]);
+    }();
     const InnerOutput u = inner.update(cmd, s[V], s[OMEGA], dt);
     if (u.saturated) ++result.saturated_steps;
     if (trace) trace({t, &s, &ref, &cmd, &u, inner.m0Hat(), inner.i0Hat(), ex, ey, eth});
