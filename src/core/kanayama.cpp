@@ -1,6 +1,7 @@
 #include "sowing_robot/core/kanayama.h"
 
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 
 #include "sowing_robot/core/validation.h"
@@ -30,18 +31,44 @@ void Kanayama::setGains(const KanayamaGains& g) {
   gains_ = g;
 }
 
-PostureError Kanayama::postureError(const Pose2D& r, const Pose2D& a) {
-  const double c = std::cos(a.theta), s = std::sin(a.theta);
+namespace {
+
+// eq 4.1 with c = cos(a.theta), s = sin(a.theta).
+inline PostureError postureErrorWith(const Pose2D& r, const Pose2D& a, double c, double s) {
   const double dx = r.x - a.x, dy = r.y - a.y;
   return {c * dx + s * dy, -s * dx + c * dy, wrapAngle(r.theta - a.theta)};
 }
 
+bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+}  // namespace
+
+PostureError Kanayama::postureError(const Pose2D& r, const Pose2D& a) {
+  return postureErrorWith(r, a, std::cos(a.theta), std::sin(a.theta));
+}
+
 VelocityCommand Kanayama::compute(const Reference& ref, const Pose2D& actual, double v, double omega) const {
+  return compute(ref, actual, std::cos(actual.theta), std::sin(actual.theta), v, omega);
+}
+
+VelocityCommand Kanayama::compute(const Reference& ref, const Pose2D& actual, double cos_theta, double sin_theta,
+                                  double v, double omega) const {
   if (!allFinite(ref.pose.x, ref.pose.y, ref.pose.theta, ref.v, ref.omega, ref.v_dot, ref.omega_dot, actual.x, actual.y,
                  actual.theta, v, omega))
     return VelocityCommand{};
-  const PostureError e = postureError(ref.pose, actual);
-  const double c = std::cos(e.thetae), s = std::sin(e.thetae);
+  const PostureError e = postureErrorWith(ref.pose, actual, cos_theta, sin_theta);
+  // Along a reference heading of 0 (the thesis line, rows along x) theta_e is exactly -theta, and cos is
+  // even and sin odd to the bit (glibc computes both on |x| and restores the sign; test_kanayama's
+  // CosSinOfANegatedAngleAreTheMirroredOnes holds the library to it): the robot's heading's cos/sin
+  // serve, without a second sincos.
+  double c, s;
+  if (sameBits(e.thetae, -actual.theta)) {
+    c = cos_theta;
+    s = -sin_theta;
+  } else {
+    c = std::cos(e.thetae);
+    s = std::sin(e.thetae);
+  }
   VelocityCommand out;
   out.v = ref.v * c + gains_.kx * e.xe;
   out.omega = ref.omega + ref.v * (gains_.ky * e.ye + gains_.ktheta * s);

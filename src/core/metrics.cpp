@@ -11,17 +11,25 @@
 namespace sowing_robot {
 namespace core {
 
-void MetricsAccumulator::reserve(std::size_t n) {
-  if (!keep_) return;
-  t_.reserve(n);
-  for (auto& v : e_) v.reserve(n);
+void StreamingTimeDomain::result(AxisMetrics& m) const {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  m.rise_time = m.settling_time = nan;
+  m.overshoot = m.peak = 0.0;
+  if (n_ == 0) return;
+  m.peak = peak_;
+  if (!(peak_ > 0.0)) {
+    m.rise_time = m.settling_time = 0.0;
+    return;
+  }
+  m.rise_time = have_t90_ && have_t10_ ? t10_ - t90_ : nan;
+  m.settling_time = settling_;
+  m.overshoot = 100.0 * worst_ / peak_;
 }
 
 void MetricsAccumulator::reset() {
   count_ = rejected_ = 0;
   acc_ = {};
-  t_.clear();
-  for (auto& v : e_) v.clear();
+  for (auto& d : time_domain_) d.reset();
 }
 
 bool MetricsAccumulator::add(double t, double ex, double ey, double etheta) {
@@ -43,17 +51,15 @@ bool MetricsAccumulator::add(double t, double ex, double ey, double etheta) {
   last_t_ = t;
   last_e_ = e;
   ++count_;
-  if (keep_) {
-    t_.push_back(t);
-    for (int a = 0; a < AXIS_COUNT; ++a) e_[a].push_back(e[a]);
-  }
+  if (keep_)
+    for (int a = 0; a < AXIS_COUNT; ++a) time_domain_[a].add(t, e[a]);
   return true;
 }
 
 std::array<AxisMetrics, AXIS_COUNT> MetricsAccumulator::result() const {
   auto r = acc_;
-  if (keep_ && !t_.empty()) {
-    for (int a = 0; a < AXIS_COUNT; ++a) timeDomainMetrics(t_, e_[a], r[a]);
+  if (keep_ && count_ > 0) {
+    for (int a = 0; a < AXIS_COUNT; ++a) time_domain_[a].result(r[a]);
   } else {
     const double nan = std::numeric_limits<double>::quiet_NaN();  // not computed, not zero
     for (auto& m : r) m.rise_time = m.settling_time = m.overshoot = m.peak = nan;
@@ -61,6 +67,8 @@ std::array<AxisMetrics, AXIS_COUNT> MetricsAccumulator::result() const {
   return r;
 }
 
+// The definition over a stored series (the reference StreamingTimeDomain is tested against; the Python
+// module's time_domain_metrics).
 void timeDomainMetrics(const std::vector<double>& t, const std::vector<double>& e, AxisMetrics& m) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   m.rise_time = m.settling_time = nan;

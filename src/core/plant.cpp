@@ -1,6 +1,7 @@
 #include "sowing_robot/core/plant.h"
 
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <stdexcept>
 
@@ -53,24 +54,33 @@ void Plant::reset(const State& initial, double t) {
   cached_disturbance_time_ = std::numeric_limits<double>::quiet_NaN();
 }
 
-void Plant::sinusoidalDisturbance(double t, double& right, double& left) const {
-  if (!disturbance_.sinusoidal) {
+namespace {
+
+// The sinusoid of Fig 5.9. One angle held in a local: writing through right could alias the
+// parameters, which would make the compiler recompute the product and miss fusing sin and cos into one
+// sincos call. A file-local function, so that step() gets it inlined (a member of the shared library
+// is called through its PLT: semantic interposition).
+inline void sinusoid(const PlantDisturbance& d, double t, double& right, double& left) {
+  if (!d.sinusoidal) {
     right = left = 0.0;
     return;
   }
-  // One angle held in a local: writing through right could alias disturbance_, which would make the
-  // compiler recompute the product and miss fusing sin and cos into one sincos call.
-  const double angle = disturbance_.frequency * t, amplitude = disturbance_.amplitude;
+  const double angle = d.frequency * t, amplitude = d.amplitude;
   right = amplitude * std::sin(angle);
   left = amplitude * std::cos(angle);
+}
+
+}  // namespace
+
+void Plant::sinusoidalDisturbance(double t, double& right, double& left) const {
+  sinusoid(disturbance_, t, right, left);
 }
 
 State Plant::derivative(const State& s, double applied_right, double applied_left) const {
   return derivativeWithHeading(s, std::cos(s[THETA]), std::sin(s[THETA]), applied_right, applied_left);
 }
 
-// Inline body of derivative() with cos/sin of the heading supplied, so that step() can evaluate the
-// four RK4 stages without a call through the shared library's PLT per stage.
+// derivative() with cos/sin of the heading supplied (step() writes the same arithmetic out on scalars).
 inline State Plant::derivativeWithHeading(const State& s, double cos_th, double sin_th, double applied_right,
                                           double applied_left) const {
   const double v = s[V], w = s[OMEGA];
@@ -89,11 +99,11 @@ inline State Plant::derivativeWithHeading(const State& s, double cos_th, double 
   return ds;
 }
 
-void Plant::disturbanceAt(double t, double& right, double& left) {
+inline void Plant::disturbanceAt(double t, double& right, double& left) {
   // RK4 asks for three times per step (t, t + h/2 twice, t + h) and the next step starts where this one
   // ended: remembering the last time evaluated halves the sin/cos calls, with bit-identical values.
   if (t != cached_disturbance_time_) {
-    sinusoidalDisturbance(t, cached_disturbance_right_, cached_disturbance_left_);
+    sinusoid(disturbance_, t, cached_disturbance_right_, cached_disturbance_left_);
     cached_disturbance_time_ = t;
   }
   right = cached_disturbance_right_;
@@ -101,6 +111,18 @@ void Plant::disturbanceAt(double t, double& right, double& left) {
 }
 
 bool Plant::step(double tau_right, double tau_left, double dt) {
+  return stepWithHeading(tau_right, tau_left, dt, std::cos(state_[THETA]), std::sin(state_[THETA]));
+}
+
+bool Plant::step(double tau_right, double tau_left, double dt, double theta, double cos_theta, double sin_theta) {
+  // Bit pattern, not ==: -0.0 == 0.0, but their sines differ in sign.
+  if (std::memcmp(&theta, &state_[THETA], sizeof theta) == 0)
+    return stepWithHeading(tau_right, tau_left, dt, cos_theta, sin_theta);
+  return step(tau_right, tau_left, dt);
+}
+
+// cos0, sin0: cos and sin of state_[THETA].
+bool Plant::stepWithHeading(double tau_right, double tau_left, double dt, double cos0, double sin0) {
   if (!allFinite(tau_right, tau_left, dt) || !(dt > 0.0)) return false;
   double noise_r = 0.0, noise_l = 0.0;
   if (disturbance_.noise_std > 0.0) {
@@ -111,19 +133,47 @@ bool Plant::step(double tau_right, double tau_left, double dt) {
   // Stages 2 and 3 share t + h/2, and stage 4's t + h is the next step's stage 1.
   // The heading's cos/sin come from one sincos at the start of the step, turned by each stage's small
   // heading increment (rotateHeading), instead of a sincos per stage.
-  const double cos0 = std::cos(state_[THETA]), sin0 = std::sin(state_[THETA]);
-  auto f = [&](const State& s, double t, double heading_increment) {
-    double dr, dl, c, sn;
-    disturbanceAt(t, dr, dl);
-    rotateHeading(cos0, sin0, heading_increment, c, sn);
-    return derivativeWithHeading(s, c, sn, tau_right + noise_r + dr, tau_left + noise_l + dl);
-  };
   const double t = time_, h = dt;
-  const State k1 = f(state_, t, 0.0);
-  const State k2 = f(state_ + 0.5 * h * k1, t + 0.5 * h, 0.5 * h * k1[THETA]);
-  const State k3 = f(state_ + 0.5 * h * k2, t + 0.5 * h, 0.5 * h * k2[THETA]);
-  const State k4 = f(state_ + h * k3, t + h, h * k3[THETA]);
-  state_ += (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+  // Each stage's derivative (eq 3.13, 3.54) on plain scalars: the same operations, in the same order, as
+  // derivativeWithHeading() on the Eigen state (the RK4 below is Eigen's element-wise evaluation of
+  // s + (h/2) k, written out), without the temporaries. Wheel angles never enter a derivative, so the
+  // stage states only carry x, y, theta, v, omega.
+  const double R = nominal_.R, L = nominal_.L;
+  const double applied_r0 = tau_right + noise_r, applied_l0 = tau_left + noise_l;
+  struct Rates {
+    double x, y, theta, v, omega, phi_r, phi_l;
+  };
+  auto f = [&](double v, double w, double ts, double heading_increment) {
+    double dr, dl, c, sn;
+    disturbanceAt(ts, dr, dl);
+    rotateHeading(cos0, sin0, heading_increment, c, sn);
+    const double applied_right = applied_r0 + dr, applied_left = applied_l0 + dl;
+    const double u1 = applied_right + applied_left, u2 = applied_right - applied_left;
+    Rates k;
+    k.x = v * c;
+    k.y = v * sn;
+    k.theta = w;
+    k.v = (mcd_ * w * w + u1 / R) / m0_;
+    k.omega = (-mcd_ * w * v + L * u2 / R) / i0_;
+    k.phi_r = (v + L * w) / R;
+    k.phi_l = (v - L * w) / R;
+    return k;
+  };
+  const double v0 = state_[V], w0 = state_[OMEGA];
+  const double half = 0.5 * h;
+  const Rates k1 = f(v0, w0, t, 0.0);
+  const Rates k2 = f(v0 + half * k1.v, w0 + half * k1.omega, t + 0.5 * h, 0.5 * h * k1.theta);
+  const Rates k3 = f(v0 + half * k2.v, w0 + half * k2.omega, t + 0.5 * h, 0.5 * h * k2.theta);
+  const Rates k4 = f(v0 + h * k3.v, w0 + h * k3.omega, t + h, h * k3.theta);
+  const double sixth = h / 6.0;
+  auto combine = [sixth](double a, double b, double c, double d) { return sixth * (a + 2.0 * b + 2.0 * c + d); };
+  state_[X] += combine(k1.x, k2.x, k3.x, k4.x);
+  state_[Y] += combine(k1.y, k2.y, k3.y, k4.y);
+  state_[THETA] += combine(k1.theta, k2.theta, k3.theta, k4.theta);
+  state_[V] += combine(k1.v, k2.v, k3.v, k4.v);
+  state_[OMEGA] += combine(k1.omega, k2.omega, k3.omega, k4.omega);
+  state_[PHI_R] += combine(k1.phi_r, k2.phi_r, k3.phi_r, k4.phi_r);
+  state_[PHI_L] += combine(k1.phi_l, k2.phi_l, k3.phi_l, k4.phi_l);
   time_ += dt;
   return true;
 }

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <type_traits>
 
 #include "sowing_robot/core/validation.h"
 
@@ -57,11 +58,25 @@ RunResult loop(const Scenario& sc, ReferenceSource& reference, Outer& outer, Inn
     }
     // What the controllers receive in nav_msgs/Odometry.
     const Pose2D pose{s[X], s[Y], yawThroughQuaternion(s[THETA])};
-    const Reference ref = reference.next(t);
+    // With Kanayama: cos/sin of that yaw, which Kanayama needs, and so does the plant's step when the
+    // quaternion round trip gave the heading back to the bit (about two steps in three): computed once.
+    constexpr bool kanayama = std::is_same_v<Outer, Kanayama>;
+    double cos_yaw = 0.0, sin_yaw = 0.0;
+    if constexpr (kanayama) {
+      cos_yaw = std::cos(pose.theta);
+      sin_yaw = std::sin(pose.theta);
+    }
+    const Reference& ref = reference.next(t);  // the source's copy, valid until the next call
     double ex, ey, eth;
     worldErrors(ref, pose, ex, ey, eth);
     metrics.add(t, ex, ey, eth);
-    const VelocityCommand cmd = outer.compute(ref, pose, s[V], s[OMEGA]);
+    // Initialised from the call (not assigned): the controller writes the command in place.
+    const VelocityCommand cmd = [&] {
+      if constexpr (kanayama)
+        return outer.compute(ref, pose, cos_yaw, sin_yaw, s[V], s[OMEGA]);
+      else
+        return outer.compute(ref, pose, s[V], s[OMEGA]);
+    }();
     const InnerOutput u = inner.update(cmd, s[V], s[OMEGA], dt);
     if (u.saturated) ++result.saturated_steps;
     if (trace) trace({t, &s, &ref, &cmd, &u, inner.m0Hat(), inner.i0Hat(), ex, ey, eth});
@@ -70,7 +85,12 @@ RunResult loop(const Scenario& sc, ReferenceSource& reference, Outer& outer, Inn
       result.stopped = true;
       break;
     }
-    if (k < n) plant.step(u.torques.right, u.torques.left, dt);
+    if (k < n) {
+      if constexpr (kanayama)
+        plant.step(u.torques.right, u.torques.left, dt, pose.theta, cos_yaw, sin_yaw);
+      else
+        plant.step(u.torques.right, u.torques.left, dt);
+    }
   }
   result.final_state = plant.state();
   result.metrics = metrics.result();

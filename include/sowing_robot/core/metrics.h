@@ -2,7 +2,10 @@
 // metrics node and in analyze_bag (through the Python module sowing_robot.core; README lists them).
 #pragma once
 
+#include <algorithm>
 #include <array>
+#include <cmath>
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -24,12 +27,64 @@ struct AxisMetrics {
   double peak = 0.0;           ///< E
 };
 
-/// Accumulates errors sample by sample; integrals use the trapezoidal rule on the sample times.
+/// The time-domain figures of one error series, computed sample by sample in O(1) memory, with the same
+/// comparisons, in the same order, as timeDomainMetrics() makes over the stored series, so both give
+/// bit-identical values (test_metrics: StreamingTimeDomainEqualsTheStoredSeries). Why streaming works:
+/// the peak E only grows, and every figure looks at the samples from the peak on (rise, overshoot), or
+/// at the last sample above 0.02 E, which is the peak itself or a later one; so whenever a new peak
+/// arrives, what was found before it is thrown away and the search starts again at the new peak.
+class StreamingTimeDomain {
+ public:
+  void reset() { *this = StreamingTimeDomain{}; }
+  void add(double t, double e) {
+    const double a = std::fabs(e);
+    if (n_ == 0 || a > peak_) {  // a new (first) peak: the figures start again from here
+      peak_ = a;
+      sign_ = e > 0.0 ? 1.0 : -1.0;
+      have_t90_ = have_t10_ = false;
+      worst_ = 0.0;
+    }
+    if (n_ == 0) settling_ = t;  // no sample above 0.02 E: the first time
+    ++n_;
+    if (!have_t10_) {  // the stored search stops at the first sample <= 0.1 E after the peak
+      if (!have_t90_ && a <= 0.9 * peak_) {
+        t90_ = t;
+        have_t90_ = true;
+      }
+      if (a <= 0.1 * peak_) {
+        t10_ = t;
+        have_t10_ = true;
+      }
+    }
+    worst_ = std::max(worst_, -sign_ * e);
+    // settling: the sample after the last one above 0.02 E (that one itself when it is the last)
+    if (a > 0.02 * peak_) {
+      settling_ = t;
+      after_exceed_ = true;
+    } else if (after_exceed_) {
+      settling_ = t;
+      after_exceed_ = false;
+    }
+  }
+  /// rise_time, settling_time, overshoot and peak of the samples so far (integrals left untouched).
+  void result(AxisMetrics& m) const;
+
+ private:
+  std::size_t n_ = 0;
+  double peak_ = 0.0, sign_ = 1.0, worst_ = 0.0;  // E, the sign of the peak's error, max of -sign e
+  double t90_ = 0.0, t10_ = 0.0, settling_ = 0.0;
+  bool have_t90_ = false, have_t10_ = false, after_exceed_ = false;
+};
+
+/// Accumulates errors sample by sample; integrals use the trapezoidal rule on the sample times. O(1)
+/// memory: the time-domain figures are computed as the samples arrive (StreamingTimeDomain).
 class MetricsAccumulator {
  public:
-  /// keep_samples: store the series for the time-domain figures (allocates; off in the PSO loop).
+  /// keep_samples: compute the time-domain figures too (the name is historical: no sample is stored any
+  /// more; off in the PSO loop, where they are NaN).
   explicit MetricsAccumulator(bool keep_samples = true) : keep_(keep_samples) {}
-  void reserve(std::size_t n);
+  /// Kept for callers that sized the sample store; nothing is stored, so it does nothing.
+  void reserve(std::size_t) {}
   void reset();
   /// One sample at time t [s] of the world-frame errors (x, y [m]; theta [rad]). A sample with a
   /// non-finite value is refused (returns false, counted by rejected()) so that one bad message cannot
@@ -46,8 +101,7 @@ class MetricsAccumulator {
   double last_t_ = 0.0;
   std::array<double, AXIS_COUNT> last_e_{};
   std::array<AxisMetrics, AXIS_COUNT> acc_{};
-  std::vector<double> t_;
-  std::array<std::vector<double>, AXIS_COUNT> e_;
+  std::array<StreamingTimeDomain, AXIS_COUNT> time_domain_{};
 };
 
 /// Time-domain figures of one series (the definitions above).

@@ -23,7 +23,9 @@ class ReferenceSource {
   /// Reference at time t [s]; t never decreases between two calls after reset(). A non-finite t is
   /// rejected: the generator's state is untouched and the previous reference is returned again (the
   /// default Reference, at the origin, before the first one); rejected() counts these.
-  Reference next(double t) {
+  /// The reference returned stays valid (and unchanged) until the next call of next() or reset(): it is
+  /// the source's own copy, so the closed loop does not copy it once more every period.
+  const Reference& next(double t) {
     if (!std::isfinite(t)) {
       ++rejected_;
       return last_;
@@ -60,10 +62,8 @@ class LineReference : public ReferenceSource {
  protected:
   void restart() override {}
   Reference evaluate(double t) override {
-    Reference r;
-    r.pose = {x0_ + v_r_ * t, row_y_, 0.0};
-    r.v = v_r_;
-    return r;
+    // Every field in one initialiser: built in registers, not zeroed on the stack and patched.
+    return Reference{Pose2D{x0_ + v_r_ * t, row_y_, 0.0}, v_r_, 0.0, 0.0, 0.0, true};
   }
 
  private:
