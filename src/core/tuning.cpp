@@ -1,8 +1,8 @@
 #include "sowing_robot/core/tuning.h"
 
 #include <algorithm>
-#include <charconv>
 #include <atomic>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -97,8 +97,8 @@ bool actsInPair(const Scenario& sc, const std::string& key) {
 }
 
 template <typename S>
-void collect(const ParamTable<S>& table, S Scenario::*member, const char* node, const char* prefix,
-             const Scenario& sc, std::vector<GainRef>& out) {
+void collect(const ParamTable<S>& table, S Scenario::*member, const char* node, const char* prefix, const Scenario& sc,
+             std::vector<GainRef>& out) {
   for (const auto& e : table.entries()) {
     if (!e.info.tunable || !actsInPair(sc, e.info.key)) continue;
     GainRef g;
@@ -215,8 +215,7 @@ double getGain(const Scenario& sc, const std::string& name) {
   return findGain(sc, name, g) ? g.get(sc) : std::numeric_limits<double>::quiet_NaN();
 }
 
-std::string setControllerParam(Scenario& sc, const std::string& node, const std::string& key,
-                               const ParamValue& value) {
+std::string setControllerParam(Scenario& sc, const std::string& node, const std::string& key, const ParamValue& value) {
   auto under = [&key](const char* prefix) { return key.rfind(prefix, 0) == 0; };
   if (node == kKinematicNode) {
     if (under(kPurePursuitPrefix))

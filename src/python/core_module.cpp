@@ -270,9 +270,9 @@ py::dict runPy(const std::string& controller, const py::object& params, const py
                std::int64_t control_period_ns, bool disturbance, double mass_scale, double inertia_scale,
                double noise_std, std::uint64_t seed, const std::array<double, 3>& start, double disturbance_phase,
                const std::optional<std::array<double, 3>>& line, bool keep_samples, bool trace) {
-  const Scenario sc = buildScenario(controller, params, gains,
-                                    {duration, control_period_ns, disturbance, mass_scale, inertia_scale, noise_std,
-                                     seed, start, disturbance_phase});
+  const Scenario sc = buildScenario(
+      controller, params, gains,
+      {duration, control_period_ns, disturbance, mass_scale, inertia_scale, noise_std, seed, start, disturbance_phase});
   return runScenario(sc, lineOf(line), keep_samples, trace);
 }
 
@@ -300,9 +300,9 @@ py::dict tunePy(const std::string& controller, const py::object& params, const p
                 bool disturbance, double mass_scale, double inertia_scale, double noise_std, std::uint64_t seed,
                 const std::array<double, 3>& start, double disturbance_phase,
                 const std::optional<std::array<double, 3>>& line) {
-  const Scenario base = buildScenario(controller, params, gains,
-                                      {duration, control_period_ns, disturbance, mass_scale, inertia_scale,
-                                       noise_std, seed, start, disturbance_phase});
+  const Scenario base = buildScenario(
+      controller, params, gains,
+      {duration, control_period_ns, disturbance, mass_scale, inertia_scale, noise_std, seed, start, disturbance_phase});
   const std::vector<GainBounds> box = boundsFrom(base, bounds);
   TuningObjective objective;
   if (!parseCostType(cost, objective.cost)) throw py::value_error("unknown cost '" + cost + "' (itae|ise|iae|itse)");

@@ -187,8 +187,8 @@ PsoTuner::PsoTuner(ros::NodeHandle nh, ros::NodeHandle pnh) {
 std::string PsoTuner::scenarioText() const {
   const core::PlantDisturbance& d = base_.disturbance;
   std::string s = g(base_.duration) + " s at " + g(1e9 / static_cast<double>(base_.control_period_ns)) + " Hz, " +
-                  base_.controllerName() + adaptationText() + ", start (" + g(base_.start.x) + ", " +
-                  g(base_.start.y) + ", " + g(base_.start.theta) + "), line x = " + g(line_x0_) + " + " + g(line_v_) +
+                  base_.controllerName() + adaptationText() + ", start (" + g(base_.start.x) + ", " + g(base_.start.y) +
+                  ", " + g(base_.start.theta) + "), line x = " + g(line_x0_) + " + " + g(line_v_) +
                   " t, y = " + g(line_y_) + ", ";
   s += d.sinusoidal ? "sinusoidal disturbance A " + g(d.amplitude) + " N.m w " + g(d.frequency) + " rad/s"
                     : "no sinusoidal disturbance";

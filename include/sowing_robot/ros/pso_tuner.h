@@ -43,8 +43,8 @@ class PsoTuner {
 };
 
 /// Writes the gains YAML (core::gainsYaml: every tunable gain of the pair under kinematic_controller /
-/// torque_controller, the tuned ones marked with their bounds) after `header` (lines already starting with '#'). Written to a
-/// temporary file and renamed, so a reader never sees half a file. "" on success, else the reason.
+/// torque_controller, the tuned ones marked with their bounds) after `header` (lines already starting with '#').
+/// Written to a temporary file and renamed, so a reader never sees half a file. "" on success, else the reason.
 std::string writeGainsYaml(const std::string& path, const std::string& header, const core::Scenario& tuned,
                            const std::vector<core::GainBounds>& searched);
 
