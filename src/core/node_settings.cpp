@@ -196,6 +196,8 @@ const ParamTable<PsoTunerSettings>& PsoTunerSettings::table() {
       number("c1", &S::c1, 2.0, Limits::nonNegative(), "", "cognitive acceleration, eq 4.27"),
       number("c2", &S::c2, 2.0, Limits::nonNegative(), "", "social acceleration"),
       choice("mode", &S::adaptive, true, {{"atsmc", true}, {"tsmc", false}}, "controller tuned"),
+      text("controller", &S::controller, "",
+           "pair tuned, outer+inner (kanayama|pure_pursuit|rpp + atsmc|tsmc|pid); \"\" = kanayama + mode"),
       number("duration", &S::duration, 25.0, Limits::closed(1e-3, 1e5), "s", "simulated length of one evaluation"),
       number("control_rate", &S::control_rate, 1000.0, Limits::closed(1.0, 100000.0), "Hz",
              "plant step and control rate of the evaluations"),

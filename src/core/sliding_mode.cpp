@@ -44,6 +44,10 @@ const ParamTable<SlidingModeParams>& slidingModeTable() {
         tunable(number("rate_m", &P::rate_m, 0.1, Limits::nonNegative(), "",
                        "adaptation rate of m0_hat (Table 5.3 gamma1; applied to S·phi, README deviation 8)")),
         tunable(number("rate_i", &P::rate_i, 0.1, Limits::nonNegative(), "", "adaptation rate of I0_hat (gamma2)")),
+        choice("adaptation", &P::adaptation, Adaptation::mass_inertia,
+               {{"mass_inertia", Adaptation::mass_inertia}, {"eq_4_22", Adaptation::eq_4_22}},
+               "what the rates act on: mass_inertia m0_hat, I0_hat (deviation 8); eq_4_22 gamma_hat = m0_hat R, "
+               "alpha_hat = I0_hat R/L (1/R, L/R x faster)"),
         number("m0_min", &P::m0_min, 17.51, Limits::positive(), "kg", "projection bound: lowest m0_hat"),
         number("m0_max", &P::m0_max, 37.51, Limits::positive(), "kg", "projection bound: highest m0_hat"),
         number("i0_min", &P::i0_min, 0.57, Limits::positive(), "kg·m^2", "projection bound: lowest I0_hat"),
@@ -76,6 +80,15 @@ std::string SlidingModeParams::validate() const {
   return e;
 }
 
+namespace {
+/// The rates of m0_hat and I0_hat for the chosen reading. eq 4.22 adapts gamma_hat = m0_hat R and
+/// alpha_hat = I0_hat R / L at the given rates: d m0_hat = d gamma_hat / R, d I0_hat = d alpha_hat L / R.
+void estimateRates(const SlidingModeParams& p, double R, double L, double& rate_m, double& rate_i) {
+  rate_m = p.adaptation == Adaptation::eq_4_22 ? p.rate_m / R : p.rate_m;
+  rate_i = p.adaptation == Adaptation::eq_4_22 ? p.rate_i * L / R : p.rate_i;
+}
+}  // namespace
+
 SlidingModeController::SlidingModeController(const SlidingModeParams& params, const RobotParams& nominal)
     : params_(params),
       R_(nominal.R),
@@ -84,6 +97,7 @@ SlidingModeController::SlidingModeController(const SlidingModeParams& params, co
       i0_initial_(params.i0_initial > 0.0 ? params.i0_initial : nominal.I0()) {
   const std::string error = firstError({params.validate(), nominal.validate()});
   if (!error.empty()) throw std::invalid_argument(error);
+  estimateRates(params_, R_, L_, rate_m_, rate_i_);
   reset();
 }
 
@@ -102,6 +116,7 @@ void SlidingModeController::setParams(const SlidingModeParams& params) {
   const std::string error = params.validate();
   if (!error.empty()) throw std::invalid_argument(error);
   params_ = params;
+  estimateRates(params_, R_, L_, rate_m_, rate_i_);
   if (params_.adaptive) {
     m0_hat_ = std::clamp(m0_hat_, params_.m0_min, params_.m0_max);
     i0_hat_ = std::clamp(i0_hat_, params_.i0_min, params_.i0_max);
@@ -149,8 +164,9 @@ SlidingModeOutput SlidingModeController::update(const VelocityCommand& desired, 
     // Adaptive law with the sign that makes the Lyapunov derivative (4.21) negative for e = X_d - X:
     // m0_hat' = +rate S1 phi1 (4.22 prints a minus). Euler step followed by the projection onto the
     // bounds, the discrete form of the discontinuous projection (Liu 2011).
-    m0_hat_ = std::clamp(m0_hat_ + dt * params_.rate_m * out.s_v * phi_v, params_.m0_min, params_.m0_max);
-    i0_hat_ = std::clamp(i0_hat_ + dt * params_.rate_i * out.s_omega * phi_w, params_.i0_min, params_.i0_max);
+    // rate_m_, rate_i_: params_.rate_m, rate_i themselves, or scaled for eq 4.22's gamma_hat, alpha_hat.
+    m0_hat_ = std::clamp(m0_hat_ + dt * rate_m_ * out.s_v * phi_v, params_.m0_min, params_.m0_max);
+    i0_hat_ = std::clamp(i0_hat_ + dt * rate_i_ * out.s_omega * phi_w, params_.i0_min, params_.i0_max);
   }
 
   const double right = 0.5 * (out.u1 + out.u2), left = 0.5 * (out.u1 - out.u2);

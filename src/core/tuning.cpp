@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -18,13 +19,6 @@ namespace core {
 namespace {
 
 constexpr double INF = std::numeric_limits<double>::infinity();
-
-/// A tunable entry of the Kanayama or the sliding-mode table (the `tunable` mark in their tables).
-template <typename S>
-const ParamEntry<S>* tunableEntry(const ParamTable<S>& table, const std::string& name) {
-  const ParamEntry<S>* e = table.find(name);
-  return e && e->info.tunable ? e : nullptr;
-}
 
 std::string num(double v) {
   char b[32];
@@ -77,45 +71,233 @@ const char* costTypeName(CostType type) {
   return "?";
 }
 
-const std::vector<std::string>& tunableGainNames() {
-  static const std::vector<std::string> names = [] {
-    std::vector<std::string> n;
-    for (const auto& e : kanayamaTable().entries())
-      if (e.info.tunable) n.push_back(e.info.key);
-    for (const auto& e : slidingModeTable().entries())
-      if (e.info.tunable) n.push_back(e.info.key);
-    return n;
-  }();
-  return names;
+namespace {
+
+const char* const kKinematicNode = "kinematic_controller";
+const char* const kTorqueNode = "torque_controller";
+// Where the baselines' tables nest under their node (the nodes' namespaces and the gains YAML).
+const char* const kPurePursuitPrefix = "pure_pursuit/";
+const char* const kPidPrefix = "pid/";
+
+/// A tunable gain of the scenario's pair: its table entry, node, key prefix and the struct it sets.
+struct GainRef {
+  const ParamInfo* info = nullptr;
+  const char* node = "";
+  const char* prefix = "";
+  std::function<void(Scenario&, double)> set;
+  std::function<double(const Scenario&)> get;
+};
+
+/// Whether a `tunable` mark acts in this pair (the rates only adapt in ATSMC; the min radius only
+/// regulates in RPP).
+bool actsInPair(const Scenario& sc, const std::string& key) {
+  if (key == "rate_m" || key == "rate_i") return sc.inner == InnerKind::sliding_mode && sc.sliding.adaptive;
+  if (key == "regulated_linear_scaling_min_radius") return sc.outer == OuterKind::rpp;
+  return true;
 }
 
-std::string gainNode(const std::string& name) {
-  if (tunableEntry(kanayamaTable(), name)) return "kinematic_controller";
-  if (tunableEntry(slidingModeTable(), name)) return "torque_controller";
-  return "";
+template <typename S>
+void collect(const ParamTable<S>& table, S Scenario::*member, const char* node, const char* prefix, const Scenario& sc,
+             std::vector<GainRef>& out) {
+  for (const auto& e : table.entries()) {
+    if (!e.info.tunable || !actsInPair(sc, e.info.key)) continue;
+    GainRef g;
+    g.info = &e.info;
+    g.node = node;
+    g.prefix = prefix;
+    const ParamEntry<S>* entry = &e;  // the tables are static: the pointer outlives the scenario
+    g.set = [entry, member](Scenario& s, double v) { entry->set(s.*member, v); };
+    g.get = [entry, member](const Scenario& s) { return std::get<double>(entry->get(s.*member)); };
+    out.push_back(std::move(g));
+  }
 }
 
-bool setGain(Scenario& sc, const std::string& name, double value) {
-  if (const auto* e = tunableEntry(kanayamaTable(), name)) {
-    e->set(sc.kanayama, value);
-    return true;
-  }
-  if (const auto* e = tunableEntry(slidingModeTable(), name)) {
-    e->set(sc.sliding, value);
-    return true;
-  }
+/// Every tunable gain of the scenario's pair, outer's then inner's, in table order.
+std::vector<GainRef> pairGains(const Scenario& sc) {
+  std::vector<GainRef> out;
+  if (sc.outer == OuterKind::kanayama)
+    collect(kanayamaTable(), &Scenario::kanayama, kKinematicNode, "", sc, out);
+  else
+    collect(purePursuitTable(), &Scenario::pure_pursuit, kKinematicNode, kPurePursuitPrefix, sc, out);
+  if (sc.inner == InnerKind::sliding_mode)
+    collect(slidingModeTable(), &Scenario::sliding, kTorqueNode, "", sc, out);
+  else
+    collect(wheelPidTable(), &Scenario::pid, kTorqueNode, kPidPrefix, sc, out);
+  return out;
+}
+
+bool findGain(const Scenario& sc, const std::string& name, GainRef& out) {
+  for (auto& g : pairGains(sc))
+    if (g.info->key == name) {
+      out = std::move(g);
+      return true;
+    }
   return false;
 }
 
+/// Search bounds of every tunable mark, one row per gain (gainSearchBounds' comment gives the reasons).
+const std::vector<GainBounds>& searchBoundsList() {
+  static const std::vector<GainBounds> list = {
+      // Kanayama: [0.1, 10], since the thesis default ktheta = 2.2 is already outside Table 5.4's [0.1, 2].
+      {"kx", 0.1, 10.0},
+      {"ky", 0.1, 10.0},
+      {"ktheta", 0.1, 10.0},
+      // Sliding mode: Table 5.4 (beta [0.1, 2], K [0.1, 1000]); eta spans the 2.75 N·m disturbance.
+      {"beta_v", 0.1, 2.0},
+      {"beta_omega", 0.1, 2.0},
+      {"k1", 0.1, 1000.0},
+      {"k2", 0.1, 1000.0},
+      {"eta1", 0.1, 10.0},
+      {"eta2", 0.1, 10.0},
+      {"rate_m", 0.0, 10.0},
+      {"rate_i", 0.0, 10.0},
+      // Pure pursuit / RPP: nav2's lookahead range; the along-track feedback up to Kanayama's kx range.
+      {"lookahead_dist", 0.3, 0.9},
+      {"regulated_linear_scaling_min_radius", 0.1, 3.0},
+      {"k_along", 0.0, 10.0},
+      // Wheel PID (wheel-speed error in rad/s, 1 m/s ~ 10.5 rad/s): up to ~25x the defaults 2 and 20.
+      {"kp", 0.0, 50.0},
+      {"ki", 0.0, 500.0},
+      {"kd", 0.0, 0.5},
+      {"feedforward", 0.0, 2.0},
+  };
+  return list;
+}
+
+/// Set one entry of `table` (in `params`) from a key and a value: "" or the reason.
+template <typename S>
+std::string setEntry(const ParamTable<S>& table, S& params, const std::string& node, const std::string& key,
+                     const ParamValue& value) {
+  const ParamEntry<S>* e = table.find(key);
+  if (!e) return node + "/" + key + " is no controller parameter";
+  ParamValue v = value;
+  // An integer where the table wants a double (YAML "2" for 2.0) is that double.
+  if (std::holds_alternative<int>(v) && std::holds_alternative<double>(e->info.default_value))
+    v = static_cast<double>(std::get<int>(v));
+  const std::string error = e->info.check(v, node + "/");
+  if (!error.empty()) return error;
+  e->set(params, v);
+  return "";
+}
+
+}  // namespace
+
+std::vector<std::string> tunableGainNames(const Scenario& sc) {
+  std::vector<std::string> names;
+  for (const auto& g : pairGains(sc)) names.push_back(g.info->key);
+  return names;
+}
+
+const std::vector<std::string>& tunableGainNames() {
+  static const std::vector<std::string> names = tunableGainNames(Scenario());
+  return names;
+}
+
+std::string gainNode(const Scenario& sc, const std::string& name) {
+  GainRef g;
+  return findGain(sc, name, g) ? g.node : "";
+}
+
+std::string gainKey(const Scenario& sc, const std::string& name) {
+  GainRef g;
+  return findGain(sc, name, g) ? std::string(g.prefix) + name : "";
+}
+
+bool setGain(Scenario& sc, const std::string& name, double value) {
+  GainRef g;
+  if (!findGain(sc, name, g)) return false;
+  g.set(sc, value);
+  return true;
+}
+
 double getGain(const Scenario& sc, const std::string& name) {
-  if (const auto* e = tunableEntry(kanayamaTable(), name)) return std::get<double>(e->get(sc.kanayama));
-  if (const auto* e = tunableEntry(slidingModeTable(), name)) return std::get<double>(e->get(sc.sliding));
-  return std::numeric_limits<double>::quiet_NaN();
+  GainRef g;
+  return findGain(sc, name, g) ? g.get(sc) : std::numeric_limits<double>::quiet_NaN();
+}
+
+std::string setControllerParam(Scenario& sc, const std::string& node, const std::string& key, const ParamValue& value) {
+  auto under = [&key](const char* prefix) { return key.rfind(prefix, 0) == 0; };
+  if (node == kKinematicNode) {
+    if (under(kPurePursuitPrefix))
+      return setEntry(purePursuitTable(), sc.pure_pursuit, node + "/" + kPurePursuitPrefix,
+                      key.substr(std::string(kPurePursuitPrefix).size()), value);
+    return setEntry(kanayamaTable(), sc.kanayama, node, key, value);
+  }
+  if (node == kTorqueNode) {
+    if (under(kPidPrefix))
+      return setEntry(wheelPidTable(), sc.pid, node + "/" + kPidPrefix, key.substr(std::string(kPidPrefix).size()),
+                      value);
+    return setEntry(slidingModeTable(), sc.sliding, node, key, value);
+  }
+  return "unknown controller node '" + node + "' (kinematic_controller, torque_controller)";
+}
+
+GainBounds gainSearchBounds(const std::string& name) {
+  for (const auto& b : searchBoundsList())
+    if (b.name == name) return b;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  return {name, nan, nan};
+}
+
+std::vector<GainBounds> defaultGainBounds(const Scenario& sc) {
+  std::vector<GainBounds> out;
+  for (const auto& name : tunableGainNames(sc)) out.push_back(gainSearchBounds(name));
+  return out;
 }
 
 std::vector<GainBounds> defaultGainBounds() {
-  return {{"kx", 0.1, 10.0},   {"ky", 0.1, 10.0},   {"ktheta", 0.1, 10.0}, {"k1", 0.1, 1000.0},
-          {"k2", 0.1, 1000.0}, {"eta1", 0.1, 10.0}, {"eta2", 0.1, 10.0}};
+  std::vector<GainBounds> out;
+  for (const char* n : {"kx", "ky", "ktheta", "k1", "k2", "eta1", "eta2"}) out.push_back(gainSearchBounds(n));
+  return out;
+}
+
+std::string yamlFloat(double v) {
+  if (std::isnan(v)) return ".nan";
+  if (std::isinf(v)) return v > 0 ? ".inf" : "-.inf";
+  char b[64];
+  const auto r = std::to_chars(b, b + sizeof b, v);
+  std::string s(b, r.ptr);
+  if (s.find('.') == std::string::npos) {  // YAML 1.1 needs the dot: "2" is an int, "1e-05" a string
+    const auto e = s.find('e');
+    if (e == std::string::npos)
+      s += ".0";
+    else
+      s.insert(e, ".0");
+  }
+  return s;
+}
+
+std::string gainsYaml(const Scenario& tuned, const std::vector<GainBounds>& searched) {
+  std::string out, node, prefix;
+  auto line = [&out](const std::string& indent, const std::string& key, const std::string& value,
+                     const std::string& comment) {
+    std::string l = indent + key + ": " + value;
+    l.resize(std::max<std::size_t>(l.size() + 1, 36), ' ');
+    out += l + comment + "\n";
+  };
+  for (const GainRef& g : pairGains(tuned)) {
+    if (g.node != node) {
+      node = g.node;
+      prefix.clear();
+      out += node + ":\n";
+    }
+    if (g.prefix != prefix) {
+      prefix = g.prefix;
+      out += "  " + prefix.substr(0, prefix.size() - 1) + ":\n";
+    }
+    std::string comment = "# base value (not tuned)";
+    for (const auto& b : searched)
+      if (b.name == g.info->key) comment = "# tuned in [" + num(b.lower) + ", " + num(b.upper) + "]";
+    line(prefix.empty() ? "  " : "    ", g.info->key, yamlFloat(g.get(tuned)), comment);
+  }
+  // The reading the rates were tuned with, when it is not the default (a default file stays gains only).
+  if (tuned.inner == InnerKind::sliding_mode && tuned.sliding.adaptive &&
+      tuned.sliding.adaptation != Adaptation::mass_inertia) {
+    if (node != kTorqueNode) out += std::string(kTorqueNode) + ":\n";
+    line("  ", "adaptation", formatValue(slidingModeTable().find("adaptation")->get(tuned.sliding)),
+         "# the rates act on gamma_hat, alpha_hat (docs/deviations.md 8)");
+  }
+  return out;
 }
 
 std::string validateGainBounds(const Scenario& base, const std::vector<GainBounds>& gains) {
@@ -123,10 +305,10 @@ std::string validateGainBounds(const Scenario& base, const std::vector<GainBound
   for (std::size_t i = 0; i < gains.size(); ++i) {
     const GainBounds& g = gains[i];
     const std::string at = "gains[" + std::to_string(i) + "] (" + g.name + ")";
-    if (gainNode(g.name).empty()) {
+    if (gainNode(base, g.name).empty()) {
       std::string known;
-      for (const auto& n : tunableGainNames()) known += (known.empty() ? "" : ", ") + n;
-      return at + ": unknown gain '" + g.name + "' (tunable: " + known + ")";
+      for (const auto& n : tunableGainNames(base)) known += (known.empty() ? "" : ", ") + n;
+      return at + ": '" + g.name + "' is no tunable gain of " + base.controllerName() + " (tunable: " + known + ")";
     }
     for (std::size_t j = 0; j < i; ++j)
       if (gains[j].name == g.name)
@@ -139,7 +321,7 @@ std::string validateGainBounds(const Scenario& base, const std::vector<GainBound
   for (int corner = 0; corner < 2; ++corner) {
     Scenario sc = base;
     for (const auto& g : gains) setGain(sc, g.name, corner == 0 ? g.lower : g.upper);
-    const std::string e = firstError({sc.kanayama.validate(), sc.sliding.validate()});
+    const std::string e = sc.validate();
     if (!e.empty())
       return std::string("gains: with every gain at its ") + (corner == 0 ? "lower" : "upper") +
              " bound the controller refuses it: " + e;

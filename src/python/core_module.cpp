@@ -1,7 +1,8 @@
 // sowing_robot.core: the ROS-free core seen from Python (pybind11). One definition of the metrics and
 // the closed loop: analyze_bag, the tests and notebooks call this code instead of copies of it.
 //   MetricsAccumulator, metrics(), time_domain_metrics(), metrics_table()  (core/metrics.h)
-//   run_closed_loop()                                                      (core/runner.h, line reference)
+//   run_closed_loop(), run()      (core/runner.h on the line; run: any controller pair and parameters)
+//   tune(), tunable_gains(), gains_yaml()                                  (core/tuning.h: the PSO tuner)
 // Arrays in are 1-D float64 NumPy arrays (anything convertible); metrics out are plain dicts
 // {"x": {"ise": .., ..., "peak": ..}, "y": {...}, "theta": {...}}, so they compare with == to the bit.
 #include <pybind11/numpy.h>
@@ -17,6 +18,7 @@
 #include "sowing_robot/core/metrics.h"
 #include "sowing_robot/core/reference.h"
 #include "sowing_robot/core/runner.h"
+#include "sowing_robot/core/tuning.h"
 
 namespace py = pybind11;
 using namespace sowing_robot::core;
@@ -141,26 +143,91 @@ struct Trace {
   }
 };
 
-py::dict runClosedLoopPy(bool adaptive, double duration, std::int64_t control_period_ns, bool disturbance,
-                         double mass_scale, double inertia_scale, double noise_std, std::uint64_t seed,
-                         const std::array<double, 3>& start, const std::string& switching, double width,
-                         const std::optional<std::array<double, 3>>& line, bool keep_samples, bool trace) {
+/// The plant / timing part of a scenario, shared by run_closed_loop, run and tune.
+struct PlantArgs {
+  double duration;
+  std::int64_t control_period_ns;
+  bool disturbance;
+  double mass_scale, inertia_scale, noise_std;
+  std::uint64_t seed;
+  std::array<double, 3> start;
+  double disturbance_phase;
+};
+
+void applyPlant(Scenario& sc, const PlantArgs& a) {
+  sc.duration = a.duration;
+  sc.control_period_ns = a.control_period_ns;
+  sc.disturbance.sinusoidal = a.disturbance;
+  sc.disturbance.mass_scale = a.mass_scale;
+  sc.disturbance.inertia_scale = a.inertia_scale;
+  sc.disturbance.noise_std = a.noise_std;
+  sc.disturbance.seed = a.seed;
+  sc.start = {a.start[0], a.start[1], a.start[2]};
+  sc.disturbance_phase = a.disturbance_phase;
+}
+
+/// A Python value as a table value (bool before int: Python's bool is an int).
+ParamValue toParamValue(const py::handle& v, const std::string& where) {
+  if (py::isinstance<py::bool_>(v)) return v.cast<bool>();
+  if (py::isinstance<py::int_>(v)) return static_cast<int>(v.cast<long long>());
+  if (py::isinstance<py::float_>(v)) return v.cast<double>();
+  if (py::isinstance<py::str>(v)) return v.cast<std::string>();
+  throw py::type_error(where + ": a bool, int, float or str is needed, got " + std::string(py::str(v.get_type())));
+}
+
+/// params: {node: {key: value}} as in a gains YAML (yaml.safe_load of config/tuned/*.yaml; nested maps
+/// such as pure_pursuit: {...} are keys joined by '/'), or {"node/key": value}.
+void applyParams(Scenario& sc, const std::string& node, const std::string& key, const py::handle& v) {
+  if (py::isinstance<py::dict>(v)) {
+    for (const auto& kv : v.cast<py::dict>()) {
+      const std::string k = kv.first.cast<std::string>();
+      if (node.empty())
+        applyParams(sc, k, "", kv.second);
+      else
+        applyParams(sc, node, key.empty() ? k : key + "/" + k, kv.second);
+    }
+    return;
+  }
+  std::string n = node, k = key;
+  if (k.empty()) {  // "node/key": value
+    const auto slash = n.find('/');
+    if (slash == std::string::npos) throw py::value_error("params: '" + n + "' is no node/key");
+    k = n.substr(slash + 1);
+    n = n.substr(0, slash);
+  }
+  const std::string e = setControllerParam(sc, n, k, toParamValue(v, n + "/" + k));
+  if (!e.empty()) throw py::value_error(e);
+}
+
+/// The scenario of `controller` ("outer+inner") with params (gains YAML shape) and gains ({name: value},
+/// tunable gains of the pair) applied over the core defaults, then the plant arguments.
+Scenario buildScenario(const std::string& controller, const py::object& params, const py::object& gains,
+                       const PlantArgs& plant) {
   Scenario sc;
-  sc.sliding.adaptive = adaptive;
-  sc.duration = duration;
-  sc.control_period_ns = control_period_ns;
-  sc.disturbance.sinusoidal = disturbance;
-  sc.disturbance.mass_scale = mass_scale;
-  sc.disturbance.inertia_scale = inertia_scale;
-  sc.disturbance.noise_std = noise_std;
-  sc.disturbance.seed = seed;
-  sc.start = {start[0], start[1], start[2]};
-  if (!SwitchFunction::parse(switching, sc.sliding.switching.type))
-    throw py::value_error("unknown switching function '" + switching + "' (sign, sat, relay, atan, tanh)");
-  sc.sliding.switching.width = width;
-  const std::string err = sc.validate();
-  if (!err.empty()) throw py::value_error(err);
-  LineReference reference = line ? LineReference((*line)[0], (*line)[1], (*line)[2]) : LineReference();
+  std::string e = parseControllerPair(controller, sc.outer, sc.inner, sc.sliding.adaptive);
+  if (!e.empty()) throw py::value_error(e);
+  if (!params.is_none()) {
+    if (!py::isinstance<py::dict>(params)) throw py::type_error("params must be a dict {node: {key: value}}");
+    applyParams(sc, "", "", params);
+  }
+  if (!gains.is_none()) {
+    for (const auto& kv : gains.cast<py::dict>()) {
+      const std::string name = kv.first.cast<std::string>();
+      if (!setGain(sc, name, kv.second.cast<double>()))
+        throw py::value_error("'" + name + "' is no tunable gain of " + sc.controllerName());
+    }
+  }
+  applyPlant(sc, plant);
+  e = sc.validate();
+  if (!e.empty()) throw py::value_error(e);
+  return sc;
+}
+
+LineReference lineOf(const std::optional<std::array<double, 3>>& line) {
+  return line ? LineReference((*line)[0], (*line)[1], (*line)[2]) : LineReference();
+}
+
+py::dict runScenario(const Scenario& sc, LineReference reference, bool keep_samples, bool trace) {
   Trace columns;
   RunResult r;
   {
@@ -173,6 +240,7 @@ py::dict runClosedLoopPy(bool adaptive, double duration, std::int64_t control_pe
     }
   }
   py::dict d;
+  d["controller"] = sc.controllerName();
   d["metrics"] = metricsToDict(r.metrics);
   std::vector<double> final_state(r.final_state.data(), r.final_state.data() + r.final_state.size());
   d["final_state"] = toArray(final_state);
@@ -181,6 +249,102 @@ py::dict runClosedLoopPy(bool adaptive, double duration, std::int64_t control_pe
   d["saturated_steps"] = r.saturated_steps;
   if (trace) d["trace"] = columns.toDict();
   return d;
+}
+
+py::dict runClosedLoopPy(bool adaptive, double duration, std::int64_t control_period_ns, bool disturbance,
+                         double mass_scale, double inertia_scale, double noise_std, std::uint64_t seed,
+                         const std::array<double, 3>& start, const std::string& switching, double width,
+                         const std::optional<std::array<double, 3>>& line, bool keep_samples, bool trace) {
+  Scenario sc;
+  sc.sliding.adaptive = adaptive;
+  applyPlant(sc, {duration, control_period_ns, disturbance, mass_scale, inertia_scale, noise_std, seed, start, 0.0});
+  if (!SwitchFunction::parse(switching, sc.sliding.switching.type))
+    throw py::value_error("unknown switching function '" + switching + "' (sign, sat, relay, atan, tanh)");
+  sc.sliding.switching.width = width;
+  const std::string err = sc.validate();
+  if (!err.empty()) throw py::value_error(err);
+  return runScenario(sc, lineOf(line), keep_samples, trace);
+}
+
+py::dict runPy(const std::string& controller, const py::object& params, const py::object& gains, double duration,
+               std::int64_t control_period_ns, bool disturbance, double mass_scale, double inertia_scale,
+               double noise_std, std::uint64_t seed, const std::array<double, 3>& start, double disturbance_phase,
+               const std::optional<std::array<double, 3>>& line, bool keep_samples, bool trace) {
+  const Scenario sc = buildScenario(
+      controller, params, gains,
+      {duration, control_period_ns, disturbance, mass_scale, inertia_scale, noise_std, seed, start, disturbance_phase});
+  return runScenario(sc, lineOf(line), keep_samples, trace);
+}
+
+std::vector<GainBounds> boundsFrom(const Scenario& sc, const py::object& bounds) {
+  if (bounds.is_none()) return defaultGainBounds(sc);
+  std::vector<GainBounds> out;
+  for (const auto& b : bounds) {
+    const auto t = b.cast<py::sequence>();
+    if (t.size() != 3) throw py::value_error("bounds: one (name, lower, upper) per gain");
+    out.push_back({t[0].cast<std::string>(), t[1].cast<double>(), t[2].cast<double>()});
+  }
+  return out;
+}
+
+py::list boundsToList(const std::vector<GainBounds>& b) {
+  py::list l;
+  for (const auto& g : b) l.append(py::make_tuple(g.name, g.lower, g.upper));
+  return l;
+}
+
+py::dict tunePy(const std::string& controller, const py::object& params, const py::object& gains,
+                const py::object& bounds, int particles, int iterations, std::uint64_t pso_seed, int threads,
+                double velocity_clamp, double w_max, double w_min, double c1, double c2, const std::string& cost,
+                double torque_weight, double chattering_weight, double duration, std::int64_t control_period_ns,
+                bool disturbance, double mass_scale, double inertia_scale, double noise_std, std::uint64_t seed,
+                const std::array<double, 3>& start, double disturbance_phase,
+                const std::optional<std::array<double, 3>>& line) {
+  const Scenario base = buildScenario(
+      controller, params, gains,
+      {duration, control_period_ns, disturbance, mass_scale, inertia_scale, noise_std, seed, start, disturbance_phase});
+  const std::vector<GainBounds> box = boundsFrom(base, bounds);
+  TuningObjective objective;
+  if (!parseCostType(cost, objective.cost)) throw py::value_error("unknown cost '" + cost + "' (itae|ise|iae|itse)");
+  objective.torque_weight = torque_weight;
+  objective.chattering_weight = chattering_weight;
+  PsoParams p;  // the pso_tuner node's mapping of config/pso.yaml
+  p.particles = particles;
+  p.iterations = iterations;
+  p.seed = pso_seed;
+  p.threads = threads;
+  p.max_velocity_fraction = velocity_clamp;
+  p.w_max = w_max;
+  p.w_min = w_min;
+  p.c1 = c1;
+  p.c2 = c2;
+  const LineReference reference = lineOf(line);
+  TuningResult r;
+  try {
+    py::gil_scoped_release no_gil;
+    r = tuneGains(base, reference, box, objective, p);
+  } catch (const std::invalid_argument& e) {
+    throw py::value_error(e.what());
+  }
+  const Scenario tuned = TuningProblem(base, reference, box, objective, 1).scenarioFor(r.best_gains);
+  py::dict best;
+  for (std::size_t d = 0; d < box.size(); ++d) best[box[d].name.c_str()] = r.best_gains[d];
+  py::dict out;
+  out["controller"] = base.controllerName();
+  out["best_gains"] = best;
+  out["best_cost"] = r.pso.best_cost;
+  out["initial_best_cost"] = r.initial_best_cost;
+  out["cost_per_iteration"] = toArray(r.pso.best_cost_per_iteration);
+  out["tracking"] = r.best.tracking;
+  out["effort"] = r.best.effort;
+  out["chattering"] = r.best.chattering;
+  out["evaluations"] = r.pso.evaluations;
+  out["evaluations_cut"] = r.evaluations_cut;
+  out["threads"] = r.threads;
+  out["wall_s"] = r.wall_s;
+  out["bounds"] = boundsToList(box);
+  out["yaml"] = gainsYaml(tuned, box);
+  return out;
 }
 
 }  // namespace
@@ -271,4 +435,55 @@ Returns {"metrics": {axis: {field: value}}, "final_state": array (x, y, theta, v
 "diverged": bool, "periods": int, "saturated_steps": int} and, with trace=True, "trace": {column: array}
 with one row per control period (t, state, reference, command, torques, sliding variables, estimates,
 errors ex, ey, etheta). Raises ValueError for an invalid scenario.)doc");
+
+  m.def("run", &runPy, py::kw_only(), py::arg("controller") = std::string("kanayama+atsmc"),
+        py::arg("params") = py::none(), py::arg("gains") = py::none(), py::arg("duration") = defaults.duration,
+        py::arg("control_period_ns") = defaults.control_period_ns,
+        py::arg("disturbance") = defaults.disturbance.sinusoidal,
+        py::arg("mass_scale") = defaults.disturbance.mass_scale,
+        py::arg("inertia_scale") = defaults.disturbance.inertia_scale,
+        py::arg("noise_std") = defaults.disturbance.noise_std, py::arg("seed") = defaults.disturbance.seed,
+        py::arg("start") = std::array<double, 3>{defaults.start.x, defaults.start.y, defaults.start.theta},
+        py::arg("disturbance_phase") = defaults.disturbance_phase, py::arg("line") = py::none(),
+        py::arg("keep_samples") = true, py::arg("trace") = false,
+        R"doc(core::runClosedLoop of any controller pair on the line (None: the thesis's row).
+
+controller: "outer+inner", outer kanayama|pure_pursuit|rpp, inner atsmc|tsmc|pid.
+params: controller parameters by node as in a gains YAML, {"kinematic_controller": {"kx": 2.0,
+"pure_pursuit": {"lookahead_dist": 0.5}}, "torque_controller": {"adaptation": "eq_4_22", "pid": {"kp": 3}}}
+(yaml.safe_load of config/tuned/<pair>.yaml as it is), or flat {"torque_controller/k1": 400.0}.
+gains: {name: value} of the pair's tunable gains (tunable_gains()). Plant arguments as run_closed_loop's.
+Returns run_closed_loop's dict plus "controller". Raises ValueError for a bad name, key or value.)doc");
+
+  m.def("tune", &tunePy, py::kw_only(), py::arg("controller") = std::string("kanayama+atsmc"),
+        py::arg("params") = py::none(), py::arg("gains") = py::none(), py::arg("bounds") = py::none(),
+        py::arg("particles") = 20, py::arg("iterations") = 30, py::arg("pso_seed") = 1, py::arg("threads") = 0,
+        py::arg("velocity_clamp") = 0.2, py::arg("w_max") = 0.9, py::arg("w_min") = 0.1, py::arg("c1") = 2.0,
+        py::arg("c2") = 2.0, py::arg("cost") = std::string("itae"), py::arg("torque_weight") = 0.0,
+        py::arg("chattering_weight") = 0.0, py::arg("duration") = defaults.duration,
+        py::arg("control_period_ns") = defaults.control_period_ns,
+        py::arg("disturbance") = defaults.disturbance.sinusoidal,
+        py::arg("mass_scale") = defaults.disturbance.mass_scale,
+        py::arg("inertia_scale") = defaults.disturbance.inertia_scale,
+        py::arg("noise_std") = defaults.disturbance.noise_std, py::arg("seed") = defaults.disturbance.seed,
+        py::arg("start") = std::array<double, 3>{defaults.start.x, defaults.start.y, defaults.start.theta},
+        py::arg("disturbance_phase") = defaults.disturbance_phase, py::arg("line") = py::none(),
+        R"doc(core::tuneGains: the pso_tuner node's PSO on the scenario run() would build.
+
+bounds: [(name, lower, upper), ...]; None = every tunable gain of the pair in its default bounds
+(tunable_gains()). PSO settings as config/pso.yaml's (velocity_clamp 0.2). Same arguments, same
+result, bit for bit, whatever `threads`. Returns {"best_gains": {name: value}, "best_cost",
+"initial_best_cost", "cost_per_iteration" (array), "tracking", "effort", "chattering", "evaluations",
+"evaluations_cut", "threads", "wall_s", "bounds", "yaml" (the gains YAML body of the tuned pair)}.)doc");
+
+  m.def(
+      "tunable_gains",
+      [](const std::string& controller) {
+        Scenario sc;
+        const std::string e = parseControllerPair(controller, sc.outer, sc.inner, sc.sliding.adaptive);
+        if (!e.empty()) throw py::value_error(e);
+        return boundsToList(defaultGainBounds(sc));
+      },
+      py::arg("controller") = std::string("kanayama+atsmc"),
+      "The pair's tunable gains (the tables' `tunable` marks) with their default search bounds: [(name, lo, hi)].");
 }

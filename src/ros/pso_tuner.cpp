@@ -35,10 +35,10 @@ std::string defaultOutput() {
 }
 
 /// ~gains: a list of {name: str, lower: number, upper: number}. "" or one line naming the bad entry.
-std::string parseGains(const ros::NodeHandle& pnh, std::vector<core::GainBounds>& out) {
+std::string parseGains(const ros::NodeHandle& pnh, const core::Scenario& base, std::vector<core::GainBounds>& out) {
   const std::string full = pnh.resolveName("gains");
-  if (!pnh.hasParam("gains")) {
-    out = core::defaultGainBounds();
+  if (!pnh.hasParam("gains")) {  // every tunable gain of the pair, in its search bounds (core/tuning.h)
+    out = core::defaultGainBounds(base);
     return "";
   }
   XmlRpc::XmlRpcValue list;
@@ -79,21 +79,7 @@ std::string parseGains(const ros::NodeHandle& pnh, std::vector<core::GainBounds>
 
 }  // namespace
 
-std::string yamlFloat(double v) {
-  if (std::isnan(v)) return ".nan";
-  if (std::isinf(v)) return v > 0 ? ".inf" : "-.inf";
-  char b[64];
-  const auto r = std::to_chars(b, b + sizeof b, v);
-  std::string s(b, r.ptr);
-  if (s.find('.') == std::string::npos) {  // YAML 1.1 needs the dot: "2" is an int, "1e-05" a string
-    const auto e = s.find('e');
-    if (e == std::string::npos)
-      s += ".0";
-    else
-      s.insert(e, ".0");
-  }
-  return s;
-}
+std::string yamlFloat(double v) { return core::yamlFloat(v); }
 
 std::string writeGainsYaml(const std::string& path, const std::string& header, const core::Scenario& tuned,
                            const std::vector<core::GainBounds>& searched) {
@@ -106,21 +92,7 @@ std::string writeGainsYaml(const std::string& path, const std::string& header, c
   {
     std::ofstream f(tmp);
     if (!f) return "cannot open " + tmp + " for writing";
-    f << header;
-    std::string node;
-    for (const std::string& name : core::tunableGainNames()) {
-      const std::string n = core::gainNode(name);
-      if (n != node) {
-        node = n;
-        f << node << ":\n";
-      }
-      std::string comment = "# base value (not tuned)";
-      for (const auto& b : searched)
-        if (b.name == name) comment = "# tuned in [" + g(b.lower) + ", " + g(b.upper) + "]";
-      std::string line = "  " + name + ": " + yamlFloat(core::getGain(tuned, name));
-      line.resize(std::max<std::size_t>(line.size() + 1, 36), ' ');
-      f << line << comment << "\n";
-    }
+    f << header << core::gainsYaml(tuned, searched);
     f.flush();
     if (!f) return "write to " + tmp + " failed";
   }
@@ -175,14 +147,20 @@ PsoTuner::PsoTuner(ros::NodeHandle nh, ros::NodeHandle pnh) {
   base_.kanayama = kin_settings.gains;
   base_.sliding = torque_settings.sliding;
   base_.sliding.adaptive = settings.adaptive;
+  // The baselines' parameters, nested under the same nodes as the gains YAML writes them (core::gainKey).
+  loadTable(kin, core::purePursuitTable(), base_.pure_pursuit, "pure_pursuit/");
+  loadTable(torque, core::wheelPidTable(), base_.pid, "pid/");
+  std::string pair_error;
+  if (!settings.controller.empty())
+    pair_error = core::parseControllerPair(settings.controller, base_.outer, base_.inner, base_.sliding.adaptive);
   line_v_ = ref_settings.line_v_r;
   line_y_ = ref_settings.line_y;
   line_x0_ = ref_settings.line_x0;
   reference_ = core::LineReference(line_v_, line_y_, line_x0_);
 
-  const std::string gains_error = parseGains(pnh, gains_);
+  const std::string gains_error = pair_error.empty() ? parseGains(pnh, base_, gains_) : "";
   std::string e = core::firstError({runp.error(), plant.error(), kin.error(), torque.error(), refp.error(), robot_error,
-                                    settings.validate(), gains_error});
+                                    settings.validate(), pair_error, gains_error});
   if (e.empty())
     e = core::firstError({base_.validate(), core::validateGainBounds(base_, gains_), objective_.validate()});
   if (e.empty()) {
@@ -209,14 +187,29 @@ PsoTuner::PsoTuner(ros::NodeHandle nh, ros::NodeHandle pnh) {
 std::string PsoTuner::scenarioText() const {
   const core::PlantDisturbance& d = base_.disturbance;
   std::string s = g(base_.duration) + " s at " + g(1e9 / static_cast<double>(base_.control_period_ns)) + " Hz, " +
-                  (base_.sliding.adaptive ? "atsmc" : "tsmc") + ", start (" + g(base_.start.x) + ", " +
-                  g(base_.start.y) + ", " + g(base_.start.theta) + "), line x = " + g(line_x0_) + " + " + g(line_v_) +
+                  base_.controllerName() + adaptationText() + ", start (" + g(base_.start.x) + ", " + g(base_.start.y) +
+                  ", " + g(base_.start.theta) + "), line x = " + g(line_x0_) + " + " + g(line_v_) +
                   " t, y = " + g(line_y_) + ", ";
   s += d.sinusoidal ? "sinusoidal disturbance A " + g(d.amplitude) + " N.m w " + g(d.frequency) + " rad/s"
                     : "no sinusoidal disturbance";
   s += ", mismatch mass x" + g(d.mass_scale) + " inertia x" + g(d.inertia_scale);
   s += ", noise std " + g(d.noise_std) + " N.m (seed " + std::to_string(d.seed) + ")";
   return s;
+}
+
+std::string PsoTuner::adaptationText() const {
+  if (base_.inner != core::InnerKind::sliding_mode || !base_.sliding.adaptive ||
+      base_.sliding.adaptation == core::Adaptation::mass_inertia)
+    return "";
+  return " (adaptation eq_4_22)";
+}
+
+std::string PsoTuner::loadArgs() const {
+  // sim.launch's controller:=atsmc|tsmc for the thesis pair; the baselines' outer:= / inner:= selection.
+  if (base_.outer == core::OuterKind::kanayama && base_.inner == core::InnerKind::sliding_mode)
+    return std::string("controller:=") + (base_.sliding.adaptive ? "atsmc" : "tsmc");
+  return std::string("outer:=") + core::outerName(base_.outer) +
+         " inner:=" + core::innerName(base_.inner, base_.sliding.adaptive);
 }
 
 void PsoTuner::onProgress(const core::PsoProgress& p) {
@@ -267,8 +260,7 @@ int PsoTuner::run() {
     searched += (searched.empty() ? "" : ", ") + b.name + " [" + g(b.lower) + ", " + g(b.upper) + "]";
   std::string h;
   h += "# Controller gains tuned offline by pso_tuner (PSO, thesis eqs 4.26-4.31, Table 5.4).\n";
-  h += "# Load with: roslaunch sowing_robot sim.launch gains:=THIS_FILE controller:=" +
-       std::string(base_.sliding.adaptive ? "atsmc" : "tsmc") + "\n";
+  h += "# Load with: roslaunch sowing_robot sim.launch gains:=THIS_FILE " + loadArgs() + "\n";
   h += "# date: " + std::string(date) + "\n";
   h += "# scenario: " + scenarioText() + "\n";
   h += "# cost: " + std::string(core::costTypeName(objective_.cost)) + " summed over x, y, theta";
@@ -285,7 +277,7 @@ int PsoTuner::run() {
        std::to_string(r.pso.evaluations) + ", " + std::to_string(r.threads) + " thread(s), " + fmt("%.2f", r.wall_s) +
        " s wall\n";
   h += "# searched: " + searched + "\n";
-  h += "# Other torque_controller parameters (p, q, switching, bounds, max_torque) were those of the base config.\n";
+  h += "# Other parameters of " + base_.controllerName() + " were those of the base config.\n";
   const std::string e = writeGainsYaml(output_, h, tuned, gains_);
   if (!e.empty()) {
     ROS_ERROR("pso_tuner: %s", e.c_str());

@@ -66,3 +66,79 @@ TEST(TuneGains, BoundedSearchFindsTheSameGainsAsTheExactOne) {
   EXPECT_EQ(tuned.pso.best_cost, exact.best_cost);
   EXPECT_EQ(tuned.pso.best_cost_per_iteration, exact.best_cost_per_iteration);
 }
+
+namespace {
+Scenario pair(const std::string& name) {
+  Scenario sc = shortThesisRun();
+  const std::string e = parseControllerPair(name, sc.outer, sc.inner, sc.sliding.adaptive);
+  EXPECT_EQ(e, "") << name;
+  return sc;
+}
+using Names = std::vector<std::string>;
+}  // namespace
+
+TEST(TunableGains, EachPairSearchesItsTablesMarks) {
+  EXPECT_EQ(tunableGainNames(pair("kanayama+atsmc")),
+            (Names{"kx", "ky", "ktheta", "beta_v", "beta_omega", "k1", "k2", "eta1", "eta2", "rate_m", "rate_i"}));
+  // TSMC does not adapt: its rates are no search dimension.
+  EXPECT_EQ(tunableGainNames(pair("kanayama+tsmc")),
+            (Names{"kx", "ky", "ktheta", "beta_v", "beta_omega", "k1", "k2", "eta1", "eta2"}));
+  EXPECT_EQ(tunableGainNames(pair("kanayama+pid")), (Names{"kx", "ky", "ktheta", "kp", "ki", "kd", "feedforward"}));
+  EXPECT_EQ(tunableGainNames(pair("rpp+pid")), (Names{"lookahead_dist", "regulated_linear_scaling_min_radius",
+                                                      "k_along", "kp", "ki", "kd", "feedforward"}));
+  // Plain pure pursuit has no regulation radius.
+  EXPECT_EQ(tunableGainNames(pair("pure_pursuit+pid")),
+            (Names{"lookahead_dist", "k_along", "kp", "ki", "kd", "feedforward"}));
+  EXPECT_EQ(tunableGainNames(), tunableGainNames(Scenario()));
+}
+
+TEST(TunableGains, EveryMarkHasSearchBoundsTheControllerAccepts) {
+  for (const char* name : {"kanayama+atsmc", "kanayama+tsmc", "kanayama+pid", "rpp+pid", "rpp+atsmc"}) {
+    const Scenario sc = pair(name);
+    const std::vector<GainBounds> box = defaultGainBounds(sc);
+    ASSERT_EQ(box.size(), tunableGainNames(sc).size()) << name;
+    for (const GainBounds& b : box) EXPECT_TRUE(b.lower < b.upper) << name << " " << b.name;
+    EXPECT_EQ(validateGainBounds(sc, box), "") << name;
+  }
+  EXPECT_TRUE(std::isnan(gainSearchBounds("bogus").lower));
+}
+
+TEST(TunableGains, SetAndGetReachThePairsOwnParameters) {
+  Scenario sc = pair("rpp+pid");
+  EXPECT_TRUE(setGain(sc, "lookahead_dist", 0.45));
+  EXPECT_EQ(sc.pure_pursuit.lookahead_dist, 0.45);
+  EXPECT_TRUE(setGain(sc, "kp", 7.0));
+  EXPECT_EQ(sc.pid.kp, 7.0);
+  EXPECT_EQ(getGain(sc, "kp"), 7.0);
+  EXPECT_FALSE(setGain(sc, "kx", 2.0));  // not a gain of rpp+pid
+  EXPECT_TRUE(std::isnan(getGain(sc, "k1")));
+  EXPECT_EQ(gainNode(sc, "kp"), "torque_controller");
+  EXPECT_EQ(gainKey(sc, "kp"), "pid/kp");
+  EXPECT_EQ(gainKey(sc, "lookahead_dist"), "pure_pursuit/lookahead_dist");
+  EXPECT_NE(validateGainBounds(sc, {{"kx", 0.1, 10.0}}).find("no tunable gain of rpp+pid"), std::string::npos);
+}
+
+TEST(TunableGains, ControllerParamsByNodeKey) {
+  Scenario sc;
+  EXPECT_EQ(setControllerParam(sc, "torque_controller", "adaptation", std::string("eq_4_22")), "");
+  EXPECT_EQ(sc.sliding.adaptation, Adaptation::eq_4_22);
+  EXPECT_EQ(setControllerParam(sc, "torque_controller", "pid/ki", 3), "");  // an int for a double
+  EXPECT_EQ(sc.pid.ki, 3.0);
+  EXPECT_EQ(setControllerParam(sc, "kinematic_controller", "pure_pursuit/k_along", 1.5), "");
+  EXPECT_EQ(sc.pure_pursuit.k_along, 1.5);
+  EXPECT_NE(setControllerParam(sc, "kinematic_controller", "kz", 1.0), "");
+  EXPECT_NE(setControllerParam(sc, "torque_controller", "k1", -1.0), "");
+  EXPECT_NE(setControllerParam(sc, "plant_sim", "k1", 1.0), "");
+}
+
+TEST(GainsYaml, NestsTheBaselinesAndNamesTheVariant) {
+  Scenario sc = pair("rpp+pid");
+  const std::string y = gainsYaml(sc, {{"kp", 0.0, 50.0}});
+  EXPECT_NE(y.find("kinematic_controller:\n  pure_pursuit:\n    lookahead_dist: 0.6"), std::string::npos) << y;
+  EXPECT_NE(y.find("torque_controller:\n  pid:\n    kp: 2.0"), std::string::npos) << y;
+  EXPECT_NE(y.find("# tuned in [0, 50]"), std::string::npos) << y;
+  Scenario a = pair("kanayama+atsmc");
+  EXPECT_EQ(gainsYaml(a, {}).find("adaptation"), std::string::npos);  // default reading: gains only
+  a.sliding.adaptation = Adaptation::eq_4_22;
+  EXPECT_NE(gainsYaml(a, {}).find("  adaptation: eq_4_22"), std::string::npos);
+}

@@ -103,7 +103,8 @@ struct PsoTunerSettings {
   PsoTunerSettings();
   int particles, iterations, seed, threads;
   double velocity_clamp, w_max, w_min, c1, c2;
-  bool adaptive;  ///< mode: the controller tuned
+  bool adaptive;           ///< mode: the controller tuned
+  std::string controller;  ///< "outer+inner" tuned; "" = kanayama + mode
   double duration, control_rate;
   std::string cost, output;
   double torque_weight, chattering_weight;

@@ -14,6 +14,12 @@ namespace core {
 /// Real power x^(num/den) for an odd den, i.e. the real root: sign(x)^num |x|^(num/den).
 double realPower(double x, int num, int den);
 
+/// Which estimate the adaptation rates act on (README deviation 8, docs/deviations.md).
+///   mass_inertia (default): the rates multiply S·phi in the laws of m0_hat and I0_hat themselves;
+///   eq_4_22: the literal eq 4.22, the rates act on gamma_hat = m0_hat R and alpha_hat = I0_hat R / L,
+///            so m0_hat moves 1/R (~10.5x) and I0_hat L/R times as fast for the same rate.
+enum class Adaptation { mass_inertia, eq_4_22 };
+
 /// Defaults, ranges, units and meanings: slidingModeTable().
 struct SlidingModeParams {
   SlidingModeParams();
@@ -23,6 +29,7 @@ struct SlidingModeParams {
   double k1, k2;                  ///< feedback gains K1 [N·m·s/m], K2 [N·m·s/rad]
   double eta1, eta2;              ///< switching gains [N·m]
   double rate_m, rate_i;          ///< adaptation rates of m0_hat and I0_hat (Table 5.3 gamma1/2)
+  Adaptation adaptation;          ///< what rate_m, rate_i act on (default mass_inertia)
   double m0_min, m0_max;          ///< projection bounds on m0_hat [kg]
   double i0_min, i0_max;          ///< projection bounds on I0_hat [kg·m^2]
   double m0_initial, i0_initial;  ///< initial/nominal estimates; 0 means "from the URDF"
@@ -32,7 +39,7 @@ struct SlidingModeParams {
   /// Ranges (the table), then p/q odd with 1 < p/q < 2, min < max, initial estimates within the bounds.
   std::string validate() const;
 };
-/// mode, p, q, beta_v, beta_omega, k1, k2, eta1, eta2, rate_m, rate_i, m0_min, m0_max, i0_min, i0_max,
+/// mode, p, q, beta_v, beta_omega, k1, k2, eta1, eta2, rate_m, rate_i, adaptation, m0_min, m0_max, i0_min, i0_max,
 /// m0_initial, i0_initial, max_torque, switching, switch_width.
 const ParamTable<SlidingModeParams>& slidingModeTable();
 
@@ -80,6 +87,7 @@ class SlidingModeController {
   double R_, L_;
   double m0_initial_, i0_initial_;
   double m0_hat_, i0_hat_;
+  double rate_m_, rate_i_;  ///< the rates of m0_hat and I0_hat themselves (params_ scaled by `adaptation`)
   Channel linear_, angular_;
   SlidingModeOutput last_output_;  ///< held on a rejected input
 };

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "sowing_robot/core/param_table.h"
 #include "sowing_robot/core/pso.h"
 #include "sowing_robot/core/reference.h"
 #include "sowing_robot/core/runner.h"
@@ -22,15 +23,28 @@ enum class CostType { ITAE, ISE, IAE, ITSE };
 bool parseCostType(const std::string& name, CostType& out);
 const char* costTypeName(CostType type);
 
-/// The gains the tuner may search, in their node's parameter names:
-/// kx, ky, ktheta (kinematic_controller) and k1, k2, eta1, eta2, beta_v, beta_omega, rate_m, rate_i
-/// (torque_controller).
+/// The gains the tuner may search for the scenario's controller pair (Scenario::outer, inner), outer's
+/// then inner's, each in its table's order: the entries marked `tunable` in kanayamaTable() /
+/// purePursuitTable() (outer) and slidingModeTable() / wheelPidTable() (inner). Two marks only apply
+/// where they act: rate_m, rate_i only for an adaptive sliding-mode inner (ATSMC), RPP's
+/// regulated_linear_scaling_min_radius only for rpp. Names are the tables' keys (unique over all four).
+std::vector<std::string> tunableGainNames(const Scenario& sc);
+/// The same for the default pair kanayama+atsmc: kx, ky, ktheta, beta_v, ..., rate_m, rate_i.
 const std::vector<std::string>& tunableGainNames();
-/// "kinematic_controller" or "torque_controller" for a tunable gain, "" for anything else.
-std::string gainNode(const std::string& name);
-/// Set / read a tunable gain in the scenario; false / NaN for an unknown name.
+/// The node whose parameters hold this gain of the scenario's pair ("kinematic_controller" or
+/// "torque_controller"), "" if the pair has no such tunable gain.
+std::string gainNode(const Scenario& sc, const std::string& name);
+/// The gain's key under its node, as the nodes and the gains YAML nest it: "kx", "k1" (Kanayama and the
+/// sliding-mode table at the node's top level), "pure_pursuit/lookahead_dist", "pid/kp".
+std::string gainKey(const Scenario& sc, const std::string& name);
+/// Set / read a tunable gain of the scenario's pair; false / NaN for a name the pair does not tune.
 bool setGain(Scenario& sc, const std::string& name, double value);
 double getGain(const Scenario& sc, const std::string& name);
+
+/// One parameter of a controller by its node and key as in a gains YAML or the node's namespace
+/// (gainKey's nesting; any table entry, tunable or not: "torque_controller", "adaptation", "eq_4_22").
+/// Applies to the scenario's tables whatever the pair. "" or one line naming the bad key or value.
+std::string setControllerParam(Scenario& sc, const std::string& node, const std::string& key, const ParamValue& value);
 
 /// One dimension of the search box [same unit as the gain].
 struct GainBounds {
@@ -38,9 +52,24 @@ struct GainBounds {
   double lower = 0.0, upper = 0.0;
 };
 
-/// The default search space: Kanayama kx, ky, ktheta in [0.1, 10]; K1, K2 in [0.1, 1000] (Table 5.4);
-/// eta1, eta2 in [0.1, 10] N·m.
+/// The search bounds of every tunable gain, one list beside the tables (tuning.cpp): Kanayama kx, ky,
+/// ktheta [0.1, 10]; beta [0.1, 2], K1, K2 [0.1, 1000] (Table 5.4); eta [0.1, 10] N·m; rates [0, 10];
+/// pure pursuit lookahead [0.3, 0.9] m (nav2's min/max), k_along [0, 10] 1/s, RPP min radius [0.1, 3] m;
+/// PID kp [0, 50], ki [0, 500], kd [0, 0.5], feedforward [0, 2]. NaN bounds for an unknown name.
+GainBounds gainSearchBounds(const std::string& name);
+/// The whole search space of the scenario's pair: every tunableGainNames(sc) with gainSearchBounds.
+std::vector<GainBounds> defaultGainBounds(const Scenario& sc);
+/// The seven gains results/tuned_gains.yaml searched (kanayama+atsmc without beta and the rates): kx,
+/// ky, ktheta [0.1, 10]; K1, K2 [0.1, 1000] (Table 5.4); eta1, eta2 [0.1, 10] N·m.
 std::vector<GainBounds> defaultGainBounds();
+
+/// The gains YAML body: every tunable gain of the tuned scenario's pair under its node (gainKey's
+/// nesting: pure_pursuit:, pid: sub-maps), the tuned ones commented with their bounds, the others
+/// "base value (not tuned)"; for an adaptive sliding-mode inner also torque_controller/adaptation (the
+/// reading the rates were tuned for). rosparam-loadable; sim.launch gains:=FILE.
+std::string gainsYaml(const Scenario& tuned, const std::vector<GainBounds>& searched);
+/// Shortest round-trip decimal form of v that YAML 1.1 (rosparam) reads as a float (always has a '.').
+std::string yamlFloat(double v);
 
 /// "" if the list is usable with this base scenario, else one line naming the first bad entry: empty
 /// list, unknown or repeated name, non-finite bound, lower >= upper, or a bound the controller itself

@@ -28,6 +28,8 @@ class PsoTuner {
  private:
   void onProgress(const core::PsoProgress& p);
   std::string scenarioText() const;
+  std::string adaptationText() const;
+  std::string loadArgs() const;
 
   core::Scenario base_;
   core::LineReference reference_;
@@ -40,9 +42,9 @@ class PsoTuner {
   ros::Publisher progress_pub_;
 };
 
-/// Writes the gains YAML (all tunable gains under kinematic_controller / torque_controller, the tuned
-/// ones marked with their bounds) after `header` (lines already starting with '#'). Written to a
-/// temporary file and renamed, so a reader never sees half a file. "" on success, else the reason.
+/// Writes the gains YAML (core::gainsYaml: every tunable gain of the pair under kinematic_controller /
+/// torque_controller, the tuned ones marked with their bounds) after `header` (lines already starting with '#').
+/// Written to a temporary file and renamed, so a reader never sees half a file. "" on success, else the reason.
 std::string writeGainsYaml(const std::string& path, const std::string& header, const core::Scenario& tuned,
                            const std::vector<core::GainBounds>& searched);
 
