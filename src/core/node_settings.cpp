@@ -87,9 +87,6 @@ void nestMarked(ParamTable<S>& out, N S::*member, const ParamTable<N>& table,
   }
 }
 
-std::function<std::string(const std::string&)> markAll(const std::string& mark) {
-  return [mark](const std::string&) { return mark; };
-}
 
 }  // namespace
 
@@ -107,7 +104,7 @@ const ParamTable<KinematicControllerSettings>& KinematicControllerSettings::tabl
                "realtime: a reference older than this commands a stop (simulated time); shorter than "
                "torque_controller's, so a silent reference generator is reported as such"),
     });
-    nestMarked(t, &S::gains, kanayamaTable(), markAll("[kanayama]"));
+    t.nest("", &S::gains, kanayamaTable());  // unmarked: Kanayama's (the thesis's, as before the baselines)
     nestMarked(t, &S::pure_pursuit, purePursuitTable(), [](const std::string& key) {
       return key.rfind("regulated_", 0) == 0 ? "[rpp]" : "[pure_pursuit, rpp]";  // RPP's speed heuristic
     });
@@ -134,12 +131,12 @@ const ParamTable<TorqueControllerSettings>& TorqueControllerSettings::table() {
                "realtime: a desired_velocity older than this gives zero torque; the sliding integrals (PID: "
                "its integrals) restart when it returns (simulated time)"),
     });
-    // max_torque: one key, the motor's limit, for whichever controller runs.
+    // Unmarked: the sliding-mode controller's (as before the baselines), but max_torque: one key, the
+    // motor's limit, for whichever controller runs.
     ParamTable<S> sliding;
-    nestMarked(sliding, &S::sliding, slidingModeTable(), markAll("[sliding_mode]"));
+    sliding.nest("", &S::sliding, slidingModeTable());
     for (ParamEntry<S> e : sliding.entries()) {
       if (e.info.key == "max_torque") {
-        e.info.meaning = "[sliding_mode, pid] " + slidingModeTable().find("max_torque")->info.meaning;
         e.set = [set = e.set](S& s, const ParamValue& v) {
           set(s, v);
           s.pid.max_torque = s.sliding.max_torque;
