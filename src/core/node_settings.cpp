@@ -87,7 +87,6 @@ void nestMarked(ParamTable<S>& out, N S::*member, const ParamTable<N>& table,
   }
 }
 
-
 }  // namespace
 
 const ParamTable<KinematicControllerSettings>& KinematicControllerSettings::table() {
@@ -95,9 +94,7 @@ const ParamTable<KinematicControllerSettings>& KinematicControllerSettings::tabl
   static const ParamTable<S> table = [] {
     ParamTable<S> t({
         choice("outer", &S::outer, OuterKind::kanayama,
-               {{"kanayama", OuterKind::kanayama},
-                {"pure_pursuit", OuterKind::pure_pursuit},
-                {"rpp", OuterKind::rpp}},
+               {{"kanayama", OuterKind::kanayama}, {"pure_pursuit", OuterKind::pure_pursuit}, {"rpp", OuterKind::rpp}},
                "the outer controller: Kanayama (eqs 4.1-4.2), pure pursuit, or nav2's Regulated Pure Pursuit; "
                "the parameters of the others are checked but inert"),
         number("input_timeout", &S::input_timeout, 0.05, Limits::positive(), "s",

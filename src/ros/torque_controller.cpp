@@ -26,8 +26,8 @@ TorqueController::TorqueController(ros::NodeHandle nh, ros::NodeHandle pnh) {
     pid_ = &pid->controller();
     inner_ = std::move(pid);
   } else {
-    auto smc = std::make_unique<core::InnerAdapter<core::SlidingModeController>>(
-        core::SlidingModeController(params, robot));
+    auto smc =
+        std::make_unique<core::InnerAdapter<core::SlidingModeController>>(core::SlidingModeController(params, robot));
     smc_ = &smc->controller();
     inner_ = std::move(smc);
   }
