@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <functional>
 #include <sstream>
 
 #include "sowing_robot/core/validation.h"
@@ -94,30 +95,80 @@ std::string PlantSimSettings::validate() const {
   return firstError({table().checkRanges(*this), names_error, disturbance.validate()});
 }
 
+namespace {
+
+/// `table`'s entries under `member`, each meaning prefixed by `mark(key)`: which controller reads it,
+/// "[kanayama]" (an empty mark leaves the entry out).
+template <typename S, typename N>
+void nestMarked(ParamTable<S>& out, N S::*member, const ParamTable<N>& table,
+                const std::function<std::string(const std::string&)>& mark) {
+  ParamTable<S> nested;
+  nested.nest("", member, table);
+  for (ParamEntry<S> e : nested.entries()) {
+    const std::string m = mark(e.info.key);
+    if (m.empty()) continue;
+    e.info.meaning = m + " " + e.info.meaning;
+    out.add(std::move(e));
+  }
+}
+
+}  // namespace
+
 const ParamTable<KinematicControllerSettings>& KinematicControllerSettings::table() {
   using S = KinematicControllerSettings;
   static const ParamTable<S> table = [] {
     ParamTable<S> t({
+        choice("outer", &S::outer, OuterKind::kanayama,
+               {{"kanayama", OuterKind::kanayama}, {"pure_pursuit", OuterKind::pure_pursuit}, {"rpp", OuterKind::rpp}},
+               "the outer controller: Kanayama (eqs 4.1-4.2), pure pursuit, or nav2's Regulated Pure Pursuit; "
+               "the parameters of the others are checked but inert"),
         number("input_timeout", &S::input_timeout, 0.05, Limits::positive(), "s",
                "realtime: a reference older than this commands a stop (simulated time); shorter than "
                "torque_controller's, so a silent reference generator is reported as such"),
     });
-    return t.nest("", &S::gains, kanayamaTable());
+    t.nest("", &S::gains, kanayamaTable());  // unmarked: Kanayama's (the thesis's, as before the baselines)
+    nestMarked(t, &S::pure_pursuit, purePursuitTable(), [](const std::string& key) {
+      return key.rfind("regulated_", 0) == 0 ? "[rpp]" : "[pure_pursuit, rpp]";  // RPP's speed heuristic
+    });
+    return t;
   }();
   return table;
 }
 
 KinematicControllerSettings::KinematicControllerSettings() { table().applyDefaults(*this); }
 
+std::string KinematicControllerSettings::validate() const {
+  return firstError({table().checkRanges(*this), pure_pursuit.validate()});
+}
+
 const ParamTable<TorqueControllerSettings>& TorqueControllerSettings::table() {
   using S = TorqueControllerSettings;
   static const ParamTable<S> table = [] {
     ParamTable<S> t({
+        choice("inner", &S::inner, InnerKind::sliding_mode,
+               {{"sliding_mode", InnerKind::sliding_mode}, {"pid", InnerKind::pid}},
+               "the inner controller: the sliding-mode controller (atsmc or tsmc by `mode`) or the wheel-velocity "
+               "PID; the parameters of the other are checked but inert"),
         number("input_timeout", &S::input_timeout, 0.1, Limits::positive(), "s",
-               "realtime: a desired_velocity older than this gives zero torque; the sliding integrals restart "
-               "when it returns (simulated time)"),
+               "realtime: a desired_velocity older than this gives zero torque; the sliding integrals (PID: "
+               "its integrals) restart when it returns (simulated time)"),
     });
-    return t.nest("", &S::sliding, slidingModeTable());
+    // Unmarked: the sliding-mode controller's (as before the baselines), but max_torque: one key, the
+    // motor's limit, for whichever controller runs.
+    ParamTable<S> sliding;
+    sliding.nest("", &S::sliding, slidingModeTable());
+    for (ParamEntry<S> e : sliding.entries()) {
+      if (e.info.key == "max_torque") {
+        e.set = [set = e.set](S& s, const ParamValue& v) {
+          set(s, v);
+          s.pid.max_torque = s.sliding.max_torque;
+        };
+      }
+      t.add(std::move(e));
+    }
+    nestMarked(t, &S::pid, wheelPidTable(),
+               [](const std::string& key) { return key == "max_torque" ? std::string() : std::string("[pid]"); });
+    return t;
   }();
   return table;
 }
@@ -125,7 +176,7 @@ const ParamTable<TorqueControllerSettings>& TorqueControllerSettings::table() {
 TorqueControllerSettings::TorqueControllerSettings() { table().applyDefaults(*this); }
 
 std::string TorqueControllerSettings::validate() const {
-  return firstError({table().checkRanges(*this), sliding.validate()});
+  return firstError({table().checkRanges(*this), sliding.validate(), pid.validate()});
 }
 
 const ParamTable<ReferenceGeneratorSettings>& ReferenceGeneratorSettings::table() {

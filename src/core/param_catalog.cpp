@@ -95,11 +95,16 @@ const std::vector<CatalogSection>& parameterCatalog() {
        infos(PlantSimSettings::table()),
        {}},
       {"kinematic_controller",
-       "Kanayama outer loop, eqs 4.1-4.2 (kx, ky, ktheta live-tunable)",
+       "the outer loop, chosen by `outer`: Kanayama (eqs 4.1-4.2; kx, ky, ktheta live-tunable), pure pursuit or "
+       "nav2's Regulated Pure Pursuit (nav2's parameter names; start-up only). Unmarked parameters are Kanayama's, "
+       "[marked] ones the baselines'; the parameters of the controllers not selected are checked but inert",
        infos(KinematicControllerSettings::table()),
        {}},
       {"torque_controller",
-       "integral terminal sliding-mode inner loop, eqs 4.7-4.22 (gains live-tunable)",
+       "the inner loop, chosen by `inner`: the integral terminal sliding-mode controller (eqs 4.7-4.22; `mode` "
+       "atsmc or tsmc; gains live-tunable) or the wheel-velocity PID (start-up only). Unmarked parameters are the "
+       "sliding-mode controller's, [pid] ones the PID's; max_torque (the motor's limit) is both's; the parameters "
+       "of the controller not selected are checked but inert",
        infos(TorqueControllerSettings::table()),
        {}},
       {"reference_generator",

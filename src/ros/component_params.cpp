@@ -103,8 +103,12 @@ std::string loadPipelineScenario(core::Scenario& sc, double& duration) {
   sc.start = run.start();
   duration = run.duration;
   sc.duration = duration;
+  sc.outer = kin_settings.outer;
   sc.kanayama = kin_settings.gains;
+  sc.pure_pursuit = kin_settings.pure_pursuit;
+  sc.inner = torque_settings.inner;
   sc.sliding = torque_settings.sliding;
+  sc.pid = torque_settings.pid;
   return sc.validate();
 }
 

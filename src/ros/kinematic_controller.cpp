@@ -15,16 +15,26 @@ KinematicController::KinematicController(ros::NodeHandle nh, ros::NodeHandle pnh
   loadTable(p, core::KinematicControllerSettings::table(), settings);
   requireValid(p, settings.validate());
   input_timeout_ = settings.input_timeout;
-  kanayama_.setGains(settings.gains);
+  if (settings.outer == core::OuterKind::kanayama) {
+    auto kanayama = std::make_unique<core::OuterAdapter<core::Kanayama>>(core::Kanayama(settings.gains));
+    kanayama_ = &kanayama->controller();
+    outer_ = std::move(kanayama);
+  } else {  // validated above, so the constructor does not throw
+    outer_ = std::make_unique<core::OuterAdapter<core::PurePursuit>>(
+        core::PurePursuit(settings.pure_pursuit, settings.outer == core::OuterKind::rpp));
+  }
   logSettings("kinematic_controller", core::KinematicControllerSettings::table(), settings);
+  ROS_INFO("kinematic_controller: outer controller %s", core::outerName(settings.outer));
   lockstep_ = run.lockstep;  // lockstep: wait for the paired reference, never time out
-  reconfigure_ = std::make_unique<dynamic_reconfigure::Server<KinematicControllerConfig>>(pnh);
-  // The server starts from the .cfg defaults where a key is not set: hand it the gains in force first,
-  // so its first callback changes nothing.
-  KinematicControllerConfig in_force;
-  toConfig(core::kanayamaTable(), settings.gains, in_force);
-  reconfigure_->updateConfig(in_force);
-  reconfigure_->setCallback([this](KinematicControllerConfig& c, uint32_t level) { reconfigure(c, level); });
+  if (kanayama_) {
+    reconfigure_ = std::make_unique<dynamic_reconfigure::Server<KinematicControllerConfig>>(pnh);
+    // The server starts from the .cfg defaults where a key is not set: hand it the gains in force first,
+    // so its first callback changes nothing.
+    KinematicControllerConfig in_force;
+    toConfig(core::kanayamaTable(), settings.gains, in_force);
+    reconfigure_->updateConfig(in_force);
+    reconfigure_->setCallback([this](KinematicControllerConfig& c, uint32_t level) { reconfigure(c, level); });
+  }
   desired_pub_ = nh.advertise<DesiredVelocity>("desired_velocity", kLockstepQueue);
   error_pub_ = nh.advertise<TrackingError>("tracking_error", kLockstepQueue);
   const auto hints = ros::TransportHints().tcpNoDelay();
@@ -34,7 +44,7 @@ KinematicController::KinematicController(ros::NodeHandle nh, ros::NodeHandle pnh
 }
 
 void KinematicController::reconfigure(KinematicControllerConfig& config, uint32_t) {
-  const core::KanayamaGains old = kanayama_.gains();
+  const core::KanayamaGains old = kanayama_->gains();
   core::KanayamaGains g = old;
   std::string error = fromConfig(core::kanayamaTable(), config, g);
   if (error.empty() && g.kx == old.kx && g.ky == old.ky && g.ktheta == old.ktheta) return;
@@ -45,7 +55,7 @@ void KinematicController::reconfigure(KinematicControllerConfig& config, uint32_
     toConfig(core::kanayamaTable(), old, config);  // the server then reports (and stores) the values in force
     return;
   }
-  kanayama_.setGains(g);
+  kanayama_->setGains(g);
   ROS_INFO("kinematic_controller: gains now kx %g, ky %g, ktheta %g", g.kx, g.ky, g.ktheta);
 }
 
@@ -106,7 +116,7 @@ void KinematicController::compute() {
   ref.omega = r.omega;
   ref.v_dot = r.v_dot;
   ref.omega_dot = r.omega_dot;
-  const core::VelocityCommand cmd = kanayama_.compute(ref, pose, odom.twist.twist.linear.x, odom.twist.twist.angular.z);
+  const core::VelocityCommand cmd = outer_->compute(ref, pose, odom.twist.twist.linear.x, odom.twist.twist.angular.z);
   desired_.header.stamp = odom.header.stamp;
   desired_.v = cmd.v;
   desired_.omega = cmd.omega;

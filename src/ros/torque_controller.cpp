@@ -20,16 +20,28 @@ TorqueController::TorqueController(ros::NodeHandle nh, ros::NodeHandle pnh) {
   input_timeout_ = settings.input_timeout;
   lockstep_ = run.lockstep;  // lockstep: wait for the paired desired velocity, never time out
   dt_ = core::secondsFromNanos(run.periodNs());
-  smc_ = std::make_unique<core::SlidingModeController>(params, robot);
+  // Validated above, so the constructors do not throw.
+  if (settings.inner == core::InnerKind::pid) {
+    auto pid = std::make_unique<core::InnerAdapter<core::WheelPid>>(core::WheelPid(settings.pid, robot));
+    pid_ = &pid->controller();
+    inner_ = std::move(pid);
+  } else {
+    auto smc =
+        std::make_unique<core::InnerAdapter<core::SlidingModeController>>(core::SlidingModeController(params, robot));
+    smc_ = &smc->controller();
+    inner_ = std::move(smc);
+  }
   logSettings("torque_controller", core::TorqueControllerSettings::table(), settings);
-  ROS_INFO("torque_controller: m0_hat starts at %.4f kg, I0_hat at %.5f kg m^2; %.0f Hz", smc_->m0Hat(), smc_->i0Hat(),
-           1.0 / dt_);
-  state_.mode = params.adaptive ? "atsmc" : "tsmc";
-  reconfigure_ = std::make_unique<dynamic_reconfigure::Server<TorqueControllerConfig>>(pnh);
-  TorqueControllerConfig in_force;  // see KinematicController: the server's first callback changes nothing
-  toConfig(core::slidingModeTable(), params, in_force);
-  reconfigure_->updateConfig(in_force);
-  reconfigure_->setCallback([this](TorqueControllerConfig& c, uint32_t level) { reconfigure(c, level); });
+  ROS_INFO("torque_controller: inner controller %s; m0_hat starts at %.4f kg, I0_hat at %.5f kg m^2; %.0f Hz",
+           settings.innerName().c_str(), inner_->m0Hat(), inner_->i0Hat(), 1.0 / dt_);
+  state_.mode = settings.innerName();
+  if (smc_) {
+    reconfigure_ = std::make_unique<dynamic_reconfigure::Server<TorqueControllerConfig>>(pnh);
+    TorqueControllerConfig in_force;  // see KinematicController: the server's first callback changes nothing
+    toConfig(core::slidingModeTable(), params, in_force);
+    reconfigure_->updateConfig(in_force);
+    reconfigure_->setCallback([this](TorqueControllerConfig& c, uint32_t level) { reconfigure(c, level); });
+  }
   torque_pub_ = nh.advertise<WheelTorque>("wheel_torque", kLockstepQueue);
   state_pub_ = pnh.advertise<TorqueControllerState>("state", kLockstepQueue);
   const auto hints = ros::TransportHints().tcpNoDelay();
@@ -98,27 +110,30 @@ void TorqueController::compute() {
   const nav_msgs::Odometry& odom = inputs_.first();
   const DesiredVelocity& d = inputs_.second();
   const core::VelocityCommand cmd{d.v, d.omega, d.v_dot, d.omega_dot};
-  if (stale_) {  // input is back after a gap: restart the sliding integrals, keep the estimates
-    smc_->resetSurfaces();
+  if (stale_) {  // input is back after a gap: restart the integrals (sliding mode: keep the estimates)
+    if (smc_)
+      smc_->resetSurfaces();
+    else
+      inner_->reset();
     stale_ = false;
     ROS_INFO("torque_controller: desired_velocity is back at t = %.3f s: resuming", odom.header.stamp.toSec());
   }
-  const core::SlidingModeOutput out = smc_->update(cmd, odom.twist.twist.linear.x, odom.twist.twist.angular.z, dt_);
+  const core::InnerOutput out = inner_->update(cmd, odom.twist.twist.linear.x, odom.twist.twist.angular.z, dt_);
   torque_.header.stamp = odom.header.stamp;
   torque_.right = out.torques.right;
   torque_.left = out.torques.left;
   publishShared(torque_pub_, torque_);
   if (out.saturated)
     ROS_WARN_THROTTLE(2.0, "torque_controller: wheel torque saturated at %.4g N m (%ld periods so far)",
-                      smc_->params().max_torque, ++saturated_);
+                      smc_ ? smc_->params().max_torque : pid_->params().max_torque, ++saturated_);
 
   state_.header.stamp = odom.header.stamp;
   state_.e_v = out.e_v;
   state_.e_omega = out.e_omega;
   state_.s_v = out.s_v;
   state_.s_omega = out.s_omega;
-  state_.m0_hat = smc_->m0Hat();
-  state_.i0_hat = smc_->i0Hat();
+  state_.m0_hat = inner_->m0Hat();
+  state_.i0_hat = inner_->i0Hat();
   state_.u1 = out.u1;
   state_.u2 = out.u2;
   state_.saturated = out.saturated;

@@ -29,6 +29,16 @@ CASES = [
     ("torque_controller", {"switching": "magic"}, "switching"),
     ("torque_controller", {"mode": "pid"}, "mode"),
     ("kinematic_controller", {"kx": -1.0}, "kx"),
+    # the controller pair (issue 17): an unknown name, a typo of a baseline's key, and a bad value of a
+    # parameter of a controller not selected (checked although inert)
+    ("kinematic_controller", {"outer": "stanley"}, "outer"),
+    ("torque_controller", {"inner": "lqr"}, "inner"),
+    ("torque_controller", {"inner": "atsmc"}, "one of sliding_mode, pid"),  # atsmc is a mode, not an inner
+    ("kinematic_controller", {"lookahead_distance": 0.6}, "lookahead_distance"),  # typo: unknown key
+    ("torque_controller", {"kpp": 1.0}, "kpp"),  # typo: unknown key
+    ("kinematic_controller", {"lookahead_dist": 2.0}, "lookahead_dist"),  # above max_lookahead_dist, outer kanayama
+    ("torque_controller", {"inner": "pid", "kp": -1.0}, "kp"),
+    ("torque_controller", {"inner": "pid", "feedforward": 3.0}, "feedforward"),
     ("kinematic_controller", {"ky": float("inf")}, "ky"),
     ("reference_generator", {"line/v_r": -1.0}, "v_r"),
     # a key the configuration does not read is refused like an unknown one: field keys with type line

@@ -1,6 +1,8 @@
 // rostest: watches a lockstep run of the node pipeline to its end, then checks the tracking result
 // against the limits passed as <param>s and repeats the same scenario with the in-process runner
-// (parameters read from the nodes' own namespaces): the metrics must agree bit for bit.
+// (parameters read from the nodes' own namespaces, the outer/inner controller pair included): the
+// metrics must agree bit for bit. ~expect_pair (optional, e.g. "rpp+pid") checks the pair read is the
+// one the test means, so a fixture that silently fell back to kanayama+atsmc cannot pass.
 #include <gtest/gtest.h>
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
@@ -40,11 +42,15 @@ TEST(Pipeline, LockstepRunTracksTheLineAndEqualsTheInProcessRunner) {
   pnh.getParam("max_final_ey", max_ey);
   pnh.getParam("max_final_etheta", max_etheta);
   pnh.getParam("wall_timeout", timeout);
+  std::string expect_pair;
+  pnh.getParam("expect_pair", expect_pair);
 
   core::Scenario sc;
   double duration = 0;
   const std::string err = loadPipelineScenario(sc, duration);
   ASSERT_TRUE(err.empty()) << err;
+  std::printf("pipeline: controller pair %s\n", sc.controllerName().c_str());
+  if (!expect_pair.empty()) ASSERT_EQ(sc.controllerName(), expect_pair);
 
   Watch w;
   ros::Subscriber sub = nh.subscribe("tracking_error", 100000, &Watch::onError, &w, ros::TransportHints().tcpNoDelay());

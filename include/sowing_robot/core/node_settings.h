@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "sowing_robot/core/controllers.h"
 #include "sowing_robot/core/field.h"
 #include "sowing_robot/core/kanayama.h"
 #include "sowing_robot/core/param_table.h"
@@ -49,21 +50,33 @@ struct PlantSimSettings {
   static const ParamTable<PlantSimSettings>& table();
 };
 
-/// kinematic_controller: the Kanayama gains (nested) and the reference timeout.
+/// kinematic_controller: which outer controller (`outer`), the Kanayama gains and the pure pursuit /
+/// RPP parameters (nested, flat keys: nav2's names), and the reference timeout. Every parameter is read
+/// and checked whatever `outer` is; only the selected controller's are used (the others are inert).
 struct KinematicControllerSettings {
   KinematicControllerSettings();
   double input_timeout;
+  OuterKind outer;
   KanayamaGains gains;
-  std::string validate() const { return table().checkRanges(*this); }
+  PurePursuitParams pure_pursuit;
+  /// Ranges (the table), then the pure pursuit's min <= L <= max (checked even when not selected).
+  std::string validate() const;
   static const ParamTable<KinematicControllerSettings>& table();
 };
 
-/// torque_controller: the sliding-mode parameters (nested) and the desired-velocity timeout.
+/// torque_controller: which inner controller (`inner`: sliding_mode, whose `mode` picks atsmc or tsmc,
+/// or pid), the sliding-mode and wheel-PID parameters (nested, flat keys), and the desired-velocity
+/// timeout. `max_torque` is the motor's per-wheel limit, one key for both controllers. As for the
+/// kinematic controller, the parameters of the controller not selected are checked but inert.
 struct TorqueControllerSettings {
   TorqueControllerSettings();
   double input_timeout;
+  InnerKind inner;
   SlidingModeParams sliding;
+  WheelPidParams pid;  ///< pid.max_torque is always sliding.max_torque (the one `max_torque` key)
   std::string validate() const;
+  /// "atsmc", "tsmc" or "pid": the pair's inner name.
+  std::string innerName() const { return core::innerName(inner, sliding.adaptive); }
   static const ParamTable<TorqueControllerSettings>& table();
 };
 

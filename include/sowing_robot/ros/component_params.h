@@ -59,7 +59,8 @@ std::string loadObstacles(ParamReader& p, const std::string& key, std::vector<co
 void requireValid(const ParamReader& p, const std::string& validate_message);
 
 /// The scenario the node pipeline runs, read from the run settings and the nodes' own namespaces
-/// (/plant_sim, /kinematic_controller, /torque_controller): what the in-process runner needs to repeat a run.
+/// (/plant_sim, /kinematic_controller, /torque_controller): what the in-process runner needs to repeat a run,
+/// the outer/inner choice and every controller's parameters included.
 std::string loadPipelineScenario(core::Scenario& sc, double& duration);
 
 }  // namespace sowing_robot

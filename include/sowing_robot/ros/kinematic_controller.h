@@ -1,5 +1,7 @@
-// kinematic_controller: reference + odom -> desired body velocities (Kanayama, eqs 4.1-4.2) and the
-// tracking error for plotting and metrics.
+// kinematic_controller: reference + odom -> desired body velocities and the tracking error for plotting
+// and metrics. The outer controller is chosen by `outer`: Kanayama (eqs 4.1-4.2, gains live-tunable by
+// dynamic_reconfigure), pure pursuit or nav2's Regulated Pure Pursuit (core/pure_pursuit.h; their
+// parameters are start-up only: the reconfigure server runs only with Kanayama).
 #pragma once
 
 #include <dynamic_reconfigure/server.h>
@@ -12,6 +14,7 @@
 #include "sowing_robot/KinematicControllerConfig.h"
 #include "sowing_robot/ReferenceState.h"
 #include "sowing_robot/TrackingError.h"
+#include "sowing_robot/core/controllers.h"
 #include "sowing_robot/core/kanayama.h"
 #include "sowing_robot/ros/stamp_pair.h"
 #include "sowing_robot/ros/ready_roster.h"
@@ -31,7 +34,8 @@ class KinematicController {
   /// Realtime only: command a stop for this odom stamp when the reference is older than input_timeout.
   void stopIfStale(const nav_msgs::Odometry& odom);
 
-  core::Kanayama kanayama_;
+  std::unique_ptr<core::OuterController> outer_;
+  core::Kanayama* kanayama_ = nullptr;  // outer_'s Kanayama when outer is kanayama (live gain changes), else null
   ros::Subscriber odom_sub_, ref_sub_;
   ros::Publisher desired_pub_, error_pub_;
   bool grid_reported_ = false;  // a control_rate mismatch is reported once

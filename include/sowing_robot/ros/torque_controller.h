@@ -1,5 +1,9 @@
-// torque_controller: desired + measured velocities -> wheel torques (ATSMC or TSMC, eqs 4.7-4.22).
-// Publishes its sliding variables and adaptive estimates on ~state.
+// torque_controller: desired + measured velocities -> wheel torques. The inner controller is chosen by
+// `inner`: the sliding-mode controller (eqs 4.7-4.22; `mode` atsmc or tsmc; gains live-tunable by
+// dynamic_reconfigure) or the wheel-velocity PID (core/wheel_pid.h; start-up parameters only, the
+// reconfigure server runs only with the sliding-mode controller). Publishes its state on ~state: the
+// sliding variables and adaptive estimates, or for the PID the same record with s_v = s_omega = 0 and
+// the nominal m0, I0 (core/controllers.h, InnerOutput).
 #pragma once
 
 #include <dynamic_reconfigure/server.h>
@@ -12,6 +16,7 @@
 #include "sowing_robot/TorqueControllerConfig.h"
 #include "sowing_robot/TorqueControllerState.h"
 #include "sowing_robot/WheelTorque.h"
+#include "sowing_robot/core/controllers.h"
 #include "sowing_robot/core/sliding_mode.h"
 #include "sowing_robot/ros/stamp_pair.h"
 #include "sowing_robot/ros/ready_roster.h"
@@ -31,7 +36,9 @@ class TorqueController {
   /// Realtime only: zero torque for this odom stamp when the desired velocity is older than input_timeout.
   bool holdZeroIfStale(const nav_msgs::Odometry& odom);
 
-  std::unique_ptr<core::SlidingModeController> smc_;
+  std::unique_ptr<core::InnerController> inner_;
+  core::SlidingModeController* smc_ = nullptr;  // inner_'s sliding-mode controller (live gains), else null
+  core::WheelPid* pid_ = nullptr;               // inner_'s PID, else null
   double dt_ = 0.001;
   bool lockstep_;               // run/mode: wait for the paired desired velocity, never time out
   double input_timeout_ = 0.1;  // [s] sim
