@@ -9,10 +9,11 @@ every envelope_period) and writes, into the output directory:
 - envelope_<scenario>.png: per controller, the median cross-track and its 25-75 % and 5-95 % bands over time;
 - sweep_<scenario>.png for scenarios named *sweep*: ITAE y and the worst cross-track against the drawn
   disturbance amplitude, one colour per controller;
-- comparison.md: per scenario, where the reference pair (kanayama+atsmc) is worse than another pair
-  (success rate, medians of the tracking, effort and chattering figures), the raw material of a reading.
+- comparison.md: per scenario, where the reference pair (kanayama+atsmc) is worse than another pair by more
+  than --margin (5 %): success rate, medians of the tracking, effort and chattering figures, mean time at the
+  torque limit; the raw material of a reading.
 
-Usage: benchmark_plots DIR [--output OUT] [--reference kanayama+atsmc]
+Usage: benchmark_plots DIR [--output OUT] [--reference kanayama+atsmc] [--margin 0.05]
 """
 import argparse
 import csv
@@ -199,10 +200,28 @@ def _fmt(v):
     return "inf" if v == math.inf else f"{v:.4g}"
 
 
-def comparison(rows, reference="kanayama+atsmc"):
-    """Markdown: per scenario, every figure where `reference` is worse than another pair, with both values."""
-    lines = [f"Where **{reference}** is worse than another pair (generated from runs.csv by benchmark_plots):", ""]
+def comparison(rows, reference="kanayama+atsmc", margin=0.05):
+    """Markdown: per scenario and other pair, every figure where `reference` is worse by more than `margin`
+    (relative; the success rate by more than one run), with both values. Smaller differences are ties."""
+    lines = [f"Where **{reference}** is worse than another pair by more than {100 * margin:g} % (generated from "
+             "runs.csv by benchmark_plots; success: by at least one run):", ""]
     any_loss = False
+
+    def figure(runs, col):
+        if col == "success":
+            return 100.0 * sum(1 for r in runs if r["success"] == 1) / len(runs)
+        vals = [r[col] for r in runs]
+        if col == "time_at_limit":
+            return sum(vals) / len(vals)
+        return _median([v if not math.isnan(v) else math.inf for v in vals])
+
+    def worse(a, b):  # a (reference) worse than b, lower being better
+        if a == b or math.isnan(a) or math.isnan(b):
+            return False
+        if b == 0.0:
+            return a > 0.0
+        return a > b * (1.0 + margin)
+
     for s in _ordered(r["scenario"] for r in rows):
         by = {}
         for r in rows:
@@ -211,29 +230,22 @@ def comparison(rows, reference="kanayama+atsmc"):
         if reference not in by:
             continue
         ref = by[reference]
-
-        def figure(runs, col, how):
-            vals = [r[col] for r in runs]
-            if how == "rate":
-                return 100.0 * sum(1 for r in runs if r["success"] == 1) / len(runs)
-            if col == "time_at_limit":
-                return sum(vals) / len(vals)
-            return _median([v if not math.isnan(v) else math.inf for v in vals])
-
-        losses = []
-        r_rate = figure(ref, "success", "rate")
+        per_pair = []
         for c, runs in by.items():
             if c == reference:
                 continue
-            rate = figure(runs, "success", "rate")
-            if rate > r_rate:
-                losses.append(f"success {_fmt(r_rate)} % vs {c} {_fmt(rate)} %")
-            for col, label, better in COMPARED:
-                a, b = figure(ref, col, "median"), figure(runs, col, "median")
-                if (better == "low" and a > b) or (better == "high" and a < b):
-                    losses.append(f"{label} {_fmt(a)} vs {c} {_fmt(b)}")
-        lines.append(f"- **{s}**: " + ("; ".join(losses) if losses else "nowhere"))
-        any_loss = any_loss or bool(losses)
+            losses = []
+            ra, rb = figure(ref, "success"), figure(runs, "success")
+            if rb - ra >= 100.0 / max(len(runs), 1) - 1e-9:
+                losses.append(f"success {_fmt(ra)} % vs {_fmt(rb)} %")
+            for col, label, _ in COMPARED:
+                a, b = figure(ref, col), figure(runs, col)
+                if worse(a, b):
+                    losses.append(f"{label} {_fmt(a)} vs {_fmt(b)}")
+            if losses:
+                per_pair.append(f"vs {c}: " + ", ".join(losses))
+        lines.append(f"- **{s}**: " + ("; ".join(per_pair) if per_pair else "nowhere"))
+        any_loss = any_loss or bool(per_pair)
     if not any_loss:
         lines.append("")
         lines.append(f"({reference} is not worse in any compared figure.)")
@@ -245,6 +257,7 @@ def main(argv=None):
     p.add_argument("dir", help="a benchmark --output directory (runs.csv, envelopes.csv)")
     p.add_argument("--output", help="where the PNGs and comparison.md go (default: DIR)")
     p.add_argument("--reference", default="kanayama+atsmc", help="the pair compared against the others")
+    p.add_argument("--margin", type=float, default=0.05, help="relative difference below which figures tie")
     a = p.parse_args(argv)
     out = a.output or a.dir
     os.makedirs(out, exist_ok=True)
@@ -257,7 +270,7 @@ def main(argv=None):
     files += envelope_plots(read_envelopes(os.path.join(a.dir, "envelopes.csv")), out)
     files += sweep_plots(rows, out)
     with open(os.path.join(out, "comparison.md"), "w") as f:
-        f.write(comparison(rows, a.reference))
+        f.write(comparison(rows, a.reference, a.margin))
     files.append("comparison.md")
     print(f"benchmark_plots: {len(files)} files in {out}")
     return 0

@@ -337,11 +337,17 @@ Envelope crossTrackEnvelope(const std::vector<RunRow>& rows, double period) {
 std::string envelopeCsvHeader() { return "scenario,controller,t,p05,p25,p50,p75,p95,max_abs\n"; }
 
 std::string envelopeCsvLines(const std::string& scenario, const std::string& controller, const Envelope& e) {
+  // Six digits: a figure's data (micrometres of cross-track), not a run to repeat (runs.csv has full precision).
+  auto six = [](double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.6g", v);
+    return std::string(buf);
+  };
   std::string out;
   for (std::size_t k = 0; k < e.p50.size(); ++k)
-    out += scenario + "," + controller + "," + number(static_cast<double>(k) * e.period) + "," + number(e.p05[k]) +
-           "," + number(e.p25[k]) + "," + number(e.p50[k]) + "," + number(e.p75[k]) + "," + number(e.p95[k]) + "," +
-           number(e.max_abs[k]) + "\n";
+    out += scenario + "," + controller + "," + six(static_cast<double>(k) * e.period) + "," + six(e.p05[k]) + "," +
+           six(e.p25[k]) + "," + six(e.p50[k]) + "," + six(e.p75[k]) + "," + six(e.p95[k]) + "," + six(e.max_abs[k]) +
+           "\n";
   return out;
 }
 

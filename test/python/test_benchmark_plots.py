@@ -59,10 +59,22 @@ def test_the_comparison_names_where_the_reference_loses(tmp_path):
     rows = benchmark_plots.read_runs(str(write_output(tmp_path) / "runs.csv"))
     text = benchmark_plots.comparison(rows, "kanayama+atsmc")
     line = [l for l in text.splitlines() if l.startswith("- **thesis_line**")][0]
-    assert "median chattering" in line and "median effort" in line
+    assert "vs rpp+pid: " in line and "median chattering" in line and "median effort" in line
     assert "ITAE" not in line  # it tracks better there
     sweep = [l for l in text.splitlines() if l.startswith("- **disturbance_sweep**")][0]
-    assert "success 50 % vs rpp+pid 100 %" in sweep
+    assert "success 50 % vs 100 %" in sweep
+
+
+def test_differences_within_the_margin_are_ties(tmp_path):
+    rows = benchmark_plots.read_runs(str(write_output(tmp_path) / "runs.csv"))
+    for r in rows:  # rpp+pid within 1 % of the reference everywhere on the line
+        if r["scenario"] == "thesis_line" and r["controller"] == "rpp+pid":
+            ref = [x for x in rows if x["scenario"] == "thesis_line" and x["controller"] == "kanayama+atsmc"
+                   and x["seed"] == r["seed"]][0]
+            for k in ("itae_y", "worst_cross_track", "iae_theta", "effort", "chattering", "time_at_limit", "success"):
+                r[k] = ref[k] * 0.99
+    line = [l for l in benchmark_plots.comparison(rows).splitlines() if l.startswith("- **thesis_line**")][0]
+    assert line.endswith("nowhere"), line
 
 
 def test_a_missing_directory_is_one_error_line(tmp_path, capsys):
