@@ -2,10 +2,10 @@
 
 #include <sys/stat.h>
 
+#include <dirent.h>
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
-#include <dirent.h>
 #include <functional>
 #include <map>
 #include <set>
@@ -229,7 +229,8 @@ core::BenchScenario loadScenarioFileImpl(const std::string& path) {
   if (t == tracks.end()) fail(path, "track '" + track + "' is none of line, field, sine");
   b.track = t->second;
   for (const char* other : {"line", "sine", "field"})
-    if (other != track && root[other]) fail(path, std::string("block '") + other + "' does not apply to track " + track);
+    if (other != track && root[other])
+      fail(path, std::string("block '") + other + "' does not apply to track " + track);
   const YAML::Node block = required(root, track, path, "");
   if (b.track == core::TrackKind::line) {
     onlyKeys(block, {"x0", "v_r", "y"}, path, "line/");
@@ -260,8 +261,9 @@ core::BenchScenario loadScenarioFileImpl(const std::string& path) {
     flatten(plant, "", keys);
     for (const auto& kv : keys)
       if (kv.first != "disturbance/frequency")
-        fail(path, "plant/" + kv.first + " is drawn per run or not a plant setting: only plant/disturbance/frequency "
-                   "may be set here (the draws are under draws/)");
+        fail(path, "plant/" + kv.first +
+                       " is drawn per run or not a plant setting: only plant/disturbance/frequency "
+                       "may be set here (the draws are under draws/)");
     applyKeys(core::disturbanceTable(), keys, b.base.disturbance, path, "plant/");
   }
 
@@ -347,7 +349,8 @@ core::BenchScenario loadScenario(const std::string& name_or_path, const std::str
 void applyTunedGainsImpl(const std::string& path, core::Scenario& sc) {
   const YAML::Node root = loadYaml(path);
   onlyKeys(root, {"kinematic_controller", "torque_controller", "pure_pursuit", "pid"}, path, "");
-  if (const YAML::Node g = root["kinematic_controller"]) applyGroup(core::kanayamaTable(), g, sc.kanayama, path, "kinematic_controller");
+  if (const YAML::Node g = root["kinematic_controller"])
+    applyGroup(core::kanayamaTable(), g, sc.kanayama, path, "kinematic_controller");
   if (const YAML::Node g = root["torque_controller"]) {
     const bool adaptive = sc.sliding.adaptive;
     applyGroup(core::slidingModeTable(), g, sc.sliding, path, "torque_controller");
@@ -357,7 +360,8 @@ void applyTunedGainsImpl(const std::string& path, core::Scenario& sc) {
                      " but the pair is " + sc.controllerName());
     sc.sliding.adaptive = adaptive;
   }
-  if (const YAML::Node g = root["pure_pursuit"]) applyGroup(core::purePursuitTable(), g, sc.pure_pursuit, path, "pure_pursuit");
+  if (const YAML::Node g = root["pure_pursuit"])
+    applyGroup(core::purePursuitTable(), g, sc.pure_pursuit, path, "pure_pursuit");
   if (const YAML::Node g = root["pid"]) applyGroup(core::wheelPidTable(), g, sc.pid, path, "pid");
   const std::string e = sc.validate();
   if (!e.empty()) fail(path, e);

@@ -67,13 +67,9 @@ std::string num(double v) {
   return b;
 }
 
-std::string uniform(const Uniform& u) {
-  return u.lo == u.hi ? num(u.lo) : "U(" + num(u.lo) + ", " + num(u.hi) + ")";
-}
+std::string uniform(const Uniform& u) { return u.lo == u.hi ? num(u.lo) : "U(" + num(u.lo) + ", " + num(u.hi) + ")"; }
 
-const char* trackName(TrackKind t) {
-  return t == TrackKind::line ? "line" : t == TrackKind::field ? "field" : "sine";
-}
+const char* trackName(TrackKind t) { return t == TrackKind::line ? "line" : t == TrackKind::field ? "field" : "sine"; }
 
 /// One paragraph: what the scenario draws and how it is judged.
 std::string describe(const BenchScenario& b) {
@@ -88,8 +84,8 @@ std::string describe(const BenchScenario& b) {
          uniform(s.inertia_scale) + ", disturbance A " + uniform(s.amplitude) + " N·m at w " +
          num(b.base.disturbance.frequency) + " rad/s, phase " + uniform(s.phase) + " rad, wheel noise std " +
          num(s.noise_std) + " N·m (seed drawn), start + (" + uniform(s.start_dx) + ", " + uniform(s.start_dy) + ", " +
-         uniform(s.start_dtheta) + "); success: finished, no contact, |cross-track| < " +
-         num(s.cross_track_threshold) + " m from " + num(s.settle_time) + " s on";
+         uniform(s.start_dtheta) + "); success: finished, no contact, |cross-track| < " + num(s.cross_track_threshold) +
+         " m from " + num(s.settle_time) + " s on";
   if (b.track == TrackKind::field) out += ", axle within " + num(b.finish_tolerance) + " m of the path's end";
   return out + ".\n";
 }
@@ -118,7 +114,8 @@ bool writeAll(const std::string& dir, const std::vector<std::pair<std::string, c
 int main(int argc, char** argv) {
   std::vector<std::string> scenario_names{"thesis_line"}, controllers{"kanayama+atsmc"};
   long long seeds = -1, threads = 0, base_seed = -1;
-  std::string output, scenario_dir = SOWING_SOURCE_DIR "/config/scenarios", tuned_dir = SOWING_SOURCE_DIR "/config/tuned";
+  std::string output, scenario_dir = SOWING_SOURCE_DIR "/config/scenarios",
+                      tuned_dir = SOWING_SOURCE_DIR "/config/tuned";
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (i + 1 >= argc) return fail("missing value after " + a);
@@ -209,9 +206,9 @@ int main(int argc, char** argv) {
           if (tty && done % 10 != 0 && done != seeds) return;
           const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
           const double frac = static_cast<double>(finished + done) / static_cast<double>(total);
-          std::fprintf(stderr, "%s%s / %s: %lld/%lld runs; all %lld/%lld, %.0f s, about %.0f s left%s",
-                       tty ? "\r" : "", b.name.c_str(), name.c_str(), static_cast<long long>(done), seeds,
-                       finished + done, total, wall, frac > 0 ? wall * (1.0 - frac) / frac : 0.0, tty ? "   " : "\n");
+          std::fprintf(stderr, "%s%s / %s: %lld/%lld runs; all %lld/%lld, %.0f s, about %.0f s left%s", tty ? "\r" : "",
+                       b.name.c_str(), name.c_str(), static_cast<long long>(done), seeds, finished + done, total, wall,
+                       frac > 0 ? wall * (1.0 - frac) / frac : 0.0, tty ? "   " : "\n");
         });
       } catch (const std::exception& e) {
         if (tty) std::fprintf(stderr, "\n");
@@ -230,8 +227,9 @@ int main(int argc, char** argv) {
   std::string error;
   if (!writeAll(output, {{"runs.csv", &csv}, {"envelopes.csv", &envelopes}, {"report.md", &report}}, error))
     return fail(error);
-  std::printf("benchmark: %lld runs in %.2f s wall (%.2f ms per run, %s threads); %s/runs.csv, envelopes.csv, report.md\n",
-              total, wall, 1e3 * wall / static_cast<double>(total),
-              threads == 0 ? "all" : std::to_string(threads).c_str(), output.c_str());
+  std::printf(
+      "benchmark: %lld runs in %.2f s wall (%.2f ms per run, %s threads); %s/runs.csv, envelopes.csv, report.md\n",
+      total, wall, 1e3 * wall / static_cast<double>(total), threads == 0 ? "all" : std::to_string(threads).c_str(),
+      output.c_str());
   return 0;
 }

@@ -189,8 +189,9 @@ BenchScenario shortField(const TempDir& dir, bool avoid) {
   std::string text = readFile(kSuite + "/thesis_field.yaml");
   text = std::regex_replace(text, std::regex("name: thesis_field"), "name: short_field");
   text = std::regex_replace(text, std::regex("duration: 113.0"), "duration: 22.0");
-  text = std::regex_replace(text, std::regex("config: \\.\\./field_thesis\\.yaml"),
-                            "config: short_field_config.yaml\n  plan_detours: " + std::string(avoid ? "true" : "false"));
+  text =
+      std::regex_replace(text, std::regex("config: \\.\\./field_thesis\\.yaml"),
+                         "config: short_field_config.yaml\n  plan_detours: " + std::string(avoid ? "true" : "false"));
   text = std::regex_replace(text, std::regex("start: \\{x: -1.0, y: 0.0"), "start: {x: 0.0, y: 3.0");
   text = std::regex_replace(text, std::regex("start_d(x|y|theta): \\[[^\\]]*\\]"), "start_d$1: 0.0");
   text = std::regex_replace(text, std::regex("amplitude: \\[0.0, 2.0\\]"), "amplitude: 0.0");

@@ -14,11 +14,11 @@ namespace sowing_robot {
 namespace core {
 
 struct SineRowParams {
-  double x0 = 0.0;          ///< row start x [m]
-  double y0 = 3.0;          ///< row centre line y [m]
-  double speed_x = 1.0;     ///< u: along-x speed [m/s] (the path speed is u sqrt(1 + (A k cos)^2))
-  double amplitude = 0.5;   ///< A [m]
-  double wavelength = 10.0; ///< L [m]
+  double x0 = 0.0;           ///< row start x [m]
+  double y0 = 3.0;           ///< row centre line y [m]
+  double speed_x = 1.0;      ///< u: along-x speed [m/s] (the path speed is u sqrt(1 + (A k cos)^2))
+  double amplitude = 0.5;    ///< A [m]
+  double wavelength = 10.0;  ///< L [m]
   /// "" or one line naming the bad value.
   std::string validate() const {
     if (!(std::isfinite(x0) && std::isfinite(y0))) return "sine: x0 and y0 must be finite";
@@ -50,7 +50,7 @@ class SineReference : public ReferenceSource {
     r.pose = {p_.x0 + u * t, p_.y0 + a * s, std::atan2(yd, u)};
     r.v = v;
     r.v_dot = yd * ydd / v;
-    r.omega = u * ydd / v2;                                        // (x' y'' - y' x'') / v^2
+    r.omega = u * ydd / v2;                                            // (x' y'' - y' x'') / v^2
     r.omega_dot = u * (yddd * v2 - 2.0 * ydd * yd * ydd) / (v2 * v2);  // d/dt (u y'' / v^2), (v^2)' = 2 y' y''
     return r;
   }
