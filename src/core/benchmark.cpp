@@ -56,9 +56,9 @@ double crossTrack(const LoopSample& s) {
 
 /// Per-run extras of a benchmark scenario: the body checked against obstacles, the cross-track series.
 struct RunExtras {
-  ContactMonitor* contacts = nullptr;      ///< field tracks: the body against the obstacles
-  std::int64_t series_every = 0;           ///< sample the cross-track every this many periods (0: none)
-  Pose2D* last_reference = nullptr;        ///< gets the last reference pose (the finish check)
+  ContactMonitor* contacts = nullptr;  ///< field tracks: the body against the obstacles
+  std::int64_t series_every = 0;       ///< sample the cross-track every this many periods (0: none)
+  Pose2D* last_reference = nullptr;    ///< gets the last reference pose (the finish check)
 };
 
 RunRow measure(const Scenario& sc, ReferenceSource& reference, const MonteCarloSpec& spec, const RunDraw& draw,
@@ -69,7 +69,8 @@ RunRow measure(const Scenario& sc, ReferenceSource& reference, const MonteCarloS
   std::int64_t count = 0;
   WheelTorques prev, prev2;
   double worst = 0.0, last = 0.0;
-  if (extras.series_every > 0) row.cross_track_series.reserve(static_cast<std::size_t>(sc.steps() / extras.series_every + 1));
+  if (extras.series_every > 0)
+    row.cross_track_series.reserve(static_cast<std::size_t>(sc.steps() / extras.series_every + 1));
   const RunResult r = runClosedLoop(sc, reference, true, [&](const LoopSample& s) {
     // A period's torque is applied over the next dt: count it when the next sample arrives, so the
     // last one (never applied) is left out of the effort and of the total variation.
@@ -92,7 +93,8 @@ RunRow measure(const Scenario& sc, ReferenceSource& reference, const MonteCarloS
   row.diverged = r.diverged;
   row.min_clearance = std::numeric_limits<double>::quiet_NaN();
   if (extras.last_reference)
-    row.end_distance = std::hypot(r.final_state[X] - extras.last_reference->x, r.final_state[Y] - extras.last_reference->y);
+    row.end_distance =
+        std::hypot(r.final_state[X] - extras.last_reference->x, r.final_state[Y] - extras.last_reference->y);
   if (extras.contacts) {
     extras.contacts->finish();
     row.contacts = extras.contacts->contactCount();
@@ -225,13 +227,13 @@ std::string BenchScenario::validate() const {
   if (!e.empty()) return e;
   if (!(envelope_period > 0.0 && std::isfinite(envelope_period))) return "envelope_period must be > 0";
   if (!requires_models.empty())
-    return "scenario " + name + " needs the " + requires_models.front() + " model, which is not available yet (issue 16)";
+    return "scenario " + name + " needs the " + requires_models.front() +
+           " model, which is not available yet (issue 16)";
   switch (track) {
     case TrackKind::line:
       if (!allFinite(line_x0, line_v_r, line_y)) return "line: x0, v_r and y must be finite";
       return "";
-    case TrackKind::sine:
-      return sine.validate();
+    case TrackKind::sine: return sine.validate();
     case TrackKind::field:
       e = field.validate();
       if (!e.empty()) return e;
@@ -459,8 +461,8 @@ std::string reportSection(const std::string& scenario, const std::string& contro
       touched += r.contacts > 0;
       if (!std::isnan(r.min_clearance)) lowest = std::min(lowest, r.min_clearance);
     }
-    out += "body against the obstacles: runs with a contact " + std::to_string(touched) +
-           ", smallest body clearance " + shortNumber(lowest) + " m\n\n";
+    out += "body against the obstacles: runs with a contact " + std::to_string(touched) + ", smallest body clearance " +
+           shortNumber(lowest) + " m\n\n";
   }
   out += "| metric | mean | std | p95 | worst |\n|---|---:|---:|---:|---:|\n";
   const auto& cols = metricColumns();

@@ -182,7 +182,9 @@ TEST(Benchmark, AFieldBenchmarkGivesTheSameRowsOnOneAndTwoThreads) {
                                                                       s.obstacles = b.obstacles;
                                                                       return s;
                                                                     }())) /
-                                                                       b.envelope_period + 1e-9)) + 1;
+                                                                       b.envelope_period +
+                                                                   1e-9)) +
+                               1;
   EXPECT_NEAR(static_cast<double>(one[0].cross_track_series.size()), static_cast<double>(expected), 1.0);
 }
 

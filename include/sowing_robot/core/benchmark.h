@@ -67,8 +67,8 @@ struct RunRow {
   double time_at_limit = 0.0;      ///< time with either torque clipped [s]
   double worst_cross_track = 0.0;  ///< max |e_y| after settle_time [m]
   double final_cross_track = 0.0;  ///< |e_y| at the end [m]
-  std::size_t contacts = 0;         ///< body contacts with obstacles (field scenarios; 0 without obstacles)
-  double min_clearance = 0.0;       ///< smallest body clearance [m] (NaN without obstacles)
+  std::size_t contacts = 0;        ///< body contacts with obstacles (field scenarios; 0 without obstacles)
+  double min_clearance = 0.0;      ///< smallest body clearance [m] (NaN without obstacles)
   /// Field tracks: distance of the axle from the reference's last pose at the end [m] (NaN otherwise).
   double end_distance = std::numeric_limits<double>::quiet_NaN();
   bool diverged = false;
@@ -100,10 +100,10 @@ struct BenchScenario {
   Scenario base;
   MonteCarloSpec spec;
   double line_x0 = 0.0, line_v_r = 1.0, line_y = 3.0;  ///< track line: x_d = x0 + v_r t, y_d = y
-  SineRowParams sine;                                   ///< track sine
-  FieldParams field;                                    ///< track field (start_pose: the drawn start)
-  std::vector<Obstacle> obstacles;                      ///< track field
-  Footprint footprint = sowingRobotFootprint();         ///< track field: the body checked for contacts
+  SineRowParams sine;                                  ///< track sine
+  FieldParams field;                                   ///< track field (start_pose: the drawn start)
+  std::vector<Obstacle> obstacles;                     ///< track field
+  Footprint footprint = sowingRobotFootprint();        ///< track field: the body checked for contacts
   /// Track field: the run lasts base.duration plus the approach's extra time for the drawn start (as
   /// run_scenario --field), and is finished when the path has ended, the plan has no stop
   /// (AvoidanceStatus kOk) and the axle ends within this distance of the reference's last pose [m].
