@@ -54,23 +54,36 @@ double crossTrack(const LoopSample& s) {
   return -std::sin(th) * s.ex + std::cos(th) * s.ey;
 }
 
-RunRow runOne(const Scenario& base, ReferenceSource& reference, const MonteCarloSpec& spec, std::int64_t index) {
+/// Per-run extras of a benchmark scenario: the body checked against obstacles, the cross-track series.
+struct RunExtras {
+  ContactMonitor* contacts = nullptr;  ///< field tracks: the body against the obstacles
+  std::int64_t series_every = 0;       ///< sample the cross-track every this many periods (0: none)
+  Pose2D* last_reference = nullptr;    ///< gets the last reference pose (the finish check)
+};
+
+RunRow measure(const Scenario& sc, ReferenceSource& reference, const MonteCarloSpec& spec, const RunDraw& draw,
+               const RunExtras& extras = {}) {
   RunRow row;
-  row.draw = drawRun(spec, base, index);
-  const Scenario sc = applyDraw(base, spec, row.draw);
+  row.draw = draw;
   const double dt = secondsFromNanos(sc.control_period_ns);
   std::int64_t count = 0;
   WheelTorques prev, prev2;
   double worst = 0.0, last = 0.0;
+  if (extras.series_every > 0)
+    row.cross_track_series.reserve(static_cast<std::size_t>(sc.steps() / extras.series_every + 1));
   const RunResult r = runClosedLoop(sc, reference, true, [&](const LoopSample& s) {
     // A period's torque is applied over the next dt: count it when the next sample arrives, so the
     // last one (never applied) is left out of the effort and of the total variation.
     if (count >= 1) row.effort += dt * (prev.right * prev.right + prev.left * prev.left);
     if (count >= 2) row.chattering += std::fabs(prev.right - prev2.right) + std::fabs(prev.left - prev2.left);
+    const double e = crossTrack(s);
+    if (extras.series_every > 0 && count % extras.series_every == 0) row.cross_track_series.push_back(e);
+    if (extras.contacts) extras.contacts->update(s.t, {(*s.state)[X], (*s.state)[Y], (*s.state)[THETA]});
+    if (extras.last_reference) *extras.last_reference = s.reference->pose;
     prev2 = prev;
     prev = s.control->torques;
     ++count;
-    last = std::fabs(crossTrack(s));
+    last = std::fabs(e);
     if (s.t >= spec.settle_time) worst = std::max(worst, last);
   });
   row.metrics = r.metrics;
@@ -78,15 +91,78 @@ RunRow runOne(const Scenario& base, ReferenceSource& reference, const MonteCarlo
   row.worst_cross_track = worst;
   row.final_cross_track = last;
   row.diverged = r.diverged;
+  row.min_clearance = std::numeric_limits<double>::quiet_NaN();
+  if (extras.last_reference)
+    row.end_distance =
+        std::hypot(r.final_state[X] - extras.last_reference->x, r.final_state[Y] - extras.last_reference->y);
+  if (extras.contacts) {
+    extras.contacts->finish();
+    row.contacts = extras.contacts->contactCount();
+    row.min_clearance = extras.contacts->minClearance();
+  }
   if (r.diverged) {
     const double inf = std::numeric_limits<double>::infinity();
     row.effort = row.chattering = row.worst_cross_track = row.final_cross_track = inf;
     row.failure = "diverged";
+  } else if (row.contacts > 0) {
+    row.failure = "contact";
   } else if (!(worst < spec.cross_track_threshold)) {
     row.failure = "cross-track";
   }
   row.success = row.failure.empty();
   return row;
+}
+
+RunRow runOne(const Scenario& base, ReferenceSource& reference, const MonteCarloSpec& spec, std::int64_t index) {
+  const RunDraw draw = drawRun(spec, base, index);
+  return measure(applyDraw(base, spec, draw), reference, spec, draw);
+}
+
+/// Runs 0..runs-1 on `threads` threads; make() is called once per thread and returns that thread's
+/// run(i) -> RunRow (its own reference and state). Row i lands at index i whatever thread ran it.
+template <typename MakeWorker>
+std::vector<RunRow> parallelRows(std::int64_t runs, int threads, const std::function<void(std::int64_t)>& progress,
+                                 const MakeWorker& make) {
+  if (threads <= 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  threads = static_cast<int>(std::min<std::int64_t>(threads, runs));
+  std::vector<RunRow> rows(static_cast<std::size_t>(runs));
+  std::atomic<std::int64_t> next{0};
+  std::int64_t done = 0;
+  std::mutex progress_mutex;
+  std::exception_ptr failure;
+  std::mutex failure_mutex;
+  auto worker = [&]() {
+    try {
+      auto run = make();
+      for (std::int64_t i = next++; i < runs; i = next++) {
+        rows[static_cast<std::size_t>(i)] = run(i);
+        if (progress) {
+          std::lock_guard<std::mutex> lock(progress_mutex);
+          progress(++done);
+        }
+      }
+    } catch (...) {
+      std::lock_guard<std::mutex> lock(failure_mutex);
+      if (!failure) failure = std::current_exception();
+      next = runs;  // the others stop after their current run
+    }
+  };
+  if (threads == 1) {
+    worker();
+  } else {
+    std::vector<std::thread> pool;
+    for (int t = 0; t < threads; ++t) pool.emplace_back(worker);
+    for (auto& t : pool) t.join();
+  }
+  if (failure) std::rethrow_exception(failure);
+  return rows;
+}
+
+/// Nearest-rank quantile of sorted values.
+double quantile(const std::vector<double>& sorted, double q) {
+  const auto n = static_cast<double>(sorted.size());
+  const auto k = static_cast<std::size_t>(std::max(1.0, std::ceil(q * n)));
+  return sorted[k - 1];
 }
 
 }  // namespace
@@ -140,40 +216,141 @@ std::vector<RunRow> runMonteCarlo(const Scenario& base, const ReferenceSource& r
   // Every drawn scenario must validate too (e.g. a mismatch outside the plant's range).
   for (std::int64_t i = 0; i < runs && e.empty(); ++i) e = applyDraw(base, spec, drawRun(spec, base, i)).validate();
   if (!e.empty()) throw std::invalid_argument("a drawn run does not validate: " + e);
-  if (threads <= 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  threads = static_cast<int>(std::min<std::int64_t>(threads, runs));
+  return parallelRows(runs, threads, progress, [&]() {
+    std::shared_ptr<ReferenceSource> ref = reference.clone();
+    return [&base, &spec, ref](std::int64_t i) { return runOne(base, *ref, spec, i); };
+  });
+}
 
-  std::vector<RunRow> rows(static_cast<std::size_t>(runs));
-  std::atomic<std::int64_t> next{0};
-  std::int64_t done = 0;
-  std::mutex progress_mutex;
-  std::exception_ptr failure;
-  std::mutex failure_mutex;
-  auto worker = [&]() {
-    try {
-      std::unique_ptr<ReferenceSource> ref = reference.clone();
-      for (std::int64_t i = next++; i < runs; i = next++) {
-        rows[static_cast<std::size_t>(i)] = runOne(base, *ref, spec, i);
-        if (progress) {
-          std::lock_guard<std::mutex> lock(progress_mutex);
-          progress(++done);
+std::string BenchScenario::validate() const {
+  std::string e = firstError({spec.validate(), base.validate()});
+  if (!e.empty()) return e;
+  if (!(envelope_period > 0.0 && std::isfinite(envelope_period))) return "envelope_period must be > 0";
+  if (!requires_models.empty())
+    return "scenario " + name + " needs the " + requires_models.front() +
+           " model, which is not available yet (issue 16)";
+  switch (track) {
+    case TrackKind::line:
+      if (!allFinite(line_x0, line_v_r, line_y)) return "line: x0, v_r and y must be finite";
+      return "";
+    case TrackKind::sine: return sine.validate();
+    case TrackKind::field:
+      e = field.validate();
+      if (!e.empty()) return e;
+      for (const Obstacle& o : obstacles) {
+        e = o.validate();
+        if (!e.empty()) return "obstacle: " + e;
+      }
+      if (!(finish_tolerance > 0.0)) return "finish_tolerance must be > 0";
+      return "";
+  }
+  return "unknown track";
+}
+
+std::vector<RunRow> runBenchmark(const BenchScenario& bench, std::int64_t runs, int threads,
+                                 const std::function<void(std::int64_t)>& progress) {
+  if (runs < 1) throw std::invalid_argument("the number of runs (seeds) must be >= 1, not " + std::to_string(runs));
+  std::string e = bench.validate();
+  if (!e.empty()) throw std::invalid_argument(e);
+  const MonteCarloSpec& spec = bench.spec;
+  const Scenario& base = bench.base;
+  for (std::int64_t i = 0; i < runs && e.empty(); ++i) e = applyDraw(base, spec, drawRun(spec, base, i)).validate();
+  if (!e.empty()) throw std::invalid_argument("a drawn run does not validate: " + e);
+  const auto period_steps = static_cast<std::int64_t>(
+      std::max(1.0, std::round(bench.envelope_period / secondsFromNanos(base.control_period_ns))));
+  if (bench.track != TrackKind::field) {
+    std::unique_ptr<ReferenceSource> proto;
+    if (bench.track == TrackKind::line)
+      proto = std::make_unique<LineReference>(bench.line_v_r, bench.line_y, bench.line_x0);
+    else
+      proto = std::make_unique<SineReference>(bench.sine);
+    return parallelRows(runs, threads, progress, [&]() {
+      std::shared_ptr<ReferenceSource> ref = proto->clone();
+      return [&base, &spec, ref, period_steps](std::int64_t i) {
+        const RunDraw draw = drawRun(spec, base, i);
+        RunExtras extras;
+        extras.series_every = period_steps;
+        return measure(applyDraw(base, spec, draw), *ref, spec, draw, extras);
+      };
+    });
+  }
+  // Field: the path starts at the drawn start (the approach), so each run builds its own reference, and its
+  // duration grows by the approach's extra time, as run_scenario --field does.
+  return parallelRows(runs, threads, progress, [&]() {
+    return [&bench, &base, &spec, period_steps](std::int64_t i) {
+      const RunDraw draw = drawRun(spec, base, i);
+      Scenario sc = applyDraw(base, spec, draw);
+      FieldRunSetup setup;
+      setup.scenario = sc;
+      setup.field = bench.field;
+      setup.field.start_pose = sc.start;
+      setup.obstacles = bench.obstacles;
+      sc.duration += approachExtraTime(setup);
+      FieldReference reference(setup.field, bench.obstacles);
+      ContactMonitor contacts(bench.footprint, bench.obstacles);
+      Pose2D last_ref;
+      RunExtras extras;
+      extras.contacts = &contacts;
+      extras.series_every = period_steps;
+      extras.last_reference = &last_ref;
+      RunRow row = measure(sc, reference, spec, draw, extras);
+      // Not finished: the plan stops short of a row end, the path had not ended, or the robot is not at its end.
+      // (A contact or a divergence is the reason given before this one; a cross-track failure comes after.)
+      if (row.failure.empty() || row.failure == "cross-track") {
+        const bool stopped = reference.status().code != AvoidanceStatus::Code::kOk;
+        const bool ended = reference.finished(sc.duration);
+        if (stopped || !ended || !(row.end_distance < bench.finish_tolerance)) {
+          row.failure = "not finished";
+          row.success = false;
         }
       }
-    } catch (...) {
-      std::lock_guard<std::mutex> lock(failure_mutex);
-      if (!failure) failure = std::current_exception();
-      next = runs;  // the others stop after their current run
+      return row;
+    };
+  });
+}
+
+Envelope crossTrackEnvelope(const std::vector<RunRow>& rows, double period) {
+  Envelope env;
+  env.period = period;
+  std::size_t n = 0;
+  for (const RunRow& r : rows) n = std::max(n, r.cross_track_series.size());
+  std::vector<double> v;
+  for (std::size_t k = 0; k < n; ++k) {
+    v.clear();
+    double max_abs = 0.0;
+    for (const RunRow& r : rows) {
+      if (k >= r.cross_track_series.size()) continue;
+      double x = r.cross_track_series[k];
+      if (std::isnan(x)) x = std::numeric_limits<double>::infinity();
+      v.push_back(x);
+      max_abs = std::max(max_abs, std::fabs(x));
     }
-  };
-  if (threads == 1) {
-    worker();
-  } else {
-    std::vector<std::thread> pool;
-    for (int t = 0; t < threads; ++t) pool.emplace_back(worker);
-    for (auto& t : pool) t.join();
+    std::sort(v.begin(), v.end());
+    env.p05.push_back(quantile(v, 0.05));
+    env.p25.push_back(quantile(v, 0.25));
+    env.p50.push_back(quantile(v, 0.50));
+    env.p75.push_back(quantile(v, 0.75));
+    env.p95.push_back(quantile(v, 0.95));
+    env.max_abs.push_back(max_abs);
   }
-  if (failure) std::rethrow_exception(failure);
-  return rows;
+  return env;
+}
+
+std::string envelopeCsvHeader() { return "scenario,controller,t,p05,p25,p50,p75,p95,max_abs\n"; }
+
+std::string envelopeCsvLines(const std::string& scenario, const std::string& controller, const Envelope& e) {
+  // Six digits: a figure's data (micrometres of cross-track), not a run to repeat (runs.csv has full precision).
+  auto six = [](double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.6g", v);
+    return std::string(buf);
+  };
+  std::string out;
+  for (std::size_t k = 0; k < e.p50.size(); ++k)
+    out += scenario + "," + controller + "," + six(static_cast<double>(k) * e.period) + "," + six(e.p05[k]) + "," +
+           six(e.p25[k]) + "," + six(e.p50[k]) + "," + six(e.p75[k]) + "," + six(e.p95[k]) + "," + six(e.max_abs[k]) +
+           "\n";
+  return out;
 }
 
 Statistic statistic(std::vector<double> v) {
@@ -227,7 +404,7 @@ std::string runsCsvHeader() {
   std::string h =
       "scenario,controller,seed,mass_scale,inertia_scale,amplitude,phase,noise_seed,start_x,start_y,start_theta";
   for (const auto& c : metricColumns()) h += "," + c;
-  return h + ",diverged,success,failure\n";
+  return h + ",contacts,min_clearance,end_distance,diverged,success,failure\n";
 }
 
 std::string runsCsvLines(const std::string& scenario, const std::string& controller, const std::vector<RunRow>& rows) {
@@ -239,22 +416,54 @@ std::string runsCsvLines(const std::string& scenario, const std::string& control
            std::to_string(d.noise_seed) + "," + number(d.start_x) + "," + number(d.start_y) + "," +
            number(d.start_theta);
     for (double x : metricValues(r)) out += "," + number(x);
+    out += "," + std::to_string(r.contacts) + "," + number(r.min_clearance) + "," + number(r.end_distance);
     out += std::string(",") + (r.diverged ? "1" : "0") + "," + (r.success ? "1" : "0") + "," + r.failure + "\n";
   }
   return out;
 }
 
+namespace {
+const char* const kFailureReasons[] = {"diverged", "contact", "not finished", "cross-track"};
+
+double successRate(const std::vector<RunRow>& rows) {
+  std::int64_t ok = 0;
+  for (const RunRow& r : rows) ok += r.success;
+  return rows.empty() ? 0.0 : 100.0 * static_cast<double>(ok) / static_cast<double>(rows.size());
+}
+
+std::vector<double> column(const std::vector<RunRow>& rows, const std::function<double(const RunRow&)>& f) {
+  std::vector<double> v;
+  v.reserve(rows.size());
+  for (const RunRow& r : rows) v.push_back(f(r));
+  return v;
+}
+}  // namespace
+
 std::string reportSection(const std::string& scenario, const std::string& controller, const std::vector<RunRow>& rows) {
-  std::int64_t ok = 0, diverged = 0, cross = 0;
-  for (const RunRow& r : rows) {
-    ok += r.success;
-    diverged += r.failure == "diverged";
-    cross += r.failure == "cross-track";
-  }
+  std::int64_t ok = 0;
+  for (const RunRow& r : rows) ok += r.success;
   std::string out = "## " + scenario + " / " + controller + "\n\n";
   out += "runs " + std::to_string(rows.size()) + ", success " + std::to_string(ok) + " (" +
-         shortNumber(rows.empty() ? 0.0 : 100.0 * static_cast<double>(ok) / static_cast<double>(rows.size())) +
-         " %); failures: diverged " + std::to_string(diverged) + ", cross-track " + std::to_string(cross) + "\n\n";
+         shortNumber(successRate(rows)) + " %); failures:";
+  bool first = true;
+  for (const char* reason : kFailureReasons) {
+    std::int64_t n = 0;
+    for (const RunRow& r : rows) n += r.failure == reason;
+    out += std::string(first ? " " : ", ") + reason + " " + std::to_string(n);
+    first = false;
+  }
+  out += "\n\n";
+  const std::vector<double> clearance = column(rows, [](const RunRow& r) { return r.min_clearance; });
+  if (std::any_of(clearance.begin(), clearance.end(), [](double c) { return !std::isnan(c); })) {
+    std::int64_t touched = 0;
+    double lowest = std::numeric_limits<double>::infinity();
+    for (const RunRow& r : rows) {
+      touched += r.contacts > 0;
+      if (!std::isnan(r.min_clearance)) lowest = std::min(lowest, r.min_clearance);
+    }
+    out += "body against the obstacles: runs with a contact " + std::to_string(touched) + ", smallest body clearance " +
+           shortNumber(lowest) + " m\n\n";
+  }
   out += "| metric | mean | std | p95 | worst |\n|---|---:|---:|---:|---:|\n";
   const auto& cols = metricColumns();
   std::vector<std::vector<double>> values(cols.size());
@@ -268,6 +477,30 @@ std::string reportSection(const std::string& scenario, const std::string& contro
            " | " + shortNumber(s.worst) + " |\n";
   }
   return out + "\n";
+}
+
+std::string summaryHeader() {
+  return "| scenario | controller | runs | success % | failures | ITAE y mean | worst cross-track mean / p95 [m] | "
+         "effort mean [N²m²s] | chattering mean [N·m] | time at limit mean [s] |\n"
+         "|---|---|---:|---:|---|---:|---:|---:|---:|---:|\n";
+}
+
+std::string summaryLine(const std::string& scenario, const std::string& controller, const std::vector<RunRow>& rows) {
+  std::string failures;
+  for (const char* reason : kFailureReasons) {
+    std::int64_t n = 0;
+    for (const RunRow& r : rows) n += r.failure == reason;
+    if (n > 0) failures += (failures.empty() ? "" : ", ") + std::string(reason) + " " + std::to_string(n);
+  }
+  const Statistic itae = statistic(column(rows, [](const RunRow& r) { return r.metrics[AXIS_Y].itae; }));
+  const Statistic worst = statistic(column(rows, [](const RunRow& r) { return r.worst_cross_track; }));
+  const Statistic effort = statistic(column(rows, [](const RunRow& r) { return r.effort; }));
+  const Statistic chat = statistic(column(rows, [](const RunRow& r) { return r.chattering; }));
+  const Statistic limit = statistic(column(rows, [](const RunRow& r) { return r.time_at_limit; }));
+  return "| " + scenario + " | " + controller + " | " + std::to_string(rows.size()) + " | " +
+         shortNumber(successRate(rows)) + " | " + (failures.empty() ? "-" : failures) + " | " + shortNumber(itae.mean) +
+         " | " + shortNumber(worst.mean) + " / " + shortNumber(worst.p95) + " | " + shortNumber(effort.mean) + " | " +
+         shortNumber(chat.mean) + " | " + shortNumber(limit.mean) + " |\n";
 }
 
 }  // namespace core

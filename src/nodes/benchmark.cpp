@@ -1,15 +1,20 @@
-// benchmark: Monte-Carlo statistics of controller pairs in-process (no ROS master), issue 17 item 3.
-//   benchmark --controllers kanayama+atsmc,rpp+pid --seeds N --output DIR [--threads K]
-//             [--scenarios thesis_line] [--base-seed S]
-// Writes DIR/runs.csv (tidy, one row per run: scenario, controller, seed, the values drawn, every
-// metric) and DIR/report.md (per scenario and controller: success rate with reasons, mean, std, p95,
-// worst), and prints the wall time. The draws (MonteCarloSpec's defaults, core/benchmark.h): mismatch
-// U(0.8, 1.5) on m0 and I0 independently, disturbance amplitude U(0, 2) N·m and phase U(0, 2 pi), wheel
-// noise std 0.1 N·m with a drawn seed, start pose (-1, 0, 0) + U(+-0.5 m, +-0.5 m, +-0.3 rad); success:
-// no divergence and |cross-track| < 0.05 m from 15 s to the end. Scenarios: only thesis_line so far
-// (the thesis's Table 5.5 line, 25 s at 1 kHz); the scenario suite (config/scenarios/) is to come.
-// An unknown name, a seed count of 0 or an unwritable DIR: one error line, exit 2, no report written.
+// benchmark: Monte-Carlo statistics of controller pairs over the scenario suite, in-process (no ROS master),
+// issue 17 items 2 and 3.
+//   benchmark --scenarios A,B --controllers X,Y --seeds N --output DIR [--threads K]
+//             [--scenario-dir DIR] [--tuned-dir DIR] [--base-seed S]
+// Scenarios are names in the scenario directory (default: the package's config/scenarios; `all` for every
+// file there) or paths to scenario files; controllers are outer+inner pairs (kanayama|pure_pursuit|rpp +
+// atsmc|tsmc|pid). A pair's gains come from TUNED_DIR/OUTER+INNER.yaml when that file exists (default the
+// package's config/tuned), else from the parameter tables' defaults; the report says which.
+// Writes DIR/runs.csv (one row per run: scenario, controller, seed, the values drawn, every metric, contacts,
+// success and the failure reason), DIR/envelopes.csv (per scenario, controller and time: quantiles of the
+// cross-track error over the runs) and DIR/report.md (overview, then per scenario and controller: success
+// rate with reasons, mean, std, p95 and worst of every metric). The files do not depend on --threads.
+// Everything is loaded and checked before the first run, and written only when every run is done: an unknown
+// name, a seed count of 0, a scenario file with a typo or an unwritable DIR gives one error line, exit 2,
+// and no report. A progress line goes to stderr.
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <cstdio>
@@ -18,10 +23,16 @@
 #include <string>
 #include <vector>
 
+#include "sowing_robot/bench/scenario_loader.h"
 #include "sowing_robot/core/benchmark.h"
 #include "sowing_robot/core/runner.h"
 
 using namespace sowing_robot::core;
+namespace bench = sowing_robot::bench;
+
+#ifndef SOWING_SOURCE_DIR
+#define SOWING_SOURCE_DIR "."
+#endif
 
 namespace {
 std::vector<std::string> splitComma(const std::string& s) {
@@ -49,12 +60,62 @@ bool parseInteger(const char* text, long long& value) {
   value = std::strtoll(text, &end, 10);
   return end != text && *end == '\0';
 }
+
+std::string num(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%g", v);
+  return b;
+}
+
+std::string uniform(const Uniform& u) { return u.lo == u.hi ? num(u.lo) : "U(" + num(u.lo) + ", " + num(u.hi) + ")"; }
+
+const char* trackName(TrackKind t) { return t == TrackKind::line ? "line" : t == TrackKind::field ? "field" : "sine"; }
+
+/// One paragraph: what the scenario draws and how it is judged.
+std::string describe(const BenchScenario& b) {
+  const MonteCarloSpec& s = b.spec;
+  std::string out = "- **" + b.name + "** (" + trackName(b.track) + ", " + num(b.base.duration) + " s" +
+                    (b.track == TrackKind::field ? " + the approach's extra time" : "") + " at " +
+                    num(1e9 / static_cast<double>(b.base.control_period_ns)) + " Hz, start (" + num(b.base.start.x) +
+                    ", " + num(b.base.start.y) + ", " + num(b.base.start.theta) + ")";
+  if (b.track == TrackKind::field)
+    out += ", " + std::to_string(b.obstacles.size()) + " obstacles, body contacts counted";
+  out += "): base seed " + std::to_string(s.base_seed) + "; mass x" + uniform(s.mass_scale) + ", inertia x" +
+         uniform(s.inertia_scale) + ", disturbance A " + uniform(s.amplitude) + " N·m at w " +
+         num(b.base.disturbance.frequency) + " rad/s, phase " + uniform(s.phase) + " rad, wheel noise std " +
+         num(s.noise_std) + " N·m (seed drawn), start + (" + uniform(s.start_dx) + ", " + uniform(s.start_dy) + ", " +
+         uniform(s.start_dtheta) + "); success: finished, no contact, |cross-track| < " + num(s.cross_track_threshold) +
+         " m from " + num(s.settle_time) + " s on";
+  if (b.track == TrackKind::field) out += ", axle within " + num(b.finish_tolerance) + " m of the path's end";
+  return out + ".\n";
+}
+
+bool writeAll(const std::string& dir, const std::vector<std::pair<std::string, const std::string*>>& files,
+              std::string& error) {
+  // Each written beside its name first, then renamed: no half-written set under the real names.
+  for (const auto& f : files) {
+    std::ofstream out(dir + "/" + f.first + ".tmp");
+    out << *f.second;
+    out.close();
+    if (!out.good()) {
+      error = "cannot write " + dir + "/" + f.first + ".tmp";
+      return false;
+    }
+  }
+  for (const auto& f : files)
+    if (std::rename((dir + "/" + f.first + ".tmp").c_str(), (dir + "/" + f.first).c_str()) != 0) {
+      error = "cannot rename " + dir + "/" + f.first + ".tmp";
+      return false;
+    }
+  return true;
+}
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<std::string> scenarios{"thesis_line"}, controllers{"kanayama+atsmc"};
-  long long seeds = -1, threads = 0, base_seed = 1;
-  std::string output;
+  std::vector<std::string> scenario_names{"thesis_line"}, controllers{"kanayama+atsmc"};
+  long long seeds = -1, threads = 0, base_seed = -1;
+  std::string output, scenario_dir = SOWING_SOURCE_DIR "/config/scenarios",
+                      tuned_dir = SOWING_SOURCE_DIR "/config/tuned";
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (i + 1 >= argc) return fail("missing value after " + a);
@@ -62,76 +123,113 @@ int main(int argc, char** argv) {
     if (a == "--controllers") {
       controllers = splitComma(v);
     } else if (a == "--scenarios") {
-      scenarios = splitComma(v);
+      scenario_names = splitComma(v);
     } else if (a == "--output") {
       output = v;
+    } else if (a == "--scenario-dir") {
+      scenario_dir = v;
+    } else if (a == "--tuned-dir") {
+      tuned_dir = v;
     } else if (a == "--seeds" || a == "--threads" || a == "--base-seed") {
       long long n;
       if (!parseInteger(v, n)) return fail(a + " needs an integer, not '" + v + "'");
       (a == "--seeds" ? seeds : a == "--threads" ? threads : base_seed) = n;
     } else {
-      return fail("unknown argument '" + a + "' (--controllers --seeds --output --threads --scenarios --base-seed)");
+      return fail("unknown argument '" + a +
+                  "' (--scenarios --controllers --seeds --output --threads --scenario-dir --tuned-dir --base-seed)");
     }
   }
   if (seeds < 1) return fail(seeds == -1 ? "--seeds N is required" : "--seeds must be >= 1");
   if (threads < 0) return fail("--threads must be >= 0 (0: all cores)");
+  if (base_seed < -1) return fail("--base-seed must be >= 0");
   if (output.empty()) return fail("--output DIR is required");
-  for (const auto& s : scenarios)
-    if (s != "thesis_line") return fail("unknown scenario '" + s + "' (known: thesis_line)");
+  if (scenario_names.size() == 1 && scenario_names[0] == "all") scenario_names = bench::scenarioNames(scenario_dir);
+
+  // Load and check everything before the first run.
+  std::vector<BenchScenario> scenarios;
   std::vector<Scenario> pairs;
-  for (const auto& c : controllers) {
-    Scenario sc;
-    const std::string e = parseControllerPair(c, sc.outer, sc.inner, sc.sliding.adaptive);
-    if (!e.empty()) return fail(e);
-    pairs.push_back(sc);
+  std::vector<std::string> gains_source;
+  try {
+    for (const auto& name : scenario_names) {
+      scenarios.push_back(bench::loadScenario(name, scenario_dir));
+      if (base_seed >= 0) scenarios.back().spec.base_seed = static_cast<std::uint64_t>(base_seed);
+    }
+    for (const auto& c : controllers) {
+      Scenario sc;
+      const std::string e = parseControllerPair(c, sc.outer, sc.inner, sc.sliding.adaptive);
+      if (!e.empty()) return fail(e);
+      const std::string tuned = bench::tunedGainsFile(tuned_dir, sc);
+      if (!tuned.empty()) bench::applyTunedGains(tuned, sc);
+      gains_source.push_back(tuned.empty() ? "the parameter tables' defaults (no " + sc.controllerName() + ".yaml in " +
+                                                 tuned_dir + ")"
+                                           : tuned);
+      pairs.push_back(sc);
+    }
+  } catch (const std::exception& e) {
+    return fail(e.what());
   }
   ::mkdir(output.c_str(), 0777);  // may exist; the writes below report a real failure
-  MonteCarloSpec spec;
-  spec.base_seed = static_cast<std::uint64_t>(base_seed);
+  {
+    std::ofstream probe(output + "/.benchmark_probe");
+    if (!probe.good()) return fail("cannot write into " + output);
+  }
+  std::remove((output + "/.benchmark_probe").c_str());
 
-  // Everything is computed first, then written: a failure leaves no partial report.
-  std::string csv = runsCsvHeader(), report = "# Controller benchmark\n\n";
-  report += std::to_string(seeds) + " seeded runs per scenario and controller, base seed " + std::to_string(base_seed) +
-            ". Draws: mismatch U(0.8, 1.5) on m0 and I0 independently, disturbance amplitude U(0, 2) N·m and phase "
-            "U(0, 2 pi), wheel noise "
-            "std 0.1 N·m, start (-1, 0, 0) + U(+-0.5 m, +-0.5 m, +-0.3 rad). Success: no divergence and "
-            "|cross-track| < 0.05 m from 15 s to the end.\n\n";
+  std::string csv = runsCsvHeader(), envelopes = envelopeCsvHeader();
+  std::string report = "# Controller benchmark\n\n" + std::to_string(seeds) +
+                       " seeded runs per scenario and controller, in-process (`benchmark`, core/benchmark.h); every "
+                       "run can be repeated alone from its row of runs.csv.\n\nGains:\n\n";
+  for (std::size_t p = 0; p < pairs.size(); ++p)
+    report += "- " + pairs[p].controllerName() + ": " + gains_source[p] + "\n";
+  report += "\nScenarios:\n\n";
+  for (const auto& b : scenarios) report += describe(b);
+  std::string summary = summaryHeader(), sections;
+
+  const bool tty = ::isatty(STDERR_FILENO) != 0;
   const auto t0 = std::chrono::steady_clock::now();
-  long long total = 0;
-  for (const auto& scenario : scenarios) {
-    for (const Scenario& sc : pairs) {
-      LineReference line;  // thesis_line: x_d = t, y_d = 3
+  const long long total = seeds * static_cast<long long>(scenarios.size() * pairs.size());
+  long long finished = 0;
+  for (const BenchScenario& scenario : scenarios) {
+    for (const Scenario& pair : pairs) {
+      BenchScenario b = scenario;  // the scenario's timing, start and plant, with the pair's controllers and gains
+      b.base.outer = pair.outer;
+      b.base.inner = pair.inner;
+      b.base.kanayama = pair.kanayama;
+      b.base.sliding = pair.sliding;
+      b.base.pure_pursuit = pair.pure_pursuit;
+      b.base.pid = pair.pid;
+      const std::string name = pair.controllerName();
       std::vector<RunRow> rows;
       try {
-        rows = runMonteCarlo(sc, line, spec, seeds, static_cast<int>(threads), [&](std::int64_t done) {
-          if (done % 100 == 0 || done == seeds)
-            std::fprintf(stderr, "\r%s %s: %lld / %lld", scenario.c_str(), sc.controllerName().c_str(),
-                         static_cast<long long>(done), seeds);
+        rows = runBenchmark(b, seeds, static_cast<int>(threads), [&](std::int64_t done) {
+          if (!tty && done != seeds) return;
+          if (tty && done % 10 != 0 && done != seeds) return;
+          const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+          const double frac = static_cast<double>(finished + done) / static_cast<double>(total);
+          std::fprintf(stderr, "%s%s / %s: %lld/%lld runs; all %lld/%lld, %.0f s, about %.0f s left%s", tty ? "\r" : "",
+                       b.name.c_str(), name.c_str(), static_cast<long long>(done), seeds, finished + done, total, wall,
+                       frac > 0 ? wall * (1.0 - frac) / frac : 0.0, tty ? "   " : "\n");
         });
       } catch (const std::exception& e) {
-        std::fprintf(stderr, "\n");
-        return fail(e.what());
+        if (tty) std::fprintf(stderr, "\n");
+        return fail(b.name + " / " + name + ": " + e.what());
       }
-      std::fprintf(stderr, "\n");
-      csv += runsCsvLines(scenario, sc.controllerName(), rows);
-      report += reportSection(scenario, sc.controllerName(), rows);
-      total += seeds;
+      finished += seeds;
+      csv += runsCsvLines(b.name, name, rows);
+      envelopes += envelopeCsvLines(b.name, name, crossTrackEnvelope(rows, b.envelope_period));
+      summary += summaryLine(b.name, name, rows);
+      sections += reportSection(b.name, name, rows);
     }
   }
+  if (tty) std::fprintf(stderr, "\n");
+  report += "\n## Overview\n\n" + summary + "\n" + sections;
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  // Both written beside their names first, then renamed: no half-written pair under the real names.
-  for (const auto& file :
-       {std::make_pair(output + "/runs.csv", &csv), std::make_pair(output + "/report.md", &report)}) {
-    std::ofstream f(file.first + ".tmp");
-    f << *file.second;
-    f.close();
-    if (!f.good()) return fail("cannot write " + file.first + ".tmp");
-  }
-  for (const char* name : {"/runs.csv", "/report.md"})
-    if (std::rename((output + name + ".tmp").c_str(), (output + name).c_str()) != 0)
-      return fail("cannot rename " + output + name + ".tmp");
-  std::printf("benchmark: %lld runs in %.2f s wall (%.2f ms per run, %s threads); %s/runs.csv, %s/report.md\n", total,
-              wall, 1e3 * wall / static_cast<double>(total), threads == 0 ? "all" : std::to_string(threads).c_str(),
-              output.c_str(), output.c_str());
+  std::string error;
+  if (!writeAll(output, {{"runs.csv", &csv}, {"envelopes.csv", &envelopes}, {"report.md", &report}}, error))
+    return fail(error);
+  std::printf(
+      "benchmark: %lld runs in %.2f s wall (%.2f ms per run, %s threads); %s/runs.csv, envelopes.csv, report.md\n",
+      total, wall, 1e3 * wall / static_cast<double>(total), threads == 0 ? "all" : std::to_string(threads).c_str(),
+      output.c_str());
   return 0;
 }

@@ -131,3 +131,72 @@ TEST(Benchmark, StatisticsCountDivergedRunsAndSkipMissingFigures) {
   for (int i = 1; i <= 100; ++i) hundred.push_back(i);
   EXPECT_DOUBLE_EQ(statistic(hundred).p95, 95.0);
 }
+
+TEST(Benchmark, TheSineRowsHeadingSpeedAndYawRateAreTheDerivativesOfItsPath) {
+  SineRowParams p;
+  SineReference ref(p);
+  const double h = 1e-6;
+  for (double t : {0.3, 2.0, 4.7, 7.5}) {
+    SineReference a(p), b(p), c(p);
+    const Reference r0 = a.next(t - h), r = b.next(t), r1 = c.next(t + h);
+    const double dx = (r1.pose.x - r0.pose.x) / (2 * h), dy = (r1.pose.y - r0.pose.y) / (2 * h);
+    EXPECT_NEAR(r.v, std::hypot(dx, dy), 1e-6) << t;
+    EXPECT_NEAR(r.pose.theta, std::atan2(dy, dx), 1e-6) << t;
+    EXPECT_NEAR(r.omega, (r1.pose.theta - r0.pose.theta) / (2 * h), 1e-5) << t;
+    EXPECT_NEAR(r.v_dot, (r1.v - r0.v) / (2 * h), 1e-5) << t;
+    EXPECT_NEAR(r.omega_dot, (r1.omega - r0.omega) / (2 * h), 1e-4) << t;
+  }
+  SineRowParams bad;
+  bad.wavelength = -1.0;
+  EXPECT_NE(bad.validate(), "");
+}
+
+TEST(Benchmark, AFieldBenchmarkGivesTheSameRowsOnOneAndTwoThreads) {
+  BenchScenario b;
+  b.name = "small_field";
+  b.track = TrackKind::field;
+  b.base.duration = 14.0;
+  b.base.start = {0.0, 3.0, 0.0};
+  b.field.rows = 1;
+  b.field.row_length = 10.0;
+  b.field.start_y = 3.0;
+  b.field.potential.beta = 4.0;
+  b.obstacles = {{5.0, 3.0, 0.3}};
+  b.spec.start_dx = b.spec.start_dy = b.spec.start_dtheta = {0.0, 0.0};
+  b.spec.settle_time = 2.0;
+  ASSERT_EQ(b.validate(), "");
+  const std::vector<RunRow> one = runBenchmark(b, 3, 1), two = runBenchmark(b, 3, 2);
+  expectSameRows(one, two);
+  for (std::size_t i = 0; i < one.size(); ++i) {
+    EXPECT_EQ(one[i].min_clearance, two[i].min_clearance);
+    EXPECT_EQ(one[i].cross_track_series, two[i].cross_track_series);
+    EXPECT_FALSE(one[i].cross_track_series.empty());
+  }
+  EXPECT_EQ(envelopeCsvLines("f", "c", crossTrackEnvelope(one, b.envelope_period)),
+            envelopeCsvLines("f", "c", crossTrackEnvelope(two, b.envelope_period)));
+  // The series is sampled every envelope period from t = 0 (steps 0, 100, ... at 1 kHz).
+  const std::size_t expected = static_cast<std::size_t>(std::floor((b.base.duration + approachExtraTime([&] {
+                                                                      FieldRunSetup s;
+                                                                      s.field = b.field;
+                                                                      s.field.start_pose = b.base.start;
+                                                                      s.obstacles = b.obstacles;
+                                                                      return s;
+                                                                    }())) /
+                                                                       b.envelope_period +
+                                                                   1e-9)) +
+                               1;
+  EXPECT_NEAR(static_cast<double>(one[0].cross_track_series.size()), static_cast<double>(expected), 1.0);
+}
+
+TEST(Benchmark, EnvelopeQuantilesAreNearestRankPerSampleTime) {
+  std::vector<RunRow> rows(4);
+  for (int i = 0; i < 4; ++i) rows[i].cross_track_series = {static_cast<double>(i), -static_cast<double>(i)};
+  rows[3].cross_track_series.push_back(7.0);  // one longer run: alone at the third sample
+  const Envelope e = crossTrackEnvelope(rows, 0.5);
+  ASSERT_EQ(e.p50.size(), 3u);
+  EXPECT_EQ(e.p50[0], 1.0);  // ranks of {0, 1, 2, 3}: ceil(0.5 * 4) = 2nd
+  EXPECT_EQ(e.p95[0], 3.0);
+  EXPECT_EQ(e.p05[1], -3.0);
+  EXPECT_EQ(e.max_abs[1], 3.0);
+  EXPECT_EQ(e.p50[2], 7.0);
+}

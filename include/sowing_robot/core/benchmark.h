@@ -11,12 +11,15 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
+#include "sowing_robot/core/field_run.h"
 #include "sowing_robot/core/metrics.h"
 #include "sowing_robot/core/reference.h"
 #include "sowing_robot/core/runner.h"
+#include "sowing_robot/core/sine_reference.h"
 
 namespace sowing_robot {
 namespace core {
@@ -64,9 +67,15 @@ struct RunRow {
   double time_at_limit = 0.0;      ///< time with either torque clipped [s]
   double worst_cross_track = 0.0;  ///< max |e_y| after settle_time [m]
   double final_cross_track = 0.0;  ///< |e_y| at the end [m]
+  std::size_t contacts = 0;        ///< body contacts with obstacles (field scenarios; 0 without obstacles)
+  double min_clearance = 0.0;      ///< smallest body clearance [m] (NaN without obstacles)
+  /// Field tracks: distance of the axle from the reference's last pose at the end [m] (NaN otherwise).
+  double end_distance = std::numeric_limits<double>::quiet_NaN();
   bool diverged = false;
   bool success = false;
-  std::string failure;  ///< why not a success ("" on success): diverged, cross-track
+  std::string failure;  ///< why not a success ("" on success): diverged, contact, not finished, cross-track
+  /// Signed cross-track error sampled every envelope period from t = 0 (runBenchmark only; empty otherwise).
+  std::vector<double> cross_track_series;
 };
 
 /// Runs base (its controller pair, plant, timing) on `reference` for seeds 0..runs-1 with `threads`
@@ -76,6 +85,55 @@ struct RunRow {
 std::vector<RunRow> runMonteCarlo(const Scenario& base, const ReferenceSource& reference, const MonteCarloSpec& spec,
                                   std::int64_t runs, int threads = 0,
                                   const std::function<void(std::int64_t)>& progress = {});
+
+/// What a benchmark scenario drives on (config/scenarios/*.yaml, track:).
+enum class TrackKind { line, field, sine };
+
+/// A scenario of the benchmark suite, ROS- and YAML-free (the loader in scenario_loader.h fills it from
+/// config/scenarios/NAME.yaml): the closed loop (base: duration, rate, start, plant settings not drawn, the
+/// controller pair and gains, set by the caller), what is drawn per run and how success is judged (spec), and
+/// the track. A field scenario goes through the body: its footprint is checked against the obstacles every
+/// period (ContactMonitor, as runField does) and any contact fails the run.
+struct BenchScenario {
+  std::string name;
+  TrackKind track = TrackKind::line;
+  Scenario base;
+  MonteCarloSpec spec;
+  double line_x0 = 0.0, line_v_r = 1.0, line_y = 3.0;  ///< track line: x_d = x0 + v_r t, y_d = y
+  SineRowParams sine;                                  ///< track sine
+  FieldParams field;                                   ///< track field (start_pose: the drawn start)
+  std::vector<Obstacle> obstacles;                     ///< track field
+  Footprint footprint = sowingRobotFootprint();        ///< track field: the body checked for contacts
+  /// Track field: the run lasts base.duration plus the approach's extra time for the drawn start (as
+  /// run_scenario --field), and is finished when the path has ended, the plan has no stop
+  /// (AvoidanceStatus kOk) and the axle ends within this distance of the reference's last pose [m].
+  double finish_tolerance = 0.5;
+  double envelope_period = 0.1;  ///< period of RunRow::cross_track_series [s] (> 0)
+  /// Extension point (issue 16): conditions not modelled yet (e.g. "wet_soil", "estimated_pose"). The loader
+  /// refuses a scenario needing one; runBenchmark refuses a non-empty list until the models land.
+  std::vector<std::string> requires_models;
+
+  std::string validate() const;
+};
+
+/// Runs `bench` (its base carries the controller pair) for seeds 0..runs-1 on `threads` threads (0: all
+/// cores), as runMonteCarlo does (same draws, same thread-count independence), with the body contacts
+/// and the finish check of field tracks, and the cross-track series for envelopes. Success: not
+/// diverged, no contact, finished, and |cross-track| < threshold from settle_time on. Throws
+/// std::invalid_argument for a bad scenario or runs < 1.
+std::vector<RunRow> runBenchmark(const BenchScenario& bench, std::int64_t runs, int threads = 0,
+                                 const std::function<void(std::int64_t)>& progress = {});
+
+/// Quantiles over the runs of the cross-track series at each sample time (runs whose series is shorter
+/// are left out there; a diverged run's non-finite samples count as +inf).
+struct Envelope {
+  double period = 0.1;
+  std::vector<double> p05, p25, p50, p75, p95, max_abs;  ///< per sample time k * period
+};
+Envelope crossTrackEnvelope(const std::vector<RunRow>& rows, double period);
+/// Tidy CSV of envelopes: header, then scenario, controller, t, p05, p25, p50, p75, p95, max_abs.
+std::string envelopeCsvHeader();
+std::string envelopeCsvLines(const std::string& scenario, const std::string& controller, const Envelope& e);
 
 /// One metric over the runs. Diverged runs count: their +inf makes mean, std and worst +inf. NaN (a
 /// figure a run does not have, e.g. a rise time never reached) is left out; all NaN gives NaN. p95 is
@@ -95,6 +153,10 @@ std::string runsCsvLines(const std::string& scenario, const std::string& control
 /// Markdown section for one scenario and controller: success rate with failure reasons, then per metric
 /// mean, std, p95 and worst.
 std::string reportSection(const std::string& scenario, const std::string& controller, const std::vector<RunRow>& rows);
+/// Markdown table header and one line of the overview (one line per scenario and controller): success rate,
+/// contacts, mean ITAE y, mean and p95 of the worst cross-track, mean effort, chattering, time at the limit.
+std::string summaryHeader();
+std::string summaryLine(const std::string& scenario, const std::string& controller, const std::vector<RunRow>& rows);
 
 }  // namespace core
 }  // namespace sowing_robot

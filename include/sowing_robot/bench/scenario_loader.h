@@ -1,0 +1,45 @@
+// The benchmark's YAML side (issue 17): config/scenarios/NAME.yaml -> core::BenchScenario, and the tuned
+// gains of a controller pair (config/tuned/OUTER+INNER.yaml) onto a core::Scenario. Kept out of the
+// ROS-free core because it needs yaml-cpp; every value goes through the core's parameter tables (type and
+// range checks, unknown keys refused), and all physics stays in the core (benchmark.h runs the scenario).
+//
+// Errors: std::invalid_argument with one line "FILE: what is wrong" (an unknown key, a missing one, a
+// value of the wrong type or out of range, an unknown scenario name).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "sowing_robot/core/benchmark.h"
+#include "sowing_robot/core/runner.h"
+
+namespace sowing_robot {
+namespace bench {
+
+/// The scenario file at `path` (its `name` must equal the file's stem). A field scenario's `field/config`
+/// is read relative to the scenario file's directory.
+core::BenchScenario loadScenarioFile(const std::string& path);
+
+/// `name_or_path`: a file path (contains '/' or ends with .yaml) or a scenario name looked up as
+/// DIR/NAME.yaml; an unknown name lists the known ones.
+core::BenchScenario loadScenario(const std::string& name_or_path, const std::string& dir);
+
+/// The scenario names in `dir` (every *.yaml, sorted).
+std::vector<std::string> scenarioNames(const std::string& dir);
+
+/// Models a scenario may require (`requires:`) that are announced but not built yet (issue 16):
+/// "wet_soil" (traction plant on a wet field) and "estimated_pose" (the controllers see an estimated pose).
+/// Extension point: when one lands, parse its block in loadScenarioFile (see the comment there), apply it in
+/// core::runBenchmark, and take it off this list.
+const std::vector<std::string>& pendingModels();
+
+/// Applies a tuned-gains file (results/tuned_gains.yaml's format: groups kinematic_controller (Kanayama),
+/// torque_controller (sliding mode; its `mode`, if given, must be the pair's), pure_pursuit, pid; each
+/// read through its parameter table) onto sc. Unknown groups or keys are refused.
+void applyTunedGains(const std::string& path, core::Scenario& sc);
+
+/// DIR/OUTER+INNER.yaml for the pair of sc if that file exists, else "".
+std::string tunedGainsFile(const std::string& dir, const core::Scenario& sc);
+
+}  // namespace bench
+}  // namespace sowing_robot

@@ -1,0 +1,384 @@
+#include "sowing_robot/bench/scenario_loader.h"
+
+#include <sys/stat.h>
+
+#include <dirent.h>
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <functional>
+#include <map>
+#include <set>
+#include <stdexcept>
+
+#include <yaml-cpp/yaml.h>
+
+#include "sowing_robot/core/field.h"
+#include "sowing_robot/core/kanayama.h"
+#include "sowing_robot/core/node_settings.h"
+#include "sowing_robot/core/plant.h"
+#include "sowing_robot/core/pure_pursuit.h"
+#include "sowing_robot/core/sliding_mode.h"
+#include "sowing_robot/core/validation.h"
+#include "sowing_robot/core/wheel_pid.h"
+
+namespace sowing_robot {
+namespace bench {
+
+using core::ParamTable;
+using core::ParamValue;
+
+namespace {
+
+[[noreturn]] void fail(const std::string& file, const std::string& what) {
+  throw std::invalid_argument(file + ": " + what);
+}
+
+YAML::Node loadYaml(const std::string& path) {
+  try {
+    return YAML::LoadFile(path);
+  } catch (const YAML::BadFile&) {
+    fail(path, "cannot read the file");
+  } catch (const YAML::Exception& e) {
+    fail(path, std::string("not valid YAML: ") + e.what());
+  }
+}
+
+/// Refuses a key of `map` not in `known` (the typo check), naming the allowed ones.
+void onlyKeys(const YAML::Node& map, const std::set<std::string>& known, const std::string& file,
+              const std::string& where) {
+  if (!map.IsMap()) fail(file, where + " must be a mapping");
+  for (const auto& kv : map) {
+    const std::string key = kv.first.as<std::string>();
+    if (known.count(key)) continue;
+    std::string list;
+    for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
+    fail(file, "unknown key '" + where + key + "' (known under '" + (where.empty() ? "/" : where) + "': " + list + ")");
+  }
+}
+
+YAML::Node required(const YAML::Node& map, const std::string& key, const std::string& file, const std::string& where) {
+  const YAML::Node n = map[key];
+  if (!n) fail(file, "missing key '" + where + key + "'");
+  return n;
+}
+
+double toDouble(const YAML::Node& n, const std::string& file, const std::string& key) {
+  if (!n.IsScalar()) fail(file, key + " must be a number");
+  const std::string t = n.Scalar();
+  char* end = nullptr;
+  const double v = std::strtod(t.c_str(), &end);
+  if (t.empty() || *end != '\0' || !std::isfinite(v)) fail(file, key + " = '" + t + "' is not a finite number");
+  return v;
+}
+
+/// A scalar as the parameter's type (that of its default).
+ParamValue toParamValue(const YAML::Node& n, const ParamValue& like, const std::string& file, const std::string& key) {
+  if (!n.IsScalar()) fail(file, key + " must be a single value");
+  const std::string t = n.Scalar();
+  if (std::holds_alternative<bool>(like)) {
+    if (t == "true" || t == "True") return true;
+    if (t == "false" || t == "False") return false;
+    fail(file, key + " = '" + t + "' is not a bool");
+  }
+  if (std::holds_alternative<int>(like)) {
+    char* end = nullptr;
+    const long v = std::strtol(t.c_str(), &end, 10);
+    if (t.empty() || *end != '\0') fail(file, key + " = '" + t + "' is not an integer");
+    return static_cast<int>(v);
+  }
+  if (std::holds_alternative<double>(like)) return toDouble(n, file, key);
+  return t;
+}
+
+/// Flattens nested mappings into table keys joined by '/': {field: {rows: 3}} -> "field/rows".
+void flatten(const YAML::Node& map, const std::string& prefix, std::vector<std::pair<std::string, YAML::Node>>& out,
+             const std::set<std::string>& lists = {}) {
+  for (const auto& kv : map) {
+    const std::string key = prefix + kv.first.as<std::string>();
+    if (kv.second.IsMap())
+      flatten(kv.second, key + "/", out, lists);
+    else
+      out.emplace_back(key, kv.second);
+  }
+}
+
+/// Sets every (key, value) through `table` on s; unknown keys and bad values refused.
+template <typename S>
+void applyKeys(const ParamTable<S>& table, const std::vector<std::pair<std::string, YAML::Node>>& keys, S& s,
+               const std::string& file, const std::string& where) {
+  for (const auto& kv : keys) {
+    const auto* entry = table.find(kv.first);
+    if (!entry) {
+      std::string list;
+      for (const auto& e : table.entries()) list += (list.empty() ? "" : ", ") + e.info.key;
+      fail(file, "unknown key '" + where + kv.first + "' (known: " + list + ")");
+    }
+    const ParamValue v = toParamValue(kv.second, entry->info.default_value, file, where + kv.first);
+    const std::string error = entry->info.check(v, where);
+    if (!error.empty()) fail(file, error);
+    entry->set(s, v);
+  }
+}
+
+template <typename S>
+void applyGroup(const ParamTable<S>& table, const YAML::Node& group, S& s, const std::string& file,
+                const std::string& where) {
+  if (!group.IsMap()) fail(file, where + " must be a mapping");
+  std::vector<std::pair<std::string, YAML::Node>> keys;
+  flatten(group, "", keys);
+  applyKeys(table, keys, s, file, where + "/");
+}
+
+/// [lo, hi] or a single value (fixed).
+core::Uniform toUniform(const YAML::Node& n, const std::string& file, const std::string& key) {
+  if (n.IsScalar()) {
+    const double v = toDouble(n, file, key);
+    return {v, v};
+  }
+  if (!n.IsSequence() || n.size() != 2) fail(file, key + " must be [lo, hi] or one number");
+  return {toDouble(n[0], file, key + "[0]"), toDouble(n[1], file, key + "[1]")};
+}
+
+std::string stem(const std::string& path) {
+  const std::size_t slash = path.find_last_of('/');
+  std::string base = slash == std::string::npos ? path : path.substr(slash + 1);
+  const std::size_t dot = base.rfind(".yaml");
+  return dot == std::string::npos ? base : base.substr(0, dot);
+}
+
+std::string directoryOf(const std::string& path) {
+  const std::size_t slash = path.find_last_of('/');
+  return slash == std::string::npos ? "." : path.substr(0, slash);
+}
+
+bool fileExists(const std::string& path) {
+  struct stat st;
+  return ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
+}
+
+/// A reference_generator config (config/field*.yaml): its field/ and potential/ keys through fieldTable(),
+/// its obstacles; type must be field. Keys of the line reference (ReferenceGeneratorSettings) are allowed
+/// and unused.
+void loadFieldConfig(const std::string& path, core::FieldParams& field, std::vector<core::Obstacle>& obstacles) {
+  const YAML::Node root = loadYaml(path);
+  onlyKeys(root, {"reference_generator"}, path, "");
+  const YAML::Node rg = required(root, "reference_generator", path, "");
+  if (!rg.IsMap()) fail(path, "reference_generator must be a mapping");
+  std::vector<std::pair<std::string, YAML::Node>> keys, field_keys;
+  flatten(rg, "", keys);
+  for (const auto& kv : keys) {
+    if (kv.first == "obstacles") continue;
+    if (kv.first == "type") {
+      if (kv.second.as<std::string>() != "field") fail(path, "reference_generator/type must be field");
+      continue;
+    }
+    if (!core::fieldTable().find(kv.first) && core::ReferenceGeneratorSettings::table().find(kv.first)) continue;
+    field_keys.push_back(kv);
+  }
+  applyKeys(core::fieldTable(), field_keys, field, path, "reference_generator/");
+  obstacles.clear();
+  if (const YAML::Node list = rg["obstacles"]) {
+    if (!list.IsSequence()) fail(path, "reference_generator/obstacles must be a list");
+    for (const auto& o : list) {
+      onlyKeys(o, {"x", "y", "radius"}, path, "reference_generator/obstacles/");
+      core::Obstacle ob;
+      ob.x = toDouble(required(o, "x", path, "obstacles/"), path, "obstacles/x");
+      ob.y = toDouble(required(o, "y", path, "obstacles/"), path, "obstacles/y");
+      if (o["radius"]) ob.radius = toDouble(o["radius"], path, "obstacles/radius");
+      const std::string e = ob.validate();
+      if (!e.empty()) fail(path, "obstacle: " + e);
+      obstacles.push_back(ob);
+    }
+  }
+}
+
+}  // namespace
+
+const std::vector<std::string>& pendingModels() {
+  static const std::vector<std::string> pending{"wet_soil", "estimated_pose"};
+  return pending;
+}
+
+core::BenchScenario loadScenarioFileImpl(const std::string& path) {
+  const YAML::Node root = loadYaml(path);
+  onlyKeys(root,
+           {"name", "description", "track", "duration", "control_rate", "start", "line", "sine", "field", "plant",
+            "draws", "success", "envelope_period", "requires"},
+           path, "");
+  core::BenchScenario b;
+  b.name = required(root, "name", path, "").as<std::string>();
+  if (b.name != stem(path)) fail(path, "name '" + b.name + "' must be the file's name ('" + stem(path) + "')");
+  required(root, "description", path, "");
+
+  const std::string track = required(root, "track", path, "").as<std::string>();
+  b.base.duration = toDouble(required(root, "duration", path, ""), path, "duration");
+  const double rate = toDouble(required(root, "control_rate", path, ""), path, "control_rate");
+  if (!(rate > 0.0)) fail(path, "control_rate must be > 0");
+  b.base.control_period_ns = static_cast<std::int64_t>(1e9 / rate + 0.5);
+  const YAML::Node start = required(root, "start", path, "");
+  onlyKeys(start, {"x", "y", "theta"}, path, "start/");
+  b.base.start = {toDouble(required(start, "x", path, "start/"), path, "start/x"),
+                  toDouble(required(start, "y", path, "start/"), path, "start/y"),
+                  toDouble(required(start, "theta", path, "start/"), path, "start/theta")};
+
+  // The track and its block; the blocks of the other tracks are refused.
+  const std::map<std::string, core::TrackKind> tracks{
+      {"line", core::TrackKind::line}, {"field", core::TrackKind::field}, {"sine", core::TrackKind::sine}};
+  const auto t = tracks.find(track);
+  if (t == tracks.end()) fail(path, "track '" + track + "' is none of line, field, sine");
+  b.track = t->second;
+  for (const char* other : {"line", "sine", "field"})
+    if (other != track && root[other])
+      fail(path, std::string("block '") + other + "' does not apply to track " + track);
+  const YAML::Node block = required(root, track, path, "");
+  if (b.track == core::TrackKind::line) {
+    onlyKeys(block, {"x0", "v_r", "y"}, path, "line/");
+    b.line_x0 = toDouble(required(block, "x0", path, "line/"), path, "line/x0");
+    b.line_v_r = toDouble(required(block, "v_r", path, "line/"), path, "line/v_r");
+    b.line_y = toDouble(required(block, "y", path, "line/"), path, "line/y");
+  } else if (b.track == core::TrackKind::sine) {
+    onlyKeys(block, {"x0", "y0", "speed_x", "amplitude", "wavelength"}, path, "sine/");
+    b.sine.x0 = toDouble(required(block, "x0", path, "sine/"), path, "sine/x0");
+    b.sine.y0 = toDouble(required(block, "y0", path, "sine/"), path, "sine/y0");
+    b.sine.speed_x = toDouble(required(block, "speed_x", path, "sine/"), path, "sine/speed_x");
+    b.sine.amplitude = toDouble(required(block, "amplitude", path, "sine/"), path, "sine/amplitude");
+    b.sine.wavelength = toDouble(required(block, "wavelength", path, "sine/"), path, "sine/wavelength");
+  } else {
+    onlyKeys(block, {"config", "finish_tolerance", "approach", "plan_detours"}, path, "field/");
+    b.field = core::FieldRunSetup().field;  // with the footprint's radius, as run_scenario --field
+    const std::string config = required(block, "config", path, "field/").as<std::string>();
+    loadFieldConfig(config.front() == '/' ? config : directoryOf(path) + "/" + config, b.field, b.obstacles);
+    b.finish_tolerance = toDouble(required(block, "finish_tolerance", path, "field/"), path, "field/finish_tolerance");
+    if (block["approach"]) b.field.approach = block["approach"].as<bool>();
+    if (block["plan_detours"]) b.field.avoidance.plan_detours = block["plan_detours"].as<bool>();
+  }
+
+  // Plant settings that are not drawn (the disturbance's frequency); the drawn ones are refused here.
+  if (const YAML::Node plant = root["plant"]) {
+    if (!plant.IsMap()) fail(path, "plant must be a mapping");
+    std::vector<std::pair<std::string, YAML::Node>> keys;
+    flatten(plant, "", keys);
+    for (const auto& kv : keys)
+      if (kv.first != "disturbance/frequency")
+        fail(path, "plant/" + kv.first +
+                       " is drawn per run or not a plant setting: only plant/disturbance/frequency "
+                       "may be set here (the draws are under draws/)");
+    applyKeys(core::disturbanceTable(), keys, b.base.disturbance, path, "plant/");
+  }
+
+  // What is drawn per run (every key stated, no defaults: the file says what the numbers mean).
+  const YAML::Node draws = required(root, "draws", path, "");
+  onlyKeys(draws,
+           {"base_seed", "mass_scale", "inertia_scale", "amplitude", "phase", "noise_std", "start_dx", "start_dy",
+            "start_dtheta"},
+           path, "draws/");
+  core::MonteCarloSpec& s = b.spec;
+  const double seed = toDouble(required(draws, "base_seed", path, "draws/"), path, "draws/base_seed");
+  if (!(seed >= 0.0) || seed != std::floor(seed)) fail(path, "draws/base_seed must be an integer >= 0");
+  s.base_seed = static_cast<std::uint64_t>(seed);
+  s.mass_scale = toUniform(required(draws, "mass_scale", path, "draws/"), path, "draws/mass_scale");
+  s.inertia_scale = toUniform(required(draws, "inertia_scale", path, "draws/"), path, "draws/inertia_scale");
+  s.amplitude = toUniform(required(draws, "amplitude", path, "draws/"), path, "draws/amplitude");
+  s.phase = toUniform(required(draws, "phase", path, "draws/"), path, "draws/phase");
+  s.noise_std = toDouble(required(draws, "noise_std", path, "draws/"), path, "draws/noise_std");
+  s.start_dx = toUniform(required(draws, "start_dx", path, "draws/"), path, "draws/start_dx");
+  s.start_dy = toUniform(required(draws, "start_dy", path, "draws/"), path, "draws/start_dy");
+  s.start_dtheta = toUniform(required(draws, "start_dtheta", path, "draws/"), path, "draws/start_dtheta");
+
+  const YAML::Node success = required(root, "success", path, "");
+  onlyKeys(success, {"settle_time", "cross_track_threshold"}, path, "success/");
+  s.settle_time = toDouble(required(success, "settle_time", path, "success/"), path, "success/settle_time");
+  s.cross_track_threshold =
+      toDouble(required(success, "cross_track_threshold", path, "success/"), path, "success/cross_track_threshold");
+  if (root["envelope_period"]) b.envelope_period = toDouble(root["envelope_period"], path, "envelope_period");
+
+  // Extension point (issue 16): `requires: [wet_soil]` or `[estimated_pose]` names a model that is not built
+  // yet; such a scenario is refused with that reason. When a model lands, read its block here (e.g. a
+  // `traction:` mapping through tractionTable()), apply it in core::runBenchmark, and drop it from pendingModels().
+  if (const YAML::Node req = root["requires"]) {
+    if (!req.IsSequence()) fail(path, "requires must be a list of model names");
+    for (const auto& m : req) {
+      const std::string model = m.as<std::string>();
+      const auto& pending = pendingModels();
+      if (std::find(pending.begin(), pending.end(), model) == pending.end())
+        fail(path, "requires: unknown model '" + model + "' (announced: wet_soil, estimated_pose)");
+      b.requires_models.push_back(model);
+    }
+  }
+  const std::string e = b.validate();
+  if (!e.empty()) fail(path, e);
+  return b;
+}
+
+// yaml-cpp's own exceptions (a list where a word was expected, ...) become the one-line error too.
+core::BenchScenario loadScenarioFile(const std::string& path) {
+  try {
+    return loadScenarioFileImpl(path);
+  } catch (const YAML::Exception& e) {
+    fail(path, e.what());
+  }
+}
+
+std::vector<std::string> scenarioNames(const std::string& dir) {
+  std::vector<std::string> names;
+  if (DIR* d = ::opendir(dir.c_str())) {
+    while (const dirent* entry = ::readdir(d)) {
+      const std::string f = entry->d_name;
+      if (f.size() > 5 && f.compare(f.size() - 5, 5, ".yaml") == 0) names.push_back(f.substr(0, f.size() - 5));
+    }
+    ::closedir(d);
+  }
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+core::BenchScenario loadScenario(const std::string& name_or_path, const std::string& dir) {
+  const bool is_path = name_or_path.find('/') != std::string::npos ||
+                       (name_or_path.size() > 5 && name_or_path.compare(name_or_path.size() - 5, 5, ".yaml") == 0);
+  if (is_path) return loadScenarioFile(name_or_path);
+  const std::string path = dir + "/" + name_or_path + ".yaml";
+  if (!fileExists(path)) {
+    std::string list;
+    for (const auto& n : scenarioNames(dir)) list += (list.empty() ? "" : ", ") + n;
+    throw std::invalid_argument("unknown scenario '" + name_or_path + "' (known in " + dir + ": " + list + ")");
+  }
+  return loadScenarioFile(path);
+}
+
+void applyTunedGainsImpl(const std::string& path, core::Scenario& sc) {
+  const YAML::Node root = loadYaml(path);
+  onlyKeys(root, {"kinematic_controller", "torque_controller", "pure_pursuit", "pid"}, path, "");
+  if (const YAML::Node g = root["kinematic_controller"])
+    applyGroup(core::kanayamaTable(), g, sc.kanayama, path, "kinematic_controller");
+  if (const YAML::Node g = root["torque_controller"]) {
+    const bool adaptive = sc.sliding.adaptive;
+    applyGroup(core::slidingModeTable(), g, sc.sliding, path, "torque_controller");
+    // The pair names the controller; a file tuned for the other mode is a mix-up, not a choice.
+    if (sc.inner == core::InnerKind::sliding_mode && sc.sliding.adaptive != adaptive)
+      fail(path, "torque_controller/mode is " + std::string(sc.sliding.adaptive ? "atsmc" : "tsmc") +
+                     " but the pair is " + sc.controllerName());
+    sc.sliding.adaptive = adaptive;
+  }
+  if (const YAML::Node g = root["pure_pursuit"])
+    applyGroup(core::purePursuitTable(), g, sc.pure_pursuit, path, "pure_pursuit");
+  if (const YAML::Node g = root["pid"]) applyGroup(core::wheelPidTable(), g, sc.pid, path, "pid");
+  const std::string e = sc.validate();
+  if (!e.empty()) fail(path, e);
+}
+
+void applyTunedGains(const std::string& path, core::Scenario& sc) {
+  try {
+    applyTunedGainsImpl(path, sc);
+  } catch (const YAML::Exception& e) {
+    fail(path, e.what());
+  }
+}
+
+std::string tunedGainsFile(const std::string& dir, const core::Scenario& sc) {
+  const std::string path = dir + "/" + sc.controllerName() + ".yaml";
+  return fileExists(path) ? path : "";
+}
+
+}  // namespace bench
+}  // namespace sowing_robot

@@ -1,0 +1,110 @@
+// The `benchmark` command (src/nodes/benchmark.cpp) through its executable: bad requests give one error line,
+// exit != 0 and no report; the files it writes are the same byte for byte whatever --threads.
+#include <gtest/gtest.h>
+
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <regex>
+#include <string>
+
+namespace {
+const std::string kSource = SOWING_SOURCE_DIR;
+const std::string kBin = SOWING_BENCHMARK_BIN;
+
+std::string readFile(const std::string& path) {
+  std::ifstream f(path);
+  return std::string(std::istreambuf_iterator<char>(f), {});
+}
+bool exists(const std::string& path) {
+  struct stat st;
+  return ::stat(path.c_str(), &st) == 0;
+}
+
+struct TempDir {
+  std::string path;
+  TempDir() {
+    char tmpl[] = "/tmp/benchmark_command_XXXXXX";
+    path = ::mkdtemp(tmpl);
+  }
+  ~TempDir() { std::system(("rm -rf " + path).c_str()); }
+};
+
+struct Outcome {
+  int status = -1;
+  std::string err;
+};
+
+/// Runs the command with `args` (its stdout discarded), capturing stderr.
+Outcome run(const TempDir& dir, const std::string& args) {
+  const std::string err = dir.path + "/stderr.txt";
+  const int raw = std::system((kBin + " " + args + " > /dev/null 2> " + err).c_str());
+  Outcome o;
+  o.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  o.err = readFile(err);
+  return o;
+}
+
+/// A 3 s thesis line (the suite's file, shortened) in DIR/quick_line.yaml.
+std::string quickLine(const TempDir& dir) {
+  std::string text = readFile(kSource + "/config/scenarios/thesis_line.yaml");
+  text = std::regex_replace(text, std::regex("name: thesis_line"), "name: quick_line");
+  text = std::regex_replace(text, std::regex("duration: 25.0"), "duration: 3.0");
+  text = std::regex_replace(text, std::regex("settle_time: 15.0"), "settle_time: 2.0");
+  const std::string path = dir.path + "/quick_line.yaml";
+  std::ofstream(path) << text;
+  return path;
+}
+
+void expectOneLineRefusal(const TempDir& dir, const std::string& args, const std::string& needle) {
+  SCOPED_TRACE(args);
+  const std::string out = dir.path + "/out";
+  const Outcome o = run(dir, args + " --output " + out);
+  EXPECT_NE(o.status, 0);
+  EXPECT_NE(o.err.find(needle), std::string::npos) << o.err;
+  EXPECT_EQ(o.err.rfind("benchmark: ", 0), 0u) << o.err;
+  ASSERT_FALSE(o.err.empty());
+  EXPECT_EQ(o.err.find('\n'), o.err.size() - 1) << "more than one line: " << o.err;
+  EXPECT_FALSE(exists(out + "/report.md"));
+  EXPECT_FALSE(exists(out + "/runs.csv"));
+}
+}  // namespace
+
+TEST(BenchmarkCommand, BadRequestsGiveOneLineAndNoReport) {
+  TempDir dir;
+  const std::string line = quickLine(dir);
+  // The same request done right works (so each refusal below is the edit's).
+  const Outcome ok = run(dir, "--scenarios " + line + " --controllers kanayama+atsmc --seeds 2 --threads 1 --output " +
+                                  dir.path + "/good");
+  EXPECT_EQ(ok.status, 0) << ok.err;
+  EXPECT_TRUE(exists(dir.path + "/good/report.md"));
+  expectOneLineRefusal(dir, "--scenarios no_such_scenario --controllers kanayama+atsmc --seeds 2",
+                       "unknown scenario 'no_such_scenario'");
+  expectOneLineRefusal(dir, "--scenarios " + line + " --controllers kanayama+smc --seeds 2", "smc");
+  expectOneLineRefusal(dir, "--scenarios " + line + " --controllers kanayama+atsmc --seeds 0", "--seeds must be >= 1");
+  std::string typo = readFile(line);
+  typo.replace(typo.find("  noise_std:"), 12, "  noise_sdt:");
+  std::ofstream(dir.path + "/quick_line.yaml") << typo;
+  expectOneLineRefusal(dir, "--scenarios " + line + " --controllers kanayama+atsmc --seeds 2", "noise_sdt");
+}
+
+TEST(BenchmarkCommand, TheFilesDoNotDependOnTheThreadCount) {
+  TempDir dir;
+  const std::string line = quickLine(dir);
+  const std::string args = "--scenarios " + line + " --controllers kanayama+atsmc,rpp+pid --seeds 5 --output ";
+  ASSERT_EQ(run(dir, args + dir.path + "/one --threads 1").status, 0);
+  ASSERT_EQ(run(dir, args + dir.path + "/two --threads 2").status, 0);
+  for (const char* f : {"/runs.csv", "/envelopes.csv", "/report.md"}) {
+    const std::string a = readFile(dir.path + "/one" + f), b = readFile(dir.path + "/two" + f);
+    EXPECT_FALSE(a.empty()) << f;
+    EXPECT_EQ(a, b) << f;
+  }
+  // 2 controllers x 5 seeds, one header line.
+  const std::string csv = readFile(dir.path + "/one/runs.csv");
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 11);
+}

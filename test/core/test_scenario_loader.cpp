@@ -1,0 +1,233 @@
+// The benchmark's scenario files and tuned gains (bench/scenario_loader.h): every suite file loads, a typo or
+// a missing key is refused naming it, tuned gains go through the parameter tables, and a field scenario's
+// success counts the body's contacts with the obstacles (core::runBenchmark).
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <fstream>
+#include <regex>
+#include <stdexcept>
+#include <string>
+
+#include "sowing_robot/bench/scenario_loader.h"
+
+using namespace sowing_robot;
+using core::BenchScenario;
+using core::TrackKind;
+
+namespace {
+const std::string kSource = SOWING_SOURCE_DIR;
+const std::string kSuite = kSource + "/config/scenarios";
+
+std::string readFile(const std::string& path) {
+  std::ifstream f(path);
+  return std::string(std::istreambuf_iterator<char>(f), {});
+}
+
+/// A scratch directory removed by the test's end.
+struct TempDir {
+  std::string path;
+  TempDir() {
+    char tmpl[] = "/tmp/scenario_loader_XXXXXX";
+    path = ::mkdtemp(tmpl);
+  }
+  ~TempDir() { std::system(("rm -rf " + path).c_str()); }
+  std::string write(const std::string& name, const std::string& text) const {
+    std::ofstream(path + "/" + name) << text;
+    return path + "/" + name;
+  }
+};
+
+/// thesis_line.yaml with `from` replaced by `to` (once), written as DIR/thesis_line.yaml.
+std::string variant(const TempDir& dir, const std::string& from, const std::string& to) {
+  std::string text = readFile(kSuite + "/thesis_line.yaml");
+  const std::size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  return dir.write("thesis_line.yaml", text);
+}
+
+std::string loadError(const std::string& path) {
+  try {
+    bench::loadScenarioFile(path);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "";
+}
+}  // namespace
+
+TEST(ScenarioLoader, EverySuiteFileLoads) {
+  const auto names = bench::scenarioNames(kSuite);
+  for (const char* expected :
+       {"thesis_line", "thesis_field", "three_row_field", "sine_rows", "heavy_robot", "disturbance_sweep"})
+    EXPECT_NE(std::find(names.begin(), names.end(), expected), names.end()) << expected;
+  for (const auto& n : names) {
+    SCOPED_TRACE(n);
+    BenchScenario b;
+    ASSERT_NO_THROW(b = bench::loadScenario(n, kSuite));
+    EXPECT_EQ(b.name, n);
+    EXPECT_EQ(b.validate(), "");
+  }
+  // What the files say arrives where it belongs.
+  const BenchScenario line = bench::loadScenario("thesis_line", kSuite);
+  EXPECT_EQ(line.track, TrackKind::line);
+  EXPECT_EQ(line.base.duration, 25.0);
+  EXPECT_EQ(line.base.control_period_ns, 1000000);
+  EXPECT_EQ(line.spec.mass_scale.lo, 0.8);
+  EXPECT_EQ(line.spec.mass_scale.hi, 1.5);
+  EXPECT_EQ(line.spec.cross_track_threshold, 0.05);
+  const BenchScenario field = bench::loadScenario("thesis_field", kSuite);
+  EXPECT_EQ(field.track, TrackKind::field);
+  ASSERT_EQ(field.obstacles.size(), 3u);
+  EXPECT_EQ(field.obstacles[1].x, 50.0);
+  EXPECT_EQ(field.field.row_length, 100.0);
+  EXPECT_EQ(field.field.potential.beta, 4.0);
+  const BenchScenario rows = bench::loadScenario("three_row_field", kSuite);
+  EXPECT_EQ(rows.field.rows, 3);
+  EXPECT_EQ(rows.obstacles.size(), 1u);
+  EXPECT_EQ(bench::loadScenario("sine_rows", kSuite).track, TrackKind::sine);
+  EXPECT_GE(bench::loadScenario("heavy_robot", kSuite).spec.mass_scale.lo, 1.3);
+  EXPECT_GE(bench::loadScenario("disturbance_sweep", kSuite).spec.amplitude.hi, 5.0);
+}
+
+TEST(ScenarioLoader, TyposAndMissingKeysAreRefusedNamingThem) {
+  TempDir dir;
+  // The unmodified copy loads (so each failure below is the edit's).
+  EXPECT_EQ(loadError(variant(dir, "name: thesis_line", "name: thesis_line")), "");
+  std::string e = loadError(variant(dir, "  mass_scale:", "  mass_scal:"));
+  EXPECT_NE(e.find("unknown key 'draws/mass_scal'"), std::string::npos) << e;
+  e = loadError(variant(dir, "duration: 25.0", "duraton: 25.0"));
+  EXPECT_NE(e.find("duraton"), std::string::npos) << e;
+  e = loadError(variant(dir, "  cross_track_threshold: 0.05", "  cross_track_threshold: 0.05x"));
+  EXPECT_NE(e.find("cross_track_threshold"), std::string::npos) << e;
+  e = loadError(variant(dir, "  settle_time: 15.0", "  # settle_time gone"));
+  EXPECT_NE(e.find("missing key 'success/settle_time'"), std::string::npos) << e;
+  e = loadError(variant(dir, "track: line", "track: lnie"));
+  EXPECT_NE(e.find("lnie"), std::string::npos) << e;
+  e = loadError(variant(dir, "mass_scale: [0.8, 1.5]", "mass_scale: [1.5, 0.8]"));
+  EXPECT_NE(e.find("mass_scale"), std::string::npos) << e;
+  e = loadError(variant(dir, "disturbance: {frequency: 3.0}", "disturbance: {frequence: 3.0}"));
+  EXPECT_NE(e.find("frequence"), std::string::npos) << e;
+  e = loadError(variant(dir, "name: thesis_line", "name: other"));
+  EXPECT_NE(e.find("must be the file's name"), std::string::npos) << e;
+  // Every message is one line, starting with the file.
+  EXPECT_EQ(e.find('\n'), std::string::npos);
+  EXPECT_EQ(e.rfind(dir.path, 0), 0u) << e;
+  // An unknown name lists the known ones.
+  try {
+    bench::loadScenario("thesis_lien", kSuite);
+    FAIL();
+  } catch (const std::invalid_argument& ex) {
+    EXPECT_NE(std::string(ex.what()).find("unknown scenario 'thesis_lien'"), std::string::npos) << ex.what();
+    EXPECT_NE(std::string(ex.what()).find("thesis_line"), std::string::npos) << ex.what();
+  }
+}
+
+TEST(ScenarioLoader, ModelsNotBuiltYetAreRefusedWithTheirReason) {
+  TempDir dir;
+  std::string e = loadError(variant(dir, "requires: []", "requires: [wet_soil]"));
+  EXPECT_NE(e.find("wet_soil"), std::string::npos) << e;
+  EXPECT_NE(e.find("not available yet"), std::string::npos) << e;
+  e = loadError(variant(dir, "requires: []", "requires: [estimated_pose]"));
+  EXPECT_NE(e.find("estimated_pose"), std::string::npos) << e;
+  e = loadError(variant(dir, "requires: []", "requires: [dry_soil]"));
+  EXPECT_NE(e.find("unknown model 'dry_soil'"), std::string::npos) << e;
+}
+
+TEST(ScenarioLoader, TunedGainsGoThroughTheParameterTables) {
+  TempDir dir;
+  core::Scenario sc;
+  ASSERT_EQ(core::parseControllerPair("kanayama+atsmc", sc.outer, sc.inner, sc.sliding.adaptive), "");
+  EXPECT_EQ(bench::tunedGainsFile(dir.path, sc), "");
+  const std::string path = dir.write("kanayama+atsmc.yaml",
+                                     "kinematic_controller:\n  kx: 9.5\n  ky: 7.5\n  ktheta: 7.0\n"
+                                     "torque_controller:\n  k1: 400.0\n  rate_m: 0.5\n  mode: atsmc\n");
+  EXPECT_EQ(bench::tunedGainsFile(dir.path, sc), path);
+  bench::applyTunedGains(path, sc);
+  EXPECT_EQ(sc.kanayama.kx, 9.5);
+  EXPECT_EQ(sc.sliding.k1, 400.0);
+  EXPECT_EQ(sc.sliding.rate_m, 0.5);
+  // The results/ file of today loads as it is.
+  core::Scenario today = core::Scenario();
+  EXPECT_NO_THROW(bench::applyTunedGains(kSource + "/results/tuned_gains.yaml", today));
+  EXPECT_NE(today.kanayama.kx, core::Scenario().kanayama.kx);
+  // Unknown keys and groups, values out of range, a file of the other mode: refused.
+  auto refused = [&](const std::string& text, const std::string& needle) {
+    core::Scenario s = core::Scenario();
+    const std::string p = dir.write("bad.yaml", text);
+    try {
+      bench::applyTunedGains(p, s);
+      ADD_FAILURE() << text;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+    }
+  };
+  refused("kinematic_controller:\n  kxx: 1.0\n", "kxx");
+  refused("torque_controler:\n  k1: 1.0\n", "torque_controler");
+  refused("kinematic_controller:\n  kx: -1.0\n", "kx");
+  refused("torque_controller:\n  mode: tsmc\n", "mode");
+  refused("pid:\n  kp: fast\n", "kp");
+  core::Scenario pid;
+  ASSERT_EQ(core::parseControllerPair("rpp+pid", pid.outer, pid.inner, pid.sliding.adaptive), "");
+  bench::applyTunedGains(dir.write("rpp+pid.yaml", "pure_pursuit:\n  lookahead_dist: 0.8\npid:\n  kp: 3.0\n"), pid);
+  EXPECT_EQ(pid.pure_pursuit.lookahead_dist, 0.8);
+  EXPECT_EQ(pid.pid.kp, 3.0);
+}
+
+namespace {
+/// A 12 m row with an obstacle on it at x = 6, 22 s, from the row start: with the potential field and the
+/// planned detours the body passes it; without avoidance (gain 0, no detours) it drives through it.
+BenchScenario shortField(const TempDir& dir, bool avoid) {
+  dir.write("short_field_config.yaml",
+            "reference_generator:\n  type: field\n  field:\n    rows: 1\n    row_length: 12.0\n    start_y: 3.0\n"
+            "  potential:\n    alpha: 4.0\n    beta: 4.0\n    gain: " +
+                std::string(avoid ? "5.0" : "0.0") + "\n  obstacles:\n    - {x: 6.0, y: 3.0, radius: 0.3}\n");
+  std::string text = readFile(kSuite + "/thesis_field.yaml");
+  text = std::regex_replace(text, std::regex("name: thesis_field"), "name: short_field");
+  text = std::regex_replace(text, std::regex("duration: 113.0"), "duration: 22.0");
+  text =
+      std::regex_replace(text, std::regex("config: \\.\\./field_thesis\\.yaml"),
+                         "config: short_field_config.yaml\n  plan_detours: " + std::string(avoid ? "true" : "false"));
+  text = std::regex_replace(text, std::regex("start: \\{x: -1.0, y: 0.0"), "start: {x: 0.0, y: 3.0");
+  text = std::regex_replace(text, std::regex("start_d(x|y|theta): \\[[^\\]]*\\]"), "start_d$1: 0.0");
+  text = std::regex_replace(text, std::regex("amplitude: \\[0.0, 2.0\\]"), "amplitude: 0.0");
+  text = std::regex_replace(text, std::regex("cross_track_threshold: 0.05"), "cross_track_threshold: 10.0");
+  text = std::regex_replace(text, std::regex("settle_time: 15.0"), "settle_time: 2.0");
+  return bench::loadScenarioFile(dir.write("short_field.yaml", text));
+}
+}  // namespace
+
+TEST(ScenarioLoader, AFieldRunFailsOnABodyContact) {
+  TempDir dir;
+  for (bool avoid : {true, false}) {
+    SCOPED_TRACE(avoid ? "avoiding" : "driving through");
+    BenchScenario b = shortField(dir, avoid);
+    const std::vector<core::RunRow> rows = core::runBenchmark(b, 2, 2);
+    for (const core::RunRow& r : rows) {
+      if (avoid) {
+        EXPECT_EQ(r.contacts, 0u);
+        EXPECT_GT(r.min_clearance, 0.0);
+        EXPECT_TRUE(r.success) << r.failure << ", end distance " << r.end_distance;
+      } else {
+        EXPECT_GE(r.contacts, 1u);
+        EXPECT_LT(r.min_clearance, 0.0);
+        EXPECT_FALSE(r.success);
+        EXPECT_EQ(r.failure, "contact");
+      }
+    }
+    const std::string report = core::reportSection(b.name, "kanayama+atsmc", rows);
+    EXPECT_NE(report.find(avoid ? "contact 0" : "contact 2"), std::string::npos) << report;
+  }
+}
+
+TEST(ScenarioLoader, AFieldRunCutShortIsNotFinished) {
+  TempDir dir;
+  BenchScenario b = shortField(dir, true);
+  b.base.duration = 8.0;  // the path (12 m at 1 m/s and the ramp down) has not ended
+  const std::vector<core::RunRow> rows = core::runBenchmark(b, 1, 1);
+  EXPECT_EQ(rows[0].failure, "not finished");
+}
