@@ -14,9 +14,9 @@ namespace core {
 /// in the odom frame [m], and its soil.
 struct SoilPatch {
   std::vector<Eigen::Vector2d> polygon;
-  double mu_peak = 0.2;             ///< peak friction coefficient (as traction/mu_peak)
-  double mu_slide = 0.15;           ///< sliding friction coefficient, <= mu_peak (as traction/mu_slide)
-  double rolling_resistance = 0.05; ///< rolling-resistance coefficient (as traction/rolling_resistance)
+  double mu_peak = 0.2;              ///< peak friction coefficient (as traction/mu_peak)
+  double mu_slide = 0.15;            ///< sliding friction coefficient, <= mu_peak (as traction/mu_slide)
+  double rolling_resistance = 0.05;  ///< rolling-resistance coefficient (as traction/rolling_resistance)
 
   /// "" or one line naming `key` (e.g. "field/patches[1]") and what is wrong: fewer than 3 vertices, a
   /// non-finite vertex, a negative or non-finite coefficient, mu_slide > mu_peak, rolling_resistance > 1.
