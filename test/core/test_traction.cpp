@@ -475,7 +475,7 @@ TEST(TractionDraft, DraftSlowsTheRobotOnlyWithTheToolDown) {
   EXPECT_EQ(up.draftForce(), 0.0);
   EXPECT_LT(down.state()[V], none.state()[V] - 0.1);
   EXPECT_LT(down.state()[X], none.state()[X]);
-  EXPECT_NEAR(down.draftForce(), -10.0, 0.02);  // full draft once moving, against the motion
+  EXPECT_NEAR(down.draftForce(), -10.0, 0.02);   // full draft once moving, against the motion
   EXPECT_NEAR(down.state()[THETA], 0.0, 1e-12);  // on the axle line: no turn
   std::printf("draft 10 N: v %.3f m/s (none %.3f) after 3 s\n", down.state()[V], none.state()[V]);
 }

@@ -64,10 +64,10 @@ struct FieldRunReport {
   Eigen::Vector2d end = Eigen::Vector2d::Zero();  ///< final axle position [m]
   AvoidanceStatus status;
   bool diverged = false;
-  long saturated = 0;             ///< control periods the inner loop saturated
-  double max_slip = 0.0;          ///< with traction: largest |slip ratio| of either wheel
-  double tool_down_time = 0.0;    ///< with traction and a draft: time the tool was down (the draft acting) [s]
-  std::string summary() const;    ///< one line with every figure (the no-slip ones)
+  long saturated = 0;           ///< control periods the inner loop saturated
+  double max_slip = 0.0;        ///< with traction: largest |slip ratio| of either wheel
+  double tool_down_time = 0.0;  ///< with traction and a draft: time the tool was down (the draft acting) [s]
+  std::string summary() const;  ///< one line with every figure (the no-slip ones)
 };
 
 /// Throws std::invalid_argument on invalid parameters.

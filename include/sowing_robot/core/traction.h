@@ -35,12 +35,13 @@
 // in a patch uses its mu_peak, mu_slide and rolling_resistance (the slip curve's shape, slip_peak and
 // slip_stiffness, stays the field's), elsewhere the traction/ values.
 // The tool's draft (setToolDown, traction/draft_force D): while the tool is down, a force of magnitude
-// D acts at the tool point (xt, yt) in base_link against that point's velocity (v − w yt, w xt)
-// (regularised linearly below slip_speed_floor; semi-implicit, so that a draft far beyond the motors
-// stays stable, at the price of a relative shortfall dt D / (m v), 7e-4 for 10 N at 1 m/s). As for the caster, its generalised forces under the nonholonomic constraint are
-// F_x on v and xt F_y − yt F_x on w: a tool off the axle line (yt ≠ 0) turns the robot towards its
-// side, one behind the axle (xt < 0) damps the yaw. The sideways part is held by the wheels (no
-// lateral slip, also on ice). Evaluated once per step, as the rolling resistance.
+// D acts at the tool point (xt, yt) in base_link against that point's velocity (v − w yt, w xt),
+// regularised linearly below slip_speed_floor and semi-implicit, so that a draft far beyond the motors
+// stays stable (at the price of a relative shortfall dt D / (m v): 7e-4 for 10 N at 1 m/s). As for the
+// caster, its generalised forces under the nonholonomic constraint are F_x on v and xt F_y − yt F_x on
+// w: a tool off the axle line (yt ≠ 0) turns the robot towards its side, one behind the axle (xt < 0)
+// damps the yaw. The sideways part is held by the wheels (no lateral slip, also on ice). Evaluated
+// once per step, as the rolling resistance.
 
 #pragma once
 

@@ -17,8 +17,8 @@
 #include "sowing_robot/core/robot_params.h"
 #include "sowing_robot/core/types.h"
 #include "sowing_robot/ros/path_buffer.h"
-#include "sowing_robot/ros/plant_model.h"
 #include "sowing_robot/ros/plant_contacts.h"
+#include "sowing_robot/ros/plant_model.h"
 
 namespace sowing_robot {
 
