@@ -8,6 +8,7 @@
 
 #include "sowing_robot/core/field.h"
 #include "sowing_robot/core/node_settings.h"
+#include "sowing_robot/core/traction.h"
 
 namespace sowing_robot {
 namespace core {
@@ -90,10 +91,11 @@ const std::vector<CatalogSection>& parameterCatalog() {
        infos(RunSettings::table()),
        {}},
       {"plant_sim",
-       "the plant: its two drivers' timing, the start pose, the disturbance and the mismatch; the "
-       "geometry and inertia come from the URDF (robot_description)",
-       infos(PlantSimSettings::table()),
-       {}},
+       "the plant: its two drivers' timing, the start pose, the disturbance and the mismatch, and the "
+       "opt-in wheel-soil traction (traction/, config/traction.yaml) with the field's soil patches "
+       "(field/patches); the geometry and inertia come from the URDF (robot_description)",
+       concat(PlantSimSettings::table(), tractionTable()),
+       {"field/patches"}},
       {"kinematic_controller",
        "the outer loop, chosen by `outer`: Kanayama (eqs 4.1-4.2; kx, ky, ktheta live-tunable), pure pursuit or "
        "nav2's Regulated Pure Pursuit (nav2's parameter names; start-up only). Unmarked parameters are Kanayama's, "

@@ -39,6 +39,9 @@ const ParamTable<TractionParams>& tractionTable() {
              "caster contact ahead of the axle, for the normal loads (URDF caster_joint x)"),
       integer("traction/substeps", &T::substeps, 4, Limits::closed(1.0, 1000.0), "",
               "linearly implicit integration sub-steps per plant step"),
+      number("traction/draft_force", &T::draft_force, 0.0, Limits::closed(0.0, 1e5), "N",
+             "draft of the seed drill's tool while it is down, at the tool point (URDF tool_link) against its "
+             "motion; 0 = none (a furrow opener in loose soil: some 10..100 N)"),
   });
   return table;
 }
@@ -72,7 +75,12 @@ NormalLoads staticNormalLoads(const RobotParams& robot, double mass_scale, doubl
 
 TractionPlant::TractionPlant(const RobotParams& nominal, const PlantDisturbance& disturbance,
                              const TractionParams& traction)
-    : nominal_(nominal), disturbance_(disturbance), traction_(traction), curve_(traction), rng_(disturbance.seed) {
+    : nominal_(nominal),
+      disturbance_(disturbance),
+      traction_(traction),
+      curves_{FrictionCurve(traction)},
+      rr_{traction.rolling_resistance},
+      rng_(disturbance.seed) {
   const std::string error = firstError({nominal.validate(), disturbance.validate(), traction.validate()});
   if (!error.empty()) throw std::invalid_argument(error);
   const double spin = 2.0 * nominal.Iw / (nominal.R * nominal.R);
@@ -103,6 +111,37 @@ void TractionPlant::setNormalLoads(const NormalLoads& loads) {
   loads_ = loads;
 }
 
+void TractionPlant::setSoil(const SoilMap& soil) {
+  std::vector<FrictionCurve> curves{FrictionCurve(traction_)};
+  std::vector<double> rr{traction_.rolling_resistance};
+  for (std::size_t i = 0; i < soil.patches().size(); ++i) {
+    const SoilPatch& patch = soil.patches()[i];
+    TractionParams p = traction_;
+    p.mu_peak = patch.mu_peak;
+    p.mu_slide = patch.mu_slide;
+    p.rolling_resistance = patch.rolling_resistance;
+    const std::string e = p.validate();
+    if (!e.empty())
+      throw std::invalid_argument("field/patches[" + std::to_string(i) + "] does not fit the slip curve: " + e);
+    curves.emplace_back(p);
+    rr.push_back(patch.rolling_resistance);
+  }
+  soil_ = soil;
+  curves_ = std::move(curves);
+  rr_ = std::move(rr);
+  ground_[0] = ground_[1] = ground_[2] = 0;
+  locateContacts();
+}
+
+void TractionPlant::locateContacts() {
+  if (soil_.empty()) return;
+  const double c = std::cos(state_[THETA]), s = std::sin(state_[THETA]), L = nominal_.L;
+  const Eigen::Vector2d axle(state_[X], state_[Y]), left(-s * L, c * L);
+  ground_[RIGHT] = 1 + soil_.patchAt(axle - left);
+  ground_[LEFT] = 1 + soil_.patchAt(axle + left);
+  ground_[kCaster] = 1 + soil_.patchAt(axle + traction_.caster_x * Eigen::Vector2d(c, s));
+}
+
 void TractionPlant::reset(const State& initial, double t) {
   if (!initial.allFinite() || !std::isfinite(t)) throw std::invalid_argument("plant reset: non-finite state or time");
   state_ = initial;
@@ -110,6 +149,8 @@ void TractionPlant::reset(const State& initial, double t) {
   wheel_rate_[RIGHT] = (initial[V] + nominal_.L * initial[OMEGA]) / nominal_.R;
   wheel_rate_[LEFT] = (initial[V] - nominal_.L * initial[OMEGA]) / nominal_.R;
   slip_[RIGHT] = slip_[LEFT] = force_[RIGHT] = force_[LEFT] = 0.0;
+  draft_f_ = draft_m_ = 0.0;
+  locateContacts();
   rng_.seed(disturbance_.seed);
   noise_.reset();
 }
@@ -139,8 +180,15 @@ bool TractionPlant::step(double tau_right, double tau_left, double dt) {
     dist_c = std::cos(angle);
   }
   const double amplitude = disturbance_.sinusoidal ? disturbance_.amplitude : 0.0;
+  locateContacts();
   double rr_force, rr_moment;
   rollingResistance(rr_force, rr_moment);
+  draft_f_ = draft_m_ = 0.0;
+  if (tool_down_ && traction_.draft_force > 0.0) {
+    draft(dt, draft_f_, draft_m_);
+    rr_force += draft_f_;
+    rr_moment += draft_m_;
+  }
   for (int j = 0; j < n; ++j) {
     substep(tau_right + noise_r + amplitude * dist_s, tau_left + noise_l + amplitude * dist_c, rr_force, rr_moment, h,
             cos_th, sin_th);
@@ -153,16 +201,16 @@ bool TractionPlant::step(double tau_right, double tau_left, double dt) {
 void TractionPlant::rollingResistance(double& force, double& moment) const {
   // Non-stiff (rate c N / (floor m) of a few 1/s): once per step, from the step's start.
   force = moment = 0.0;
-  const double c_rr = traction_.rolling_resistance;
-  if (c_rr <= 0.0) return;
+  const double c_r = rr_[ground_[RIGHT]], c_l = rr_[ground_[LEFT]], c_rr = rr_[ground_[kCaster]];
+  if (c_r <= 0.0 && c_l <= 0.0 && c_rr <= 0.0) return;
   const double v = state_[V], w = state_[OMEGA], L = nominal_.L;
-  const double f_r = -c_rr * loads_.right * std::clamp((v + L * w) * inv_floor_, -1.0, 1.0);
-  const double f_l = -c_rr * loads_.left * std::clamp((v - L * w) * inv_floor_, -1.0, 1.0);
+  const double f_r = -c_r * loads_.right * std::clamp((v + L * w) * inv_floor_, -1.0, 1.0);
+  const double f_l = -c_l * loads_.left * std::clamp((v - L * w) * inv_floor_, -1.0, 1.0);
   force = f_r + f_l;
   moment = L * (f_r - f_l);
   // Caster: against its travel (v, caster_x w); the sideways part goes into the axle's nonholonomic
   // reaction, its moment about the axle stays.
-  if (loads_.caster > 0.0) {
+  if (loads_.caster > 0.0 && c_rr > 0.0) {
     const double xc = traction_.caster_x, lateral = xc * w;
     const double speed = std::sqrt(v * v + lateral * lateral);
     const double scale = c_rr * loads_.caster / std::max(speed, traction_.slip_speed_floor);
@@ -171,9 +219,30 @@ void TractionPlant::rollingResistance(double& force, double& moment) const {
   }
 }
 
+void TractionPlant::draft(double dt, double& force, double& moment) const {
+  const double xt = tool_.x(), yt = tool_.y(), v = state_[V], w = state_[OMEGA];
+  const double vx = v - w * yt, vy = w * xt, speed = std::hypot(vx, vy);
+  const double D = traction_.draft_force, floor = traction_.slip_speed_floor;
+  // Force = −c (vx, vy), c = D / max(speed, floor): full D when moving, a linear damper below the floor.
+  // Stiff when D is large against the body (c dt / m >> 1), so semi-implicit, with the tool point's
+  // mobility along the motion, M = (vx²/m + (xt vy − yt vx)²/I) / speed²: c / (1 + dt c M) cannot reverse
+  // the motion in one step, and a draft the motors cannot overcome brings the robot to rest. At speed the
+  // factor is 1 + O(dt D / (m v)) (7e-4 for 10 N at 1 m/s).
+  if (!(speed > 0.0)) {
+    force = moment = 0.0;
+    return;
+  }
+  const double c = D / std::max(speed, floor);
+  const double lever = xt * vy - yt * vx;
+  const double mobility = (vx * vx * inv_m_ + lever * lever * inv_i_) / (speed * speed);
+  const double scale = c / (1.0 + dt * c * mobility);
+  const double fx = -scale * vx, fy = -scale * vy;
+  force = fx;
+  moment = xt * fy - yt * fx;
+}
+
 void TractionPlant::substep(double tau_r, double tau_l, double rr_force, double rr_moment, double h, double& cos_th,
                             double& sin_th) {
-  const FrictionCurve& curve = curve_;
   const double R = nominal_.R, L = nominal_.L, floor = traction_.slip_speed_floor;
   const double v = state_[V], w = state_[OMEGA];
   const double u[2] = {v + L * w, v - L * w};
@@ -190,7 +259,7 @@ void TractionPlant::substep(double tau_r, double tau_l, double rr_force, double 
     // explicit (slope 0), which keeps the 2×2 system below well posed and the sliding wheel accurate.
     // Any non-negative slope keeps the linearly implicit Euler step first-order consistent.
     double jac;
-    const double mu = curve.evalForIntegration(std::fabs(kappa), jac);
+    const double mu = curves_[ground_[i]].evalForIntegration(std::fabs(kappa), jac);
     f0[i] = kappa < 0.0 ? -n_load[i] * mu : n_load[i] * mu;
     k[i] = n_load[i] * jac * inv_den;
     slip_[i] = kappa;
@@ -215,9 +284,9 @@ void TractionPlant::substep(double tau_r, double tau_l, double rr_force, double 
   const double ds_r = (m22 * b_r - m12 * b_l) * inv_det, ds_l = (m11 * b_l - m21 * b_r) * inv_det;
   // Forces at the sub-step's end, capped by the peak grip (the linearisation may overshoot the peak).
   double f[2];
-  f[RIGHT] =
-      std::clamp(f0[RIGHT] + k[RIGHT] * ds_r, -traction_.mu_peak * n_load[RIGHT], traction_.mu_peak * n_load[RIGHT]);
-  f[LEFT] = std::clamp(f0[LEFT] + k[LEFT] * ds_l, -traction_.mu_peak * n_load[LEFT], traction_.mu_peak * n_load[LEFT]);
+  const double mu_r = curves_[ground_[RIGHT]].mu_p, mu_l = curves_[ground_[LEFT]].mu_p;
+  f[RIGHT] = std::clamp(f0[RIGHT] + k[RIGHT] * ds_r, -mu_r * n_load[RIGHT], mu_r * n_load[RIGHT]);
+  f[LEFT] = std::clamp(f0[LEFT] + k[LEFT] * ds_l, -mu_l * n_load[LEFT], mu_l * n_load[LEFT]);
   force_[RIGHT] = f[RIGHT];
   force_[LEFT] = f[LEFT];
   // One force for both sides of the contact: wheel and body exchange exactly the same momentum.

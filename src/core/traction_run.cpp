@@ -8,8 +8,10 @@ namespace sowing_robot {
 namespace core {
 
 TractionRunResult runTractionClosedLoop(const Scenario& sc, const TractionParams& traction, ReferenceSource& reference,
-                                        bool keep_samples, const std::function<void(const LoopSample&)>& trace) {
+                                        bool keep_samples, const std::function<void(const LoopSample&)>& trace,
+                                        const std::function<void(TractionPlant&)>& setup) {
   TractionPlant plant(sc.robot, sc.disturbance, traction);
+  if (setup) setup(plant);
   State x0 = State::Zero();
   x0[X] = sc.start.x;
   x0[Y] = sc.start.y;

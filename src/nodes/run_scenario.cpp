@@ -3,6 +3,7 @@
 //                [--switching NAME --width W] [--repeat N] [--yaml FILE (metrics of the last mode)]
 //                [--traction MU [--slip-stiffness K] [--rolling-resistance C]]
 //   run_scenario --field [--potential-only] [--no-approach] [--start X Y THETA] [--rate HZ]
+//                [--tsmc] [--traction MU [--wet] [--draft N]]
 // Prints the Table 5.5/5.6 metrics as Markdown and the wall time per run. --field runs the thesis field
 // (config/field_thesis.yaml: a 100 m row at y = 3, obstacles r 0.3 at x = 20, 50, 80; ATSMC, disturbance,
 // 20 % mismatch, 110 s) measured on the body (the URDF's footprint) and prints clearance, contacts, peak
@@ -12,7 +13,11 @@
 // (-1, 0, 0)) and the target starts there too, on an approach to the row (field/approach);
 // --no-approach starts the target at the row start instead (the figures before the approach).
 // --traction runs the line with the traction plant (traction.h: peak friction MU, sliding 0.75 MU, the
-// other traction/* defaults) instead of the no-slip one.
+// other traction/* defaults) instead of the no-slip one. With --field it runs the field so (Kanayama +
+// ATSMC, or TSMC with --tsmc); --wet adds the wet patch of config/field_thesis_wet.yaml (mu_peak 0.2,
+// mu_slide 0.15, rolling resistance 0.08 over x 43..58 m, y 1..5 m) and --draft N the tool's draft
+// (traction/draft_force) while the tool is down; it prints the seeds' cross-track RMS / max and the
+// largest slip.
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -29,8 +34,21 @@ using namespace sowing_robot::core;
 
 namespace {
 /// The thesis field on the body; returns the exit code.
-int runThesisField(bool potential_only, bool approach, const Pose2D& start, std::int64_t period_ns) {
+int runThesisField(bool potential_only, bool approach, const Pose2D& start, std::int64_t period_ns,
+                   const TractionParams& traction, bool wet, bool adaptive) {
   FieldRunSetup s;
+  s.scenario.sliding.adaptive = adaptive;
+  if (traction.enabled) {
+    s.traction = traction;
+    if (wet) {
+      SoilPatch patch;  // config/field_thesis_wet.yaml
+      patch.polygon = {{43.0, 1.0}, {58.0, 1.0}, {58.0, 5.0}, {43.0, 5.0}};
+      patch.mu_peak = 0.2;
+      patch.mu_slide = 0.15;
+      patch.rolling_resistance = 0.08;
+      s.patches = {patch};
+    }
+  }
   s.scenario.duration = 110.0;
   if (period_ns > 0) s.scenario.control_period_ns = period_ns;
   s.scenario.start = start;
@@ -57,8 +75,8 @@ int runThesisField(bool potential_only, bool approach, const Pose2D& start, std:
   const FieldRunReport r = runField(s);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const FieldRunReport w = runField(whole);
-  std::printf("thesis field, %s%s (%.0f ms wall), start (%.2f, %.2f, %.3f), footprint circumscribed radius %.3f m:\n",
-              potential_only ? "potential field only (thesis)" : "planned detours (issue 15)",
+  std::printf("thesis field, %s%s%s (%.0f ms wall), start (%.2f, %.2f, %.3f), footprint circumscribed radius %.3f m:\n",
+              adaptive ? "" : "TSMC, ", potential_only ? "potential field only (thesis)" : "planned detours (issue 15)",
               potential_only ? "" : (approach ? ", approach from the start" : ", no approach"), 1e3 * wall, start.x,
               start.y, start.theta, s.footprint.circumscribedRadius());
   std::printf(
@@ -78,13 +96,19 @@ int runThesisField(bool potential_only, bool approach, const Pose2D& start, std:
       r.peak_ref_yaw_rate, r.peak_ref_lateral, r.peak_ref_curvature, w.peak_ref_yaw_rate, w.peak_ref_lateral,
       w.peak_ref_curvature, AvoidanceStatus::name(r.status.code), r.status.reason.empty() ? "" : ": ",
       r.status.reason.c_str(), r.status.within_bounds ? "" : "; bounds not held: ", r.status.bounds_note.c_str());
+  if (traction.enabled)
+    std::printf(
+        "traction: mu_peak %g, %zu soil patch(es), draft %g N (tool down %.1f s); max |slip ratio| %.3f; "
+        "seeds on rows: cross-track RMS %.2f mm, max %.2f mm; %ld saturated periods%s\n",
+        traction.mu_peak, s.patches.size(), traction.draft_force, r.tool_down_time, r.max_slip, 1e3 * r.rows.rms,
+        1e3 * r.rows.max, r.saturated, r.diverged ? ", DIVERGED" : "");
   return r.diverged ? 1 : 0;
 }
 }  // namespace
 
 int main(int argc, char** argv) {
   std::vector<bool> modes;
-  bool field = false, potential_only = false, approach = true;
+  bool field = false, potential_only = false, approach = true, wet = false;
   Pose2D start = Scenario().start;
   Scenario sc;
   int repeat = 1;
@@ -131,7 +155,11 @@ int main(int argc, char** argv) {
       traction.enabled = true;
       traction.mu_peak = value("--traction");
       traction.mu_slide = 0.75 * traction.mu_peak;
-    } else if (a == "--slip-stiffness")
+    } else if (a == "--wet")
+      wet = true;
+    else if (a == "--draft")
+      traction.draft_force = value("--draft");
+    else if (a == "--slip-stiffness")
       traction.slip_stiffness = value("--slip-stiffness");
     else if (a == "--rolling-resistance")
       traction.rolling_resistance = value("--rolling-resistance");
@@ -147,7 +175,15 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
-  if (field) return runThesisField(potential_only, approach, start, sc.control_period_ns);
+  if (field) {
+    const std::string err = traction.enabled ? traction.validate() : "";
+    if (!err.empty() || ((wet || traction.draft_force > 0.0) && !traction.enabled)) {
+      std::fprintf(stderr, "run_scenario: %s\n", err.empty() ? "--wet and --draft need --traction MU" : err.c_str());
+      return 2;
+    }
+    return runThesisField(potential_only, approach, start, sc.control_period_ns, traction, wet,
+                          modes.empty() || modes.back());
+  }
   if (modes.empty()) modes = {true, false};
   std::vector<std::string> names;
   std::vector<std::array<AxisMetrics, AXIS_COUNT>> results;

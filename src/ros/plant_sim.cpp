@@ -1,12 +1,35 @@
 #include "sowing_robot/ros/plant_sim.h"
 
+#include <cmath>
+
 #include "sowing_robot/core/validation.h"
 #include "sowing_robot/ros/component_params.h"
 #include "sowing_robot/ros/plant_sim_lockstep.h"
 #include "sowing_robot/ros/plant_sim_realtime.h"
+#include "sowing_robot/ros/plant_traction.h"
 #include "sowing_robot/ros/urdf_params.h"
 
 namespace sowing_robot {
+
+namespace {
+/// The draft's tool: the seed drill's tool point (URDF link `seed_drill/tool_link`) and its lowering rule
+/// (`seed_drill/engage_distance`), read where sim.launch loads config/seed_drill.yaml (the run's
+/// namespace), so the plant's "tool down" is the drill's. "" or one line naming the bad key.
+std::string loadToolSettings(const ros::NodeHandle& nh, const std::string& urdf, TractionModel::Config& out) {
+  std::string link = "tool_link";
+  nh.param<std::string>("seed_drill/tool_link", link, link);
+  double engage = out.seeding.engage_distance;
+  nh.param("seed_drill/engage_distance", engage, engage);
+  if (!(engage > 0.0) || !std::isfinite(engage))
+    return "parameter " + nh.resolveName("seed_drill/engage_distance") + " must be finite and > 0 (the draft's tool)";
+  out.seeding.engage_distance = engage;
+  double x = 0.0, y = 0.0;
+  const std::string e = linkPositionFromUrdf(urdf, link, x, y);
+  if (!e.empty()) return "the draft's tool point (seed_drill/tool_link): " + e;
+  out.tool = Eigen::Vector2d(x, y);
+  return "";
+}
+}  // namespace
 
 PlantSim::PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh) {
   ParamReader p(pnh);
@@ -16,13 +39,22 @@ PlantSim::PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh) {
   const core::RunSettings run = loadRunSettings(nh, p);
   core::PlantSimSettings settings;
   loadTable(p, core::PlantSimSettings::table(), settings);
+  // traction/... and field/patches: validated even when traction is off, so a bad value never waits for
+  // the day it is switched on.
+  TractionModel::Config traction;
+  loadTable(p, core::tractionTable(), traction.traction);
+  std::vector<core::SoilPatch> patches;
+  const std::string patch_error = loadSoilPatches(p, "field/patches", traction.traction, patches);
   // The body checked for contacts is the URDF's collision footprint (the one source of the robot's shape).
   core::Footprint footprint;
   std::string key, xml, footprint_error;
   if (robot_error.empty() && pnh.searchParam("robot_description", key) && pnh.getParam(key, xml))
     footprint_error = footprintFromUrdf(xml, footprint);
+  const std::string tool_error = traction.traction.enabled && traction.traction.draft_force > 0.0 && robot_error.empty()
+                                     ? loadToolSettings(nh, xml, traction)
+                                     : "";
   requireValid(p, core::firstError({robot_error, robot_error.empty() ? robot.validate() : "", footprint_error,
-                                    settings.validate()}));
+                                    settings.validate(), traction.traction.validate(), patch_error, tool_error}));
   cfg_.lockstep = run.lockstep;
   cfg_.period_ns = run.periodNs();
   cfg_.duration = run.duration;
@@ -48,10 +80,28 @@ PlantSim::PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh) {
   rates.max_speed = cfg_.max_speed;
   rates.odom_frame = run.odom_frame;
   rates.base_frame = run.base_frame;
-  plant_ = std::make_unique<SimulatedPlant>(nh, robot, disturbance, start, rates, footprint);
-  const core::Plant& plant = plant_->plant();
+  std::unique_ptr<PlantModel> model;
+  if (traction.traction.enabled) {
+    traction.soil = core::SoilMap(patches);  // validated above
+    traction.odom_frame = run.odom_frame;
+    try {
+      model = std::make_unique<TractionModel>(nh, robot, disturbance, SimulatedPlant::restAt(start), traction);
+    } catch (const std::invalid_argument& e) {
+      refuseToStart(e.what());
+    }
+  } else if (!patches.empty()) {
+    ROS_WARN("plant_sim: %zu soil patch(es) in field/patches have no effect: traction/enabled is false",
+             patches.size());
+  }
+  plant_ = std::make_unique<SimulatedPlant>(nh, robot, disturbance, start, rates, footprint, std::move(model));
+  const PlantModel& plant = plant_->model();
   logSettings("plant_sim", core::RunSettings::table(), run, "run/");
   logSettings("plant_sim", core::PlantSimSettings::table(), settings);
+  if (traction.traction.enabled) {
+    logSettings("plant_sim", core::tractionTable(), traction.traction);
+    ROS_INFO("plant_sim: traction plant with %zu soil patch(es); tool point (%.3f, %.3f) m", patches.size(),
+             traction.tool.x(), traction.tool.y());
+  }
   ROS_INFO("plant_sim: m0 %.4f kg (true %.4f), I0 %.5f kg m^2 (true %.5f)", robot.m0(), plant.trueM0(), robot.I0(),
            plant.trueI0());
 

@@ -77,7 +77,7 @@ void LockstepDriver::reportFinished() {
 
 bool LockstepDriver::loopConnected() const {
   return static_cast<int>(plant_.odomSubscribers()) >= cfg_.min_subscribers && torque_sub_.getNumPublishers() >= 1 &&
-         roster_.complete();
+         plant_.inputsReady() && roster_.complete();
 }
 
 std::string LockstepDriver::torqueSources() const {
@@ -88,11 +88,13 @@ std::string LockstepDriver::torqueSources() const {
 
 void LockstepDriver::report(const core::LockstepProtocol::Supervision& s) const {
   if (s.step < 0) {
+    const std::string model = plant_.model().waitingFor();
     ROS_WARN(
         "plant_sim: lockstep waiting for the loop for %.1f s wall: %u/%d odom subscribers, %u wheel_torque "
-        "publishers, not announced on ready: %s",
+        "publishers, not announced on ready: %s%s%s",
         s.waited, plant_.odomSubscribers(), cfg_.min_subscribers, torque_sub_.getNumPublishers(),
-        roster_.missing().empty() ? "none" : roster_.missing().c_str());
+        roster_.missing().empty() ? "none" : roster_.missing().c_str(), model.empty() ? "" : ", waiting for ",
+        model.c_str());
   } else {
     ROS_ERROR(
         "plant_sim: lockstep stalled at t=%.6f s: no wheel_torque stamped for it after %.1f s wall (%s); "

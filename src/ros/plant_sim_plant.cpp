@@ -10,21 +10,19 @@
 
 namespace sowing_robot {
 
-namespace {
-core::State restAt(const core::Pose2D& start) {
+core::State SimulatedPlant::restAt(const core::Pose2D& start) {
   core::State x0 = core::State::Zero();
   x0[core::X] = start.x;
   x0[core::Y] = start.y;
   x0[core::THETA] = start.theta;
   return x0;
 }
-}  // namespace
 
 SimulatedPlant::SimulatedPlant(ros::NodeHandle nh, const core::RobotParams& robot,
                                const core::PlantDisturbance& disturbance, const core::Pose2D& start, const Rates& rates,
-                               const core::Footprint& footprint)
-    : rates_(rates), plant_(robot, disturbance) {
-  plant_.reset(restAt(start), 0.0);
+                               const core::Footprint& footprint, std::unique_ptr<PlantModel> model)
+    : rates_(rates),
+      model_(model ? std::move(model) : std::make_unique<NoSlipModel>(robot, disturbance, restAt(start))) {
   visual_every_ = std::max<std::int64_t>(1, std::llround(1e9 / rates_.publish_rate / rates_.period_ns));
   if (rates_.clock_rate > 0.0)
     clock_every_ = std::max<std::int64_t>(1, std::llround(1e9 / rates_.clock_rate / rates_.period_ns));
@@ -47,6 +45,8 @@ SimulatedPlant::~SimulatedPlant() {
   if (contacts_reported_) return;
   // stdout, not rosconsole: at shutdown the logger may already be gone.
   std::printf("plant_sim: %s", contacts_->finish().c_str());  // the report ends with a newline
+  const std::string model = model_->report();
+  if (!model.empty()) std::printf("plant_sim: %s\n", model.c_str());
   std::fflush(stdout);
 }
 
@@ -56,6 +56,8 @@ void SimulatedPlant::reportContacts() {
   std::string report = contacts_->finish();
   if (!report.empty() && report.back() == '\n') report.pop_back();
   ROS_INFO("plant_sim: %s", report.c_str());
+  const std::string model = model_->report();
+  if (!model.empty()) ROS_INFO("plant_sim: %s", model.c_str());
 }
 
 ros::Time SimulatedPlant::stampOf(std::int64_t k) const {
@@ -65,31 +67,31 @@ ros::Time SimulatedPlant::stampOf(std::int64_t k) const {
 }
 
 bool SimulatedPlant::step(const core::WheelTorques& torque) {
-  plant_.step(torque.right, torque.left, dt());
+  model_->step(torque.right, torque.left, dt());
   if (!healthy()) return false;
-  const core::State& s = plant_.state();
-  contacts_->update(plant_.time(), {s[core::X], s[core::Y], s[core::THETA]});
+  const core::State& s = model_->state();
+  contacts_->update(model_->time(), {s[core::X], s[core::Y], s[core::THETA]});
   return true;
 }
 
 bool SimulatedPlant::healthy() const {
-  const core::State& s = plant_.state();
+  const core::State& s = model_->state();
   return std::isfinite(s.sum()) && std::fabs(s[core::V]) <= rates_.max_speed;
 }
 
 std::string SimulatedPlant::divergence() const {
-  const core::State& s = plant_.state();
+  const core::State& s = model_->state();
   char text[320];
   std::snprintf(text, sizeof text,
                 "state diverged at t=%.6f s (x %g, y %g, theta %g, v %g, omega %g; max_speed %g m/s): stopping the "
                 "run instead of publishing garbage",
-                plant_.time(), s[core::X], s[core::Y], s[core::THETA], s[core::V], s[core::OMEGA], rates_.max_speed);
+                model_->time(), s[core::X], s[core::Y], s[core::THETA], s[core::V], s[core::OMEGA], rates_.max_speed);
   return text;
 }
 
 void SimulatedPlant::publish(std::int64_t k, bool visuals, bool clock) {
   const ros::Time stamp = stampOf(k);
-  const core::State& s = plant_.state();
+  const core::State& s = model_->state();
   odom_msg_.header.stamp = stamp;
   odom_msg_.pose.pose.position.x = s[core::X];
   odom_msg_.pose.pose.position.y = s[core::Y];
@@ -118,10 +120,9 @@ void SimulatedPlant::publish(std::int64_t k, bool visuals, bool clock) {
   joint_msg_.header.stamp = stamp;
   joint_msg_.position[0] = s[core::PHI_R];
   joint_msg_.position[1] = s[core::PHI_L];
-  const core::State ds = plant_.derivative(s, 0.0, 0.0);  // wheel rates do not depend on torque
-  joint_msg_.velocity[0] = ds[core::PHI_R];
-  joint_msg_.velocity[1] = ds[core::PHI_L];
+  model_->wheelRates(joint_msg_.velocity[0], joint_msg_.velocity[1]);
   joint_pub_.publish(joint_msg_);
+  model_->publishVisuals(stamp);
 
   geometry_msgs::PoseStamped pose;
   pose.header = odom_msg_.header;

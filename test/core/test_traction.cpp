@@ -448,3 +448,106 @@ TEST(Traction, CostBesidePlant) {
   std::printf("plant steps/s: Plant %.3g, traction %.3g (%.2fx the time)\n", sp, st, sp / st);
   SUCCEED();
 }
+
+// --- The tool's draft (issue 16, item 3) and its edges -------------------------------------------------
+
+namespace {
+// Equal torques from rest for `seconds` with the tool at `tool`, down with `draft` N.
+TractionPlant driveWithTool(double draft, const Eigen::Vector2d& tool, bool down, double seconds = 3.0,
+                            double tau = 1.0) {
+  TractionParams t;
+  t.draft_force = draft;
+  TractionPlant plant(RobotParams{}, PlantDisturbance{}, t);
+  plant.setToolPoint(tool);
+  plant.setToolDown(down);
+  plant.reset(State::Zero());
+  for (int i = 0; i < static_cast<int>(seconds * 1000); ++i) plant.step(tau, tau, kDt);
+  return plant;
+}
+}  // namespace
+
+TEST(TractionDraft, DraftSlowsTheRobotOnlyWithTheToolDown) {
+  const Eigen::Vector2d tool(-0.45, 0.0);
+  const TractionPlant none = driveWithTool(0.0, tool, true);
+  const TractionPlant up = driveWithTool(10.0, tool, false);
+  const TractionPlant down = driveWithTool(10.0, tool, true);
+  EXPECT_EQ(up.state(), none.state());  // tool up: no draft at all
+  EXPECT_EQ(up.draftForce(), 0.0);
+  EXPECT_LT(down.state()[V], none.state()[V] - 0.1);
+  EXPECT_LT(down.state()[X], none.state()[X]);
+  EXPECT_NEAR(down.draftForce(), -10.0, 0.02);   // full draft once moving, against the motion
+  EXPECT_NEAR(down.state()[THETA], 0.0, 1e-12);  // on the axle line: no turn
+  std::printf("draft 10 N: v %.3f m/s (none %.3f) after 3 s\n", down.state()[V], none.state()[V]);
+}
+
+// A tool left of the axle line (y > 0) drags the left side back: the robot turns left (theta > 0), and
+// mirrored to the right; the moment is -yt F_x = yt D once moving straight.
+TEST(TractionDraft, LateralToolOffsetYawsTowardsItsSide) {
+  const TractionPlant left = driveWithTool(20.0, {-0.45, 0.1}, true);
+  const TractionPlant right = driveWithTool(20.0, {-0.45, -0.1}, true);
+  EXPECT_GT(left.state()[THETA], 1e-3);
+  EXPECT_LT(right.state()[THETA], -1e-3);
+  EXPECT_NEAR(left.state()[THETA], -right.state()[THETA], 1e-9);
+  EXPECT_GT(left.draftMoment(), 0.0);
+  std::printf("tool 0.1 m left, draft 20 N: heading %.4f rad after 3 s\n", left.state()[THETA]);
+}
+
+// A draft far beyond what the motors and the soil can give (500 N against ~90 N of grip): the robot
+// stays put or creeps, the state stays finite, it never runs backwards.
+TEST(TractionDraft, ADraftTheMotorsCannotOvercomeHoldsTheRobotFinite) {
+  const TractionPlant p = driveWithTool(500.0, {-0.45, 0.05}, true, 5.0, 4.0);
+  EXPECT_TRUE(p.state().allFinite());
+  EXPECT_GE(p.state()[V], -1e-9);
+  EXPECT_LT(p.state()[V], 0.05);  // below the regularisation speed: held
+  EXPECT_LT(std::fabs(p.state()[X]), 0.25);
+  std::printf("draft 500 N, 4 N·m: x %.4f m, v %.5f m/s, slip %.2f after 5 s\n", p.state()[X], p.state()[V],
+              p.slipRatio(RIGHT));
+}
+
+// Ice: no grip, a coasting robot with the tool down is braked to rest by the draft, not reversed; with
+// a wheel in the air the draft is still finite.
+TEST(TractionDraft, IceAndAWheelInTheAirWithTheDraftStayFinite) {
+  TractionParams t;
+  t.mu_peak = t.mu_slide = 0.0;
+  t.draft_force = 50.0;
+  TractionPlant plant(RobotParams{}, PlantDisturbance{}, t);
+  plant.setToolDown(true);
+  State s = State::Zero();
+  s[V] = 1.0;
+  plant.reset(s);
+  for (int i = 0; i < 5000; ++i) ASSERT_TRUE(plant.step(50.0, -50.0, kDt));
+  EXPECT_TRUE(plant.state().allFinite());
+  EXPECT_NEAR(plant.state()[V], 0.0, 1e-3);
+  EXPECT_GE(plant.state()[V], -1e-9);
+
+  TractionParams g;
+  g.draft_force = 50.0;
+  TractionPlant air(RobotParams{}, PlantDisturbance{}, g);
+  air.setToolDown(true);
+  air.reset(State::Zero());
+  NormalLoads n = air.normalLoads();
+  n.right = 0.0;
+  air.setNormalLoads(n);
+  for (int i = 0; i < 5000; ++i) ASSERT_TRUE(air.step(100.0, 100.0, kDt));
+  EXPECT_TRUE(air.state().allFinite());
+  EXPECT_TRUE(std::isfinite(air.wheelRate(RIGHT)));
+}
+
+// The closed loop against a draft it cannot overcome: the run ends, finite, saturated and reporting it.
+TEST(TractionDraft, ClosedLoopAgainstAnInsurmountableDraftEndsAndReportsSaturation) {
+  Scenario sc;
+  sc.sliding.max_torque = 4.0;
+  LineReference line;
+  TractionParams t;
+  t.draft_force = 300.0;
+  const TractionRunResult r =
+      runTractionClosedLoop(sc, t, line, false, {}, [](TractionPlant& p) { p.setToolDown(true); });
+  EXPECT_FALSE(r.run.diverged);
+  EXPECT_TRUE(r.run.final_state.allFinite());
+  EXPECT_EQ(r.run.periods, sc.steps());
+  EXPECT_GT(r.run.saturated_steps, sc.steps() / 2);
+  EXPECT_LT(r.run.final_state[X], 5.0);  // held back: the line runs away from it
+  std::printf("draft 300 N: saturated %lld of %lld periods, final x %.3f m\n",
+              static_cast<long long>(r.run.saturated_steps), static_cast<long long>(sc.steps() + 1),
+              r.run.final_state[X]);
+}

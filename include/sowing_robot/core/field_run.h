@@ -5,6 +5,7 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -15,6 +16,8 @@
 #include "sowing_robot/core/footprint.h"
 #include "sowing_robot/core/runner.h"
 #include "sowing_robot/core/seeding.h"
+#include "sowing_robot/core/soil_map.h"
+#include "sowing_robot/core/traction.h"
 
 namespace sowing_robot {
 namespace core {
@@ -39,6 +42,12 @@ struct FieldRunSetup {
   std::function<void(double t, FieldReference& reference, ContactMonitor& contacts)> on_step;
   /// Peaks are taken from this time on (e.g. after the approach from the start) [s].
   double peaks_from = 0.0;
+  /// Set: the traction plant (traction.h, runTractionClosedLoop: Kanayama + sliding mode, whatever
+  /// scenario.outer says) in place of the no-slip Plant, on these soil patches, with the tool's draft
+  /// (traction->draft_force) while the tool is down by the plant's own rule (tool_engagement.h, on the
+  /// field's rows), as plant_sim does with traction:=true.
+  std::optional<TractionParams> traction;
+  std::vector<SoilPatch> patches;
   FieldRunSetup();
 };
 
@@ -55,7 +64,10 @@ struct FieldRunReport {
   Eigen::Vector2d end = Eigen::Vector2d::Zero();  ///< final axle position [m]
   AvoidanceStatus status;
   bool diverged = false;
-  std::string summary() const;  ///< one line with every figure
+  long saturated = 0;           ///< control periods the inner loop saturated
+  double max_slip = 0.0;        ///< with traction: largest |slip ratio| of either wheel
+  double tool_down_time = 0.0;  ///< with traction and a draft: time the tool was down (the draft acting) [s]
+  std::string summary() const;  ///< one line with every figure (the no-slip ones)
 };
 
 /// Throws std::invalid_argument on invalid parameters.

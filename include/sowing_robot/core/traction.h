@@ -29,6 +29,19 @@
 // velocities (heading at the sub-step's midpoint). The sinusoidal disturbance is taken at each
 // sub-step's midpoint, the torque noise held over the step (as Plant). Errors against a 1 µs reference
 // and the no-slip limit: test/core/test_traction.cpp.
+//
+// Soil patches (setSoil, soil_map.h): at the start of every step each wheel's contact point (the axle
+// midpoint ± L sideways; right wheel at −L in base_link, URDF) and the caster's are looked up; a wheel
+// in a patch uses its mu_peak, mu_slide and rolling_resistance (the slip curve's shape, slip_peak and
+// slip_stiffness, stays the field's), elsewhere the traction/ values.
+// The tool's draft (setToolDown, traction/draft_force D): while the tool is down, a force of magnitude
+// D acts at the tool point (xt, yt) in base_link against that point's velocity (v − w yt, w xt),
+// regularised linearly below slip_speed_floor and semi-implicit, so that a draft far beyond the motors
+// stays stable (at the price of a relative shortfall dt D / (m v): 7e-4 for 10 N at 1 m/s). As for the
+// caster, its generalised forces under the nonholonomic constraint are F_x on v and xt F_y − yt F_x on
+// w: a tool off the axle line (yt ≠ 0) turns the robot towards its side, one behind the axle (xt < 0)
+// damps the yaw. The sideways part is held by the wheels (no lateral slip, also on ice). Evaluated
+// once per step, as the rolling resistance.
 
 #pragma once
 
@@ -37,10 +50,12 @@
 #include <cstdint>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "sowing_robot/core/param_table.h"
 #include "sowing_robot/core/plant.h"
 #include "sowing_robot/core/robot_params.h"
+#include "sowing_robot/core/soil_map.h"
 
 namespace sowing_robot {
 namespace core {
@@ -57,12 +72,13 @@ struct TractionParams {
   double slip_speed_floor;    ///< [m/s] smallest speed the slip ratio is divided by
   double caster_x;            ///< [m] caster contact ahead of the axle (URDF caster_joint x)
   int substeps;               ///< integration sub-steps per plant step
+  double draft_force;         ///< [N] the seed drill tool's draft while it is down (0: none)
 
   /// checkRanges() plus the cross rules: mu_slide <= mu_peak, slip_stiffness >= mu_peak / slip_peak.
   std::string validate() const;
 };
 /// traction/{enabled, mu_peak, mu_slide, slip_peak, slip_stiffness, rolling_resistance,
-/// slip_speed_floor, caster_x, substeps}.
+/// slip_speed_floor, caster_x, substeps, draft_force}.
 const ParamTable<TractionParams>& tractionTable();
 
 /// Friction coefficient μ(κ) of the curve (odd in κ): a rational rise μ_p g(|κ|/κ_p),
@@ -126,6 +142,7 @@ struct NormalLoads {
 NormalLoads staticNormalLoads(const RobotParams& robot, double mass_scale, double caster_x);
 
 enum Wheel { RIGHT = 0, LEFT = 1 };
+constexpr int kCaster = 2;  ///< contact index of the caster (patchUnder)
 
 /// The DDMR with wheel slip. step()/state()/time() as Plant; state() holds the same seven entries
 /// (PHI_R, PHI_L are the wheels' true spin angles, what an encoder would count).
@@ -152,6 +169,21 @@ class TractionPlant {
   const NormalLoads& normalLoads() const { return loads_; }
   /// Override the normal loads [N] (a wheel in the air: 0; later: terrain). Throws for negative/NaN.
   void setNormalLoads(const NormalLoads& loads);
+  /// Soil patches (validated by SoilMap); the rest of the field keeps the traction parameters. Throws
+  /// std::invalid_argument when a patch's grip does not fit the slip curve (slip_stiffness >=
+  /// mu_peak / slip_peak).
+  void setSoil(const SoilMap& soil);
+  const SoilMap& soil() const { return soil_; }
+  /// Patch index (-1: default soil) under each wheel and the caster, as of the last step's start.
+  int patchUnder(int contact) const { return ground_[contact] - 1; }
+  /// The tool point in base_link [m] (URDF tool_link; default (-0.45, 0)).
+  void setToolPoint(const Eigen::Vector2d& p) { tool_ = p; }
+  /// Tool down: the draft acts from the next step on (the caller applies the seed drill's rule).
+  void setToolDown(bool down) { tool_down_ = down; }
+  bool toolDown() const { return tool_down_; }
+  /// The draft's generalised force on v [N] and moment on w [N·m] of the last step (0 with the tool up).
+  double draftForce() const { return draft_f_; }
+  double draftMoment() const { return draft_m_; }
   /// Kinetic energy [J]: body translation and yaw plus both wheels' spin.
   double kineticEnergy() const;
   double bodyMass() const { return m_b_; }
@@ -159,12 +191,22 @@ class TractionPlant {
 
  private:
   void rollingResistance(double& force, double& moment) const;
+  /// The draft's generalised force and moment for a step of dt (see the file comment).
+  void draft(double dt, double& force, double& moment) const;
+  /// ground_ of the wheels' and the caster's contact points (soil patches).
+  void locateContacts();
   void substep(double tau_r, double tau_l, double rr_force, double rr_moment, double h, double& cos_th, double& sin_th);
 
   RobotParams nominal_;
   PlantDisturbance disturbance_;
   TractionParams traction_;
-  FrictionCurve curve_;
+  std::vector<FrictionCurve> curves_;  // [0]: the traction parameters, [1 + i]: patch i
+  std::vector<double> rr_;             // rolling resistance, indexed as curves_
+  SoilMap soil_;
+  int ground_[3] = {0, 0, 0};  // curves_ index under the right wheel, the left wheel, the caster
+  Eigen::Vector2d tool_{-0.45, 0.0};
+  bool tool_down_ = false;
+  double draft_f_ = 0.0, draft_m_ = 0.0;
   double m_b_, i_b_, mcd_;
   double sqrt_m_, sqrt_i_, inv_sqrt_mi_, inv_sqrt_m_, inv_sqrt_i_;
   double inv_m_, inv_i_, inv_iw_, inv_floor_;

@@ -16,11 +16,13 @@ struct TractionRunResult {
   double max_abs_slip = 0.0;  ///< largest |slip ratio| of either wheel over the run
 };
 
-/// runClosedLoop() with TractionPlant(scenario.robot, scenario.disturbance, traction). Throws
+/// runClosedLoop() with TractionPlant(scenario.robot, scenario.disturbance, traction). `setup` (if
+/// given) sees the plant before its reset: soil patches, normal loads, the tool (setToolDown). Throws
 /// std::invalid_argument when a parameter set does not validate.
 TractionRunResult runTractionClosedLoop(const Scenario& scenario, const TractionParams& traction,
                                         ReferenceSource& reference, bool keep_samples = true,
-                                        const std::function<void(const LoopSample&)>& trace = {});
+                                        const std::function<void(const LoopSample&)>& trace = {},
+                                        const std::function<void(TractionPlant&)>& setup = {});
 
 }  // namespace core
 }  // namespace sowing_robot

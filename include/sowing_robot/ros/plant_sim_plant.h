@@ -1,4 +1,5 @@
-// The part of plant_sim that both drivers share: the simulated DDMR (core::Plant) with its health check,
+// The part of plant_sim that both drivers share: the simulated DDMR (a PlantModel: today's core::Plant, or
+// the traction plant, plant_model.h / plant_traction.h) with its health check,
 // and the messages that show its state (odom, /clock, tf, joint_states, the travelled path). Which step
 // comes when, and with which torque, is the drivers' business (plant_sim_realtime.h, plant_sim_lockstep.h).
 #pragma once
@@ -17,6 +18,7 @@
 #include "sowing_robot/core/types.h"
 #include "sowing_robot/ros/path_buffer.h"
 #include "sowing_robot/ros/plant_contacts.h"
+#include "sowing_robot/ros/plant_model.h"
 
 namespace sowing_robot {
 
@@ -30,9 +32,13 @@ class SimulatedPlant {
     std::string odom_frame = "odom", base_frame = "base_link";  // run/odom_frame, run/base_frame (REP-105)
   };
 
-  /// Starts the plant at rest at `start` and advertises its topics on `nh`.
+  /// Starts the plant at rest at `start` and advertises its topics on `nh`. `model` (started at rest at
+  /// `start` by the caller, see restAt()) replaces today's no-slip core::Plant when given.
   SimulatedPlant(ros::NodeHandle nh, const core::RobotParams& robot, const core::PlantDisturbance& disturbance,
-                 const core::Pose2D& start, const Rates& rates, const core::Footprint& footprint);
+                 const core::Pose2D& start, const Rates& rates, const core::Footprint& footprint,
+                 std::unique_ptr<PlantModel> model = nullptr);
+  /// The state at rest at `start`.
+  static core::State restAt(const core::Pose2D& start);
   /// Prints the contact report if the run did not (a realtime run, or one stopped early).
   ~SimulatedPlant();
   /// The contact report (contacts of the body, minimum clearance) as one log line, once.
@@ -51,7 +57,9 @@ class SimulatedPlant {
   std::int64_t periodNs() const { return rates_.period_ns; }
   double dt() const { return core::secondsFromNanos(rates_.period_ns); }
   unsigned odomSubscribers() const { return odom_pub_.getNumSubscribers(); }
-  const core::Plant& plant() const { return plant_; }
+  /// Lockstep: the model has every input a step needs (the traction model with a draft: the plan).
+  bool inputsReady() const { return model_->ready(); }
+  const PlantModel& model() const { return *model_; }
   /// The FATAL text of a diverged state: its time and values, and max_speed.
   std::string divergence() const;
 
@@ -59,7 +67,7 @@ class SimulatedPlant {
   bool healthy() const;
 
   Rates rates_;
-  core::Plant plant_;
+  std::unique_ptr<PlantModel> model_;
   std::int64_t visual_every_ = 20;  // publish visuals every n steps
   std::int64_t clock_every_ = 1;    // publish /clock every n steps
   ros::Publisher clock_pub_, odom_pub_, joint_pub_, path_pub_;

@@ -1,0 +1,50 @@
+// Soil patches of a field (issue 16, item 2): polygons with their own grip and rolling resistance. The
+// traction plant (traction.h) looks up each wheel's and the caster's contact point here every step; a
+// point in no patch is on the field's default soil (the traction/ parameters).
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+namespace sowing_robot {
+namespace core {
+
+/// One patch: a simple polygon (vertices in order, either sense, not closed: the last joins the first)
+/// in the odom frame [m], and its soil.
+struct SoilPatch {
+  std::vector<Eigen::Vector2d> polygon;
+  double mu_peak = 0.2;              ///< peak friction coefficient (as traction/mu_peak)
+  double mu_slide = 0.15;            ///< sliding friction coefficient, <= mu_peak (as traction/mu_slide)
+  double rolling_resistance = 0.05;  ///< rolling-resistance coefficient (as traction/rolling_resistance)
+
+  /// "" or one line naming `key` (e.g. "field/patches[1]") and what is wrong: fewer than 3 vertices, a
+  /// non-finite vertex, a negative or non-finite coefficient, mu_slide > mu_peak, rolling_resistance > 1.
+  std::string validate(const std::string& key) const;
+};
+
+/// The patches of a field. Where patches overlap, the one listed last wins.
+class SoilMap {
+ public:
+  SoilMap() = default;
+  /// Throws std::invalid_argument (the first SoilPatch::validate() text, keys "field/patches[i]").
+  explicit SoilMap(std::vector<SoilPatch> patches);
+
+  /// Index of the patch holding p (even-odd rule; a point on an edge may fall either side), or -1.
+  int patchAt(const Eigen::Vector2d& p) const;
+  const std::vector<SoilPatch>& patches() const { return patches_; }
+  bool empty() const { return patches_.empty(); }
+
+ private:
+  struct Box {
+    Eigen::Vector2d lo, hi;
+  };
+  std::vector<SoilPatch> patches_;
+  std::vector<Box> boxes_;  // bounding boxes: most lookups end there
+};
+
+/// True when p lies inside `polygon` (even-odd rule).
+bool insidePolygon(const std::vector<Eigen::Vector2d>& polygon, const Eigen::Vector2d& p);
+
+}  // namespace core
+}  // namespace sowing_robot
