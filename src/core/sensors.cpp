@@ -30,8 +30,7 @@ const ParamTable<ImuParams>& imuTable() {
   using I = ImuParams;
   static const ParamTable<I> table({
       number("noise", &I::noise, 0.005, Limits::closed(0.0, 10.0), "rad/s", "std of the gyro's yaw-rate noise"),
-      number("bias", &I::bias, 0.002, Limits::closed(-1.0, 1.0), "rad/s",
-             "constant gyro yaw-rate bias (either sign)"),
+      number("bias", &I::bias, 0.002, Limits::closed(-1.0, 1.0), "rad/s", "constant gyro yaw-rate bias (either sign)"),
   });
   return table;
 }

@@ -26,8 +26,8 @@ class LockstepDriver : public PlantSimDriver {
  public:
   struct Config {
     core::LockstepTiming timing;
-    double duration = 25.0;   // [s] sim; <= 0 runs forever
-    int min_subscribers = 3;  // subscribers of ground_truth (+ odom with loop_on_odom) to wait for before step 0
+    double duration = 25.0;     // [s] sim; <= 0 runs forever
+    int min_subscribers = 3;    // subscribers of ground_truth (+ odom with loop_on_odom) to wait for before step 0
     bool loop_on_odom = false;  // the controllers' feedback comes from odom (the encoders), not ground_truth
   };
   LockstepDriver(ros::NodeHandle nh, SimulatedPlant& plant, const Config& config);

@@ -69,7 +69,7 @@ class SimulatedPlant {
   std::int64_t visual_every_ = 20;  // publish visuals every n steps
   std::int64_t clock_every_ = 1;    // publish /clock every n steps
   ros::Publisher clock_pub_, truth_pub_, joint_pub_, path_pub_;
-  std::unique_ptr<PlantSensors> sensors_;  // encoders, gyro, fix: read every step()
+  std::unique_ptr<PlantSensors> sensors_;    // encoders, gyro, fix: read every step()
   std::unique_ptr<PlantContacts> contacts_;  // the body against the plan's obstacles, every step
   bool contacts_reported_ = false;
   tf2_ros::TransformBroadcaster tf_;
