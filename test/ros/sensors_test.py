@@ -6,9 +6,10 @@ imu comes every step with its bias; every fix is stamped on the 1/rate grid with
 STAMP (not at its arrival, latency later), the last one sent is the one stamped duration - latency (the later
 ones are still in flight when the run ends), and none is stamped in the dropout window.
 
-Fails without the thing it protects: a fix stamped with its arrival time fails the position-at-stamp check
-(the robot moves ~0.3 m in the latency, sigma is 5 mm); odom published from the true state fails the
-"differs" check; a dropout ignored fails the window check."""
+Verified to fail: with the fix stamped at its arrival (plant_sensors.cpp) the test fails (a fix stamped
+2.0 s, in the dropout window, since it arrived then; the position-at-stamp check would follow: the robot moves
+~0.3 m in the latency, sigma is 5 mm). By construction, not run: odom published from the true state fails the
+"differs" check."""
 import math
 import threading
 import time
