@@ -9,6 +9,7 @@
 #include "sowing_robot/core/field.h"
 #include "sowing_robot/core/node_settings.h"
 #include "sowing_robot/core/traction.h"
+#include "sowing_robot/core/sensors.h"
 
 namespace sowing_robot {
 namespace core {
@@ -32,6 +33,13 @@ std::vector<ParamInfo> infos(const ParamTable<S>& table) {
 template <typename A, typename B>
 std::vector<ParamInfo> concat(const ParamTable<A>& a, const ParamTable<B>& b) {
   std::vector<ParamInfo> out = infos(a), more = infos(b);
+  out.insert(out.end(), more.begin(), more.end());
+  return out;
+}
+
+template <typename A, typename B, typename C>
+std::vector<ParamInfo> concat(const ParamTable<A>& a, const ParamTable<B>& b, const ParamTable<C>& c) {
+  std::vector<ParamInfo> out = concat(a, b), more = infos(c);
   out.insert(out.end(), more.begin(), more.end());
   return out;
 }
@@ -91,10 +99,10 @@ const std::vector<CatalogSection>& parameterCatalog() {
        infos(RunSettings::table()),
        {}},
       {"plant_sim",
-       "the plant: its two drivers' timing, the start pose, the disturbance and the mismatch, and the "
-       "opt-in wheel-soil traction (traction/, config/traction.yaml) with the field's soil patches "
-       "(field/patches); the geometry and inertia come from the URDF (robot_description)",
-       concat(PlantSimSettings::table(), tractionTable()),
+       "the plant: its two drivers' timing, the start pose, the disturbance and the mismatch, the opt-in "
+       "wheel-soil traction (traction/, config/traction.yaml) with the field's soil patches (field/patches), and "
+       "sensors/: what the robot measures of itself; the geometry and inertia come from the URDF (robot_description)",
+       concat(PlantSimSettings::table(), tractionTable(), sensorsTable()),
        {"field/patches"}},
       {"kinematic_controller",
        "the outer loop, chosen by `outer`: Kanayama (eqs 4.1-4.2; kx, ky, ktheta live-tunable), pure pursuit or "

@@ -45,6 +45,8 @@ PlantSim::PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh) {
   loadTable(p, core::tractionTable(), traction.traction);
   std::vector<core::SoilPatch> patches;
   const std::string patch_error = loadSoilPatches(p, "field/patches", traction.traction, patches);
+  core::SensorParams sensors;
+  loadTable(p, core::sensorsTable(), sensors);
   // The body checked for contacts is the URDF's collision footprint (the one source of the robot's shape).
   core::Footprint footprint;
   std::string key, xml, footprint_error;
@@ -54,7 +56,8 @@ PlantSim::PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh) {
                                      ? loadToolSettings(nh, xml, traction)
                                      : "";
   requireValid(p, core::firstError({robot_error, robot_error.empty() ? robot.validate() : "", footprint_error,
-                                    settings.validate(), traction.traction.validate(), patch_error, tool_error}));
+                                    settings.validate(), traction.traction.validate(), patch_error, tool_error,
+                                    sensors.validate()}));
   cfg_.lockstep = run.lockstep;
   cfg_.period_ns = run.periodNs();
   cfg_.duration = run.duration;
@@ -67,6 +70,7 @@ PlantSim::PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh) {
   cfg_.lockstep_give_up = settings.lockstep_give_up;
   cfg_.min_subscribers = settings.min_subscribers;
   cfg_.wait_for = settings.waitForNames();
+  cfg_.loop_on_odom = settings.loop_topic == "odom";
   cfg_.startup_delay = settings.startup_delay;
   cfg_.max_speed = settings.max_speed;
   cfg_.exit_at_end = settings.exit_at_end;
@@ -93,10 +97,11 @@ PlantSim::PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh) {
     ROS_WARN("plant_sim: %zu soil patch(es) in field/patches have no effect: traction/enabled is false",
              patches.size());
   }
-  plant_ = std::make_unique<SimulatedPlant>(nh, robot, disturbance, start, rates, footprint, std::move(model));
+  plant_ = std::make_unique<SimulatedPlant>(nh, robot, disturbance, start, rates, footprint, std::move(model), sensors);
   const PlantModel& plant = plant_->model();
   logSettings("plant_sim", core::RunSettings::table(), run, "run/");
   logSettings("plant_sim", core::PlantSimSettings::table(), settings);
+  logSettings("plant_sim", core::sensorsTable(), sensors);
   if (traction.traction.enabled) {
     logSettings("plant_sim", core::tractionTable(), traction.traction);
     ROS_INFO("plant_sim: traction plant with %zu soil patch(es); tool point (%.3f, %.3f) m", patches.size(),
@@ -114,6 +119,7 @@ PlantSim::PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh) {
     c.duration = cfg_.duration;
     c.min_subscribers = cfg_.min_subscribers;
     c.wait_for = cfg_.wait_for;
+    c.loop_on_odom = cfg_.loop_on_odom;
     driver_ = std::make_unique<LockstepDriver>(nh, *plant_, c);
   } else {
     RealtimeDriver::Config c;

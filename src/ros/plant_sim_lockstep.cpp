@@ -75,8 +75,12 @@ void LockstepDriver::reportFinished() {
   plant_.reportContacts();
 }
 
+unsigned LockstepDriver::stateSubscribers() const {
+  return plant_.truthSubscribers() + (cfg_.loop_on_odom ? plant_.odomSubscribers() : 0u);
+}
+
 bool LockstepDriver::loopConnected() const {
-  return static_cast<int>(plant_.odomSubscribers()) >= cfg_.min_subscribers && torque_sub_.getNumPublishers() >= 1 &&
+  return static_cast<int>(stateSubscribers()) >= cfg_.min_subscribers && torque_sub_.getNumPublishers() >= 1 &&
          plant_.inputsReady() && roster_.complete();
 }
 
@@ -90,11 +94,11 @@ void LockstepDriver::report(const core::LockstepProtocol::Supervision& s) const 
   if (s.step < 0) {
     const std::string model = plant_.model().waitingFor();
     ROS_WARN(
-        "plant_sim: lockstep waiting for the loop for %.1f s wall: %u/%d odom subscribers, %u wheel_torque "
+        "plant_sim: lockstep waiting for the loop for %.1f s wall: %u/%d %s subscribers, %u wheel_torque "
         "publishers, not announced on ready: %s%s%s",
-        s.waited, plant_.odomSubscribers(), cfg_.min_subscribers, torque_sub_.getNumPublishers(),
-        roster_.missing().empty() ? "none" : roster_.missing().c_str(), model.empty() ? "" : ", waiting for ",
-        model.c_str());
+        s.waited, stateSubscribers(), cfg_.min_subscribers, cfg_.loop_on_odom ? "ground_truth + odom" : "ground_truth",
+        torque_sub_.getNumPublishers(), roster_.missing().empty() ? "none" : roster_.missing().c_str(),
+        model.empty() ? "" : ", waiting for ", model.c_str());
   } else {
     ROS_ERROR(
         "plant_sim: lockstep stalled at t=%.6f s: no wheel_torque stamped for it after %.1f s wall (%s); "
@@ -105,7 +109,7 @@ void LockstepDriver::report(const core::LockstepProtocol::Supervision& s) const 
 
 std::string LockstepDriver::giveUpReason(const core::LockstepProtocol::Supervision& s) const {
   const std::string missing = roster_.missing();
-  const std::string what = s.step < 0 ? "the loop to connect (odom subscribers, a wheel_torque publisher" +
+  const std::string what = s.step < 0 ? "the loop to connect (state subscribers, a wheel_torque publisher" +
                                             (missing.empty() ? std::string(")") : "; not announced: " + missing + ")")
                                       : "a wheel_torque stamped for the current state";
   char text[200];

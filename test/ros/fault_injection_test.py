@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """rostest (realtime pipeline): inject NaN wheel torques and NaN references, then kill the torque
-controller for 1 s of simulated time and start it again. Checks: odom stays finite throughout, the
+controller for 1 s of simulated time and start it again. Checks: the state (ground_truth) stays finite throughout, the
 plant, kinematic controller and plant timeout each log their warning, the robot coasts (zero torque
 applied) while the controller is away, and it is back on the line (|e_y| < 3 cm) at the end."""
 import math
@@ -24,7 +24,7 @@ class FaultInjection(unittest.TestCase):
         self.odom_count = 0
         self.last_error = None
         self.logs = []
-        rospy.Subscriber("odom", Odometry, self.on_odom, queue_size=1000)
+        rospy.Subscriber("ground_truth", Odometry, self.on_odom, queue_size=1000)
         rospy.Subscriber("tracking_error", TrackingError, self.on_error, queue_size=1000)
         rospy.Subscriber("/rosout", Log, lambda m: self.logs.append((m.name, m.level, m.msg)), queue_size=1000)
         self.torque_pub = rospy.Publisher("wheel_torque", WheelTorque, queue_size=100)
@@ -85,7 +85,8 @@ class FaultInjection(unittest.TestCase):
         self.wait_until(t_kill + 1.0)
         self.assertTrue(self.logged("plant_sim", "applying zero torque"), "plant_sim did not report the silence")
         exe = roslib.packages.find_node("sowing_robot", "torque_controller")[0]
-        self.restarted = subprocess.Popen([exe, "__name:=torque_controller"])
+        # with the launch's remap of its feedback (pipeline.launch feedback:=ground_truth)
+        self.restarted = subprocess.Popen([exe, "__name:=torque_controller", "feedback:=ground_truth"])
         self.wait_until(t_kill + 12.0)
         self.assertEqual(self.nonfinite_odom, 0)
         self.assertLess(abs(self.last_error.y), 0.03, "did not re-converge: %s" % self.last_error)
