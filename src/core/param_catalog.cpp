@@ -9,6 +9,7 @@
 #include "sowing_robot/core/ekf.h"
 #include "sowing_robot/core/field.h"
 #include "sowing_robot/core/node_settings.h"
+#include "sowing_robot/core/sensors.h"
 
 namespace sowing_robot {
 namespace core {
@@ -92,8 +93,8 @@ const std::vector<CatalogSection>& parameterCatalog() {
        {}},
       {"plant_sim",
        "the plant: its two drivers' timing, the start pose, the disturbance and the mismatch; the "
-       "geometry and inertia come from the URDF (robot_description)",
-       infos(PlantSimSettings::table()),
+       "geometry and inertia come from the URDF (robot_description); sensors/: what the robot measures of itself",
+       concat(PlantSimSettings::table(), sensorsTable()),
        {}},
       {"kinematic_controller",
        "Kanayama outer loop, eqs 4.1-4.2 (kx, ky, ktheta live-tunable)",
