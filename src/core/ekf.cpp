@@ -25,7 +25,7 @@ const ParamTable<EkfParams>& ekfTable() {
       number("estimator/odometry/distance_noise", &P::distance_noise, 0.01, Limits::closed(0.0, 10.0), "m/√m",
              "encoder distance error per square root of the distance rolled (slip, wheel radius), added to the "
              "odometry's own covariance"),
-      number("estimator/odometry/heading_noise", &P::heading_noise, 0.01, Limits::closed(0.0, 10.0), "rad/√m",
+      number("estimator/odometry/heading_noise", &P::heading_noise, 0.03, Limits::closed(0.0, 10.0), "rad/√m",
              "encoder heading error per square root of the distance rolled (uneven slip, track width)"),
       number("estimator/bias/walk", &P::bias_walk, 1e-4, Limits::closed(0.0, 1.0), "rad/s/√s",
              "random walk of the yaw-rate sensor's bias"),
@@ -215,6 +215,15 @@ FixOutcome Ekf::fuse(const EkfFix& fix) {
   }
   ++counts_.applied;
   return FixOutcome::APPLIED;
+}
+
+Eigen::Matrix2d wheelTravelCovariance(double d_right, double d_left, double half_track, double variance_per_metre) {
+  const double qr = variance_per_metre * std::fabs(d_right), ql = variance_per_metre * std::fabs(d_left);
+  Eigen::Matrix2d c;
+  c(0, 0) = 0.25 * (qr + ql);
+  c(1, 1) = 0.25 * (qr + ql) / (half_track * half_track);
+  c(0, 1) = c(1, 0) = 0.25 * (qr - ql) / half_track;
+  return c;
 }
 
 void FixQueue::push(const EkfFix& fix) {

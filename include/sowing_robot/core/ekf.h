@@ -72,6 +72,11 @@ struct EkfStepInput {
   double rate_variance = 0.0;  ///< [(rad/s)^2] of one sample
 };
 
+/// Covariance of (distance, dtheta) of one step when each wheel's travel d_i has the variance
+/// variance_per_metre |d_i| (Siegwart's odometry model, as core/sensors.h's travel_variance states it):
+/// distance = (d_r + d_l) / 2, dtheta = (d_r - d_l) / (2 half_track).
+Eigen::Matrix2d wheelTravelCovariance(double d_right, double d_left, double half_track, double variance_per_metre);
+
 /// A position fix of the axle midpoint, stamped with its measurement time.
 struct EkfFix {
   double stamp = 0.0;  ///< [s]
