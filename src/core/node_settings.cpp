@@ -51,7 +51,11 @@ const ParamTable<PlantSimSettings>& PlantSimSettings::table() {
         number("lockstep_give_up", &S::lockstep_give_up, 120.0, Limits::nonNegative(), "s",
                "lockstep: exit 3 naming the missing input after waiting this long (wall time); 0 = never"),
         integer("min_subscribers", &S::min_subscribers, 3, Limits::closed(0, 100), "",
-                "lockstep: odom subscribers to wait for before step 0"),
+                "lockstep: subscribers to wait for before step 0, of ground_truth plus (loop_topic odom) of odom"),
+        text("loop_topic", &S::loop_topic, "ground_truth",
+             "the plant topic the controllers' feedback comes from (sim.launch feedback:=): its subscribers "
+             "count toward min_subscribers",
+             {"ground_truth", "odom"}),
         number("startup_delay", &S::startup_delay, 0.5, Limits::nonNegative(), "s",
                "lockstep: settle time before step 0 (wall time)"),
         number("max_speed", &S::max_speed, 20.0, Limits::positive(), "m/s",

@@ -18,8 +18,8 @@ const ParamTable<EncoderParams>& encoderTable() {
               "encoder counts per wheel revolution (quantisation of the wheel angle: 2π / this)"),
       number("noise", &E::noise, 0.0, Limits::closed(0.0, 100.0), "",
              "std of each reading's tick jitter, in ticks (does not accumulate); 0 = quantisation only"),
-      number("travel_variance", &E::travel_variance, 1e-4, Limits::closed(0.0, 1.0), "m",
-             "odom covariance only: each wheel's travel variance grows by this per metre travelled [m²/m]"),
+      number("travel_variance", &E::travel_variance, 1e-4, Limits::closed(0.0, 1.0), "m²/m",
+             "odom covariance only: each wheel's travel variance grows by this per metre travelled"),
       number("velocity_window", &E::velocity_window, 0.01, Limits::closed(0.0, 1.0), "s",
              "odom twist = count increments over this long (0 = the last step's increment alone)"),
   });
@@ -30,8 +30,7 @@ const ParamTable<ImuParams>& imuTable() {
   using I = ImuParams;
   static const ParamTable<I> table({
       number("noise", &I::noise, 0.005, Limits::closed(0.0, 10.0), "rad/s", "std of the gyro's yaw-rate noise"),
-      number("bias", &I::bias, 0.002, Limits::closed(-1.0, 1.0), "rad/s",
-             "constant gyro yaw-rate bias (either sign)"),
+      number("bias", &I::bias, 0.002, Limits::closed(-1.0, 1.0), "rad/s", "constant gyro yaw-rate bias (either sign)"),
   });
   return table;
 }

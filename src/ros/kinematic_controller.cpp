@@ -28,7 +28,8 @@ KinematicController::KinematicController(ros::NodeHandle nh, ros::NodeHandle pnh
   desired_pub_ = nh.advertise<DesiredVelocity>("desired_velocity", kLockstepQueue);
   error_pub_ = nh.advertise<TrackingError>("tracking_error", kLockstepQueue);
   const auto hints = ros::TransportHints().tcpNoDelay();
-  odom_sub_ = nh.subscribe("odom", kLockstepQueue, &KinematicController::odomCallback, this, hints);
+  // `feedback`: the state the loop closes on, remapped by the launch (feedback:= ground_truth | odometry).
+  odom_sub_ = nh.subscribe("feedback", kLockstepQueue, &KinematicController::odomCallback, this, hints);
   ref_sub_ = nh.subscribe("reference", kLockstepQueue, &KinematicController::referenceCallback, this, hints);
 }
 

@@ -16,13 +16,15 @@ PlantSim::PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh) {
   const core::RunSettings run = loadRunSettings(nh, p);
   core::PlantSimSettings settings;
   loadTable(p, core::PlantSimSettings::table(), settings);
+  core::SensorParams sensors;
+  loadTable(p, core::sensorsTable(), sensors);
   // The body checked for contacts is the URDF's collision footprint (the one source of the robot's shape).
   core::Footprint footprint;
   std::string key, xml, footprint_error;
   if (robot_error.empty() && pnh.searchParam("robot_description", key) && pnh.getParam(key, xml))
     footprint_error = footprintFromUrdf(xml, footprint);
   requireValid(p, core::firstError({robot_error, robot_error.empty() ? robot.validate() : "", footprint_error,
-                                    settings.validate()}));
+                                    settings.validate(), sensors.validate()}));
   cfg_.lockstep = run.lockstep;
   cfg_.period_ns = run.periodNs();
   cfg_.duration = run.duration;
@@ -34,6 +36,7 @@ PlantSim::PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh) {
   cfg_.lockstep_timeout = settings.lockstep_timeout;
   cfg_.lockstep_give_up = settings.lockstep_give_up;
   cfg_.min_subscribers = settings.min_subscribers;
+  cfg_.loop_on_odom = settings.loop_topic == "odom";
   cfg_.startup_delay = settings.startup_delay;
   cfg_.max_speed = settings.max_speed;
   cfg_.exit_at_end = settings.exit_at_end;
@@ -47,10 +50,11 @@ PlantSim::PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh) {
   rates.max_speed = cfg_.max_speed;
   rates.odom_frame = run.odom_frame;
   rates.base_frame = run.base_frame;
-  plant_ = std::make_unique<SimulatedPlant>(nh, robot, disturbance, start, rates, footprint);
+  plant_ = std::make_unique<SimulatedPlant>(nh, robot, disturbance, start, rates, footprint, sensors);
   const core::Plant& plant = plant_->plant();
   logSettings("plant_sim", core::RunSettings::table(), run, "run/");
   logSettings("plant_sim", core::PlantSimSettings::table(), settings);
+  logSettings("plant_sim", core::sensorsTable(), sensors);
   ROS_INFO("plant_sim: m0 %.4f kg (true %.4f), I0 %.5f kg m^2 (true %.5f)", robot.m0(), plant.trueM0(), robot.I0(),
            plant.trueI0());
 
@@ -62,6 +66,7 @@ PlantSim::PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh) {
     c.timing.startup_delay = cfg_.startup_delay;
     c.duration = cfg_.duration;
     c.min_subscribers = cfg_.min_subscribers;
+    c.loop_on_odom = cfg_.loop_on_odom;
     driver_ = std::make_unique<LockstepDriver>(nh, *plant_, c);
   } else {
     RealtimeDriver::Config c;

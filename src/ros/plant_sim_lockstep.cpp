@@ -74,8 +74,12 @@ void LockstepDriver::reportFinished() {
   plant_.reportContacts();
 }
 
+unsigned LockstepDriver::stateSubscribers() const {
+  return plant_.truthSubscribers() + (cfg_.loop_on_odom ? plant_.odomSubscribers() : 0u);
+}
+
 bool LockstepDriver::loopConnected() const {
-  return static_cast<int>(plant_.odomSubscribers()) >= cfg_.min_subscribers && torque_sub_.getNumPublishers() >= 1;
+  return static_cast<int>(stateSubscribers()) >= cfg_.min_subscribers && torque_sub_.getNumPublishers() >= 1;
 }
 
 std::string LockstepDriver::torqueSources() const {
@@ -87,9 +91,10 @@ std::string LockstepDriver::torqueSources() const {
 void LockstepDriver::report(const core::LockstepProtocol::Supervision& s) const {
   if (s.step < 0) {
     ROS_WARN(
-        "plant_sim: lockstep waiting for the loop for %.1f s wall: %u/%d odom subscribers, %u wheel_torque "
+        "plant_sim: lockstep waiting for the loop for %.1f s wall: %u/%d %s subscribers, %u wheel_torque "
         "publishers",
-        s.waited, plant_.odomSubscribers(), cfg_.min_subscribers, torque_sub_.getNumPublishers());
+        s.waited, stateSubscribers(), cfg_.min_subscribers, cfg_.loop_on_odom ? "ground_truth + odom" : "ground_truth",
+        torque_sub_.getNumPublishers());
   } else {
     ROS_ERROR(
         "plant_sim: lockstep stalled at t=%.6f s: no wheel_torque stamped for it after %.1f s wall (%s); "
@@ -99,7 +104,7 @@ void LockstepDriver::report(const core::LockstepProtocol::Supervision& s) const 
 }
 
 std::string LockstepDriver::giveUpReason(const core::LockstepProtocol::Supervision& s) const {
-  const char* what = s.step < 0 ? "the loop to connect (odom subscribers, a wheel_torque publisher)"
+  const char* what = s.step < 0 ? "the loop to connect (state subscribers, a wheel_torque publisher)"
                                 : "a wheel_torque stamped for the current state";
   char text[200];
   std::snprintf(text, sizeof text, "lockstep gave up at t=%.6f s after %.1f s wall (lockstep_give_up) waiting for ",

@@ -22,20 +22,21 @@ core::State restAt(const core::Pose2D& start) {
 
 SimulatedPlant::SimulatedPlant(ros::NodeHandle nh, const core::RobotParams& robot,
                                const core::PlantDisturbance& disturbance, const core::Pose2D& start, const Rates& rates,
-                               const core::Footprint& footprint)
+                               const core::Footprint& footprint, const core::SensorParams& sensors)
     : rates_(rates), plant_(robot, disturbance) {
   plant_.reset(restAt(start), 0.0);
+  sensors_ = std::make_unique<PlantSensors>(nh, sensors, robot, plant_.state(), rates.odom_frame, rates.base_frame);
   visual_every_ = std::max<std::int64_t>(1, std::llround(1e9 / rates_.publish_rate / rates_.period_ns));
   if (rates_.clock_rate > 0.0)
     clock_every_ = std::max<std::int64_t>(1, std::llround(1e9 / rates_.clock_rate / rates_.period_ns));
 
   clock_pub_ = nh.advertise<rosgraph_msgs::Clock>("/clock", 10);
-  odom_pub_ = nh.advertise<nav_msgs::Odometry>("odom", kLockstepQueue);
+  truth_pub_ = nh.advertise<nav_msgs::Odometry>("ground_truth", kLockstepQueue);
   joint_pub_ = nh.advertise<sensor_msgs::JointState>("joint_states", 10);
   path_pub_ = nh.advertise<nav_msgs::Path>("travelled_path", 1, true);
 
-  odom_msg_.header.frame_id = rates.odom_frame;
-  odom_msg_.child_frame_id = rates.base_frame;
+  truth_msg_.header.frame_id = rates.odom_frame;
+  truth_msg_.child_frame_id = rates.base_frame;
   path_ = PathBuffer(rates.odom_frame, 0.05, 10);
   joint_msg_.name = {"right_wheel_joint", "left_wheel_joint"};
   joint_msg_.position.resize(2);
@@ -69,6 +70,8 @@ bool SimulatedPlant::step(const core::WheelTorques& torque) {
   if (!healthy()) return false;
   const core::State& s = plant_.state();
   contacts_->update(plant_.time(), {s[core::X], s[core::Y], s[core::THETA]});
+  // The sensors on the stamp grid (the fix's rate and latency are counted in stamps, not summed dt).
+  sensors_->update(stampOf(std::llround(plant_.time() * 1e9 / rates_.period_ns)).toSec(), s, dt());
   return true;
 }
 
@@ -90,13 +93,14 @@ std::string SimulatedPlant::divergence() const {
 void SimulatedPlant::publish(std::int64_t k, bool visuals, bool clock) {
   const ros::Time stamp = stampOf(k);
   const core::State& s = plant_.state();
-  odom_msg_.header.stamp = stamp;
-  odom_msg_.pose.pose.position.x = s[core::X];
-  odom_msg_.pose.pose.position.y = s[core::Y];
-  odom_msg_.pose.pose.orientation = yawQuaternion(s[core::THETA]);
-  odom_msg_.twist.twist.linear.x = s[core::V];
-  odom_msg_.twist.twist.angular.z = s[core::OMEGA];
-  publishShared(odom_pub_, odom_msg_);
+  truth_msg_.header.stamp = stamp;
+  truth_msg_.pose.pose.position.x = s[core::X];
+  truth_msg_.pose.pose.position.y = s[core::Y];
+  truth_msg_.pose.pose.orientation = yawQuaternion(s[core::THETA]);
+  truth_msg_.twist.twist.linear.x = s[core::V];
+  truth_msg_.twist.twist.angular.z = s[core::OMEGA];
+  publishShared(truth_pub_, truth_msg_);
+  sensors_->publish(stamp);
   // Nothing in the control loop reads /clock (every node works on header stamps); it serves ROS time
   // for logs, rosbag and rviz, so it may go out less often than every step (clock_rate), and after the
   // state, off the loop's critical path (it has a link to every node).
@@ -107,13 +111,7 @@ void SimulatedPlant::publish(std::int64_t k, bool visuals, bool clock) {
   }
   if (!visuals) return;
 
-  geometry_msgs::TransformStamped tf;
-  tf.header = odom_msg_.header;
-  tf.child_frame_id = odom_msg_.child_frame_id;
-  tf.transform.translation.x = s[core::X];
-  tf.transform.translation.y = s[core::Y];
-  tf.transform.rotation = odom_msg_.pose.pose.orientation;
-  tf_.sendTransform(tf);
+  tf_.sendTransform(sensors_->odomTransform());  // REP-105: odom -> base_link is what odometry believes
 
   joint_msg_.header.stamp = stamp;
   joint_msg_.position[0] = s[core::PHI_R];
@@ -124,8 +122,8 @@ void SimulatedPlant::publish(std::int64_t k, bool visuals, bool clock) {
   joint_pub_.publish(joint_msg_);
 
   geometry_msgs::PoseStamped pose;
-  pose.header = odom_msg_.header;
-  pose.pose = odom_msg_.pose.pose;
+  pose.header = truth_msg_.header;
+  pose.pose = truth_msg_.pose.pose;
   if (path_.add(pose)) path_pub_.publish(path_.path());
 }
 

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cstdio>
 
+#include "sowing_robot/core/runner.h"
 #include "sowing_robot/core/validation.h"
 #include "sowing_robot/ros/component_params.h"
 #include "sowing_robot/ros/failure_log.h"
@@ -28,19 +29,36 @@ RunMonitor::RunMonitor(ros::NodeHandle nh, ros::NodeHandle pnh) : pnh_(pnh) {
   metrics_.reserve(static_cast<std::size_t>(duration_ * 1000.0) + 2);
   // Subscribed from the start: the recorder's latched stamp is then already here when the run ends.
   if (!recorder_topic_.empty()) recorder_sub_ = nh.subscribe(recorder_topic_, 10, &RunMonitor::recordedCallback, this);
-  sub_ = nh.subscribe("tracking_error", kLockstepQueue, &RunMonitor::errorCallback, this,
-                      ros::TransportHints().tcpNoDelay());
+  const auto hints = ros::TransportHints().tcpNoDelay();
+  truth_sub_ = nh.subscribe("ground_truth", kLockstepQueue, &RunMonitor::truthCallback, this, hints);
+  ref_sub_ = nh.subscribe("reference", kLockstepQueue, &RunMonitor::referenceCallback, this, hints);
 }
 
-void RunMonitor::errorCallback(const TrackingError::ConstPtr& msg) {
+void RunMonitor::truthCallback(const nav_msgs::Odometry::ConstPtr& msg) {
   if (done_) return;
-  if (metrics_.samples() > 0 && msg->header.stamp <= last_) return;            // repeats answer a retried state
-  if (!metrics_.add(msg->header.stamp.toSec(), msg->x, msg->y, msg->theta)) {  // refuses non-finite errors
+  if (inputs_.setFirst(*msg)) addPair();
+}
+
+void RunMonitor::referenceCallback(const ReferenceState::ConstPtr& msg) {
+  if (done_) return;
+  if (inputs_.setSecond(*msg)) addPair();
+}
+
+void RunMonitor::addPair() {
+  const nav_msgs::Odometry& truth = inputs_.first();
+  const ReferenceState& r = inputs_.second();
+  const ros::Time stamp = truth.header.stamp;
+  if (metrics_.samples() > 0 && stamp <= last_) return;  // repeats answer a retried state
+  core::Reference ref;
+  ref.pose = {r.x, r.y, r.theta};
+  double ex, ey, eth;
+  core::worldErrors(ref, poseOf(truth), ex, ey, eth);
+  if (!metrics_.add(stamp.toSec(), ex, ey, eth)) {  // refuses non-finite errors
     ROS_WARN_THROTTLE(1.0, "run_monitor: non-finite tracking error ignored");
     return;
   }
-  last_ = msg->header.stamp;
-  if (msg->header.stamp.toSec() >= duration_ - 1e-9) finish();
+  last_ = stamp;
+  if (stamp.toSec() >= duration_ - 1e-9) finish();
 }
 
 void RunMonitor::finish() {

@@ -47,11 +47,12 @@ SeedDrillNode::SeedDrillNode(ros::NodeHandle nh, ros::NodeHandle pnh) {
   seeds_pub_ = nh.advertise<visualization_msgs::MarkerArray>("seeds", 10);
   report_pub_ = nh.advertise<std_msgs::Float64MultiArray>("seed_report", 1, true);
   // Subscribed here, not from the plan's callback: a subscription made from a callback of the shared
-  // nodelet thread while the plant publishes odom hung a nodelet run (1 in ~10 under load). States that
+  // nodelet thread while the plant publishes its state hung a nodelet run (1 in ~10 under load). States that
   // come before the first plan (latched: it comes at once) are not scored (the robot is still at rest).
   plan_sub_ = nh.subscribe("plan", 1, &SeedDrillNode::planCallback, this);
   const auto hints = ros::TransportHints().tcpNoDelay();
-  odom_sub_ = nh.subscribe("odom", kLockstepQueue, &SeedDrillNode::odomCallback, this, hints);
+  // The true pose (the seeds fall where the robot really is, whatever the controllers believe).
+  odom_sub_ = nh.subscribe("ground_truth", kLockstepQueue, &SeedDrillNode::odomCallback, this, hints);
   ref_sub_ = nh.subscribe("reference", kLockstepQueue, &SeedDrillNode::referenceCallback, this, hints);
 }
 

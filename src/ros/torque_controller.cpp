@@ -33,7 +33,8 @@ TorqueController::TorqueController(ros::NodeHandle nh, ros::NodeHandle pnh) {
   torque_pub_ = nh.advertise<WheelTorque>("wheel_torque", kLockstepQueue);
   state_pub_ = pnh.advertise<TorqueControllerState>("state", kLockstepQueue);
   const auto hints = ros::TransportHints().tcpNoDelay();
-  odom_sub_ = nh.subscribe("odom", kLockstepQueue, &TorqueController::odomCallback, this, hints);
+  // `feedback`: the state the loop closes on, remapped by the launch (feedback:= ground_truth | odometry).
+  odom_sub_ = nh.subscribe("feedback", kLockstepQueue, &TorqueController::odomCallback, this, hints);
   desired_sub_ = nh.subscribe("desired_velocity", kLockstepQueue, &TorqueController::desiredCallback, this, hints);
 }
 

@@ -71,9 +71,9 @@ TEST(Sensors, DefaultsValidateAndAreTheTypicalValues) {
   EXPECT_DOUBLE_EQ(p.fix.latency, 0.1);
   EXPECT_DOUBLE_EQ(p.fix.dropout_duration, 0.0);
   // The contract's key names (contract16.md): other code reads them.
-  for (const char* key : {"sensors/seed", "sensors/encoder/ticks_per_turn", "sensors/encoder/noise", "sensors/imu/noise",
-                          "sensors/imu/bias", "sensors/fix/rate", "sensors/fix/sigma", "sensors/fix/latency",
-                          "sensors/fix/dropout_start", "sensors/fix/dropout_duration"})
+  for (const char* key : {"sensors/seed", "sensors/encoder/ticks_per_turn", "sensors/encoder/noise",
+                          "sensors/imu/noise", "sensors/imu/bias", "sensors/fix/rate", "sensors/fix/sigma",
+                          "sensors/fix/latency", "sensors/fix/dropout_start", "sensors/fix/dropout_duration"})
     EXPECT_NE(sensorsTable().find(key), nullptr) << key;
 }
 
@@ -209,12 +209,12 @@ TEST(Sensors, FixComesAtItsRateStampedLatencyBeforeItsDelivery) {
     if (fix.sample(t, {t, -t, 0.0})) ++sampled;
     for (const FixMeasurement& m : fix.due(t)) delivered.emplace_back(t, m);
   }
-  EXPECT_EQ(sampled, 21);                  // 0, 0.1, ..., 2.0
-  ASSERT_EQ(delivered.size(), 20u);        // the one at 2.0 is still in flight
+  EXPECT_EQ(sampled, 21);            // 0, 0.1, ..., 2.0
+  ASSERT_EQ(delivered.size(), 20u);  // the one at 2.0 is still in flight
   for (std::size_t i = 0; i < delivered.size(); ++i) {
     const double stamp = delivered[i].second.stamp;
     EXPECT_NEAR(stamp, 0.1 * i, 1e-9);
-    EXPECT_NEAR(delivered[i].first, stamp + 0.1, 1e-9);  // the first step at stamp + latency
+    EXPECT_NEAR(delivered[i].first, stamp + 0.1, 1e-9);   // the first step at stamp + latency
     EXPECT_DOUBLE_EQ(delivered[i].second.xy.x(), stamp);  // sigma 0: the truth at the stamp
     EXPECT_DOUBLE_EQ(delivered[i].second.xy.y(), -stamp);
   }

@@ -2,6 +2,7 @@
 """rostest for analyze_bag (scripts/analyze_bag, the package sowing_robot.analyze_bag): metrics on synthetic bags
 with analytic errors and equal to the C++ accumulator's, de-duplication of repeated stamps, one-line errors with
 the documented exit codes for bad input, and the figures. (test/python has the pytest edge cases.)"""
+import copy
 import math
 import os
 import shutil
@@ -230,7 +231,10 @@ class AnalyzeBag(unittest.TestCase):
                 odom.pose.pose.orientation.z = math.sin(0.05 * math.exp(-t))
                 odom.pose.pose.orientation.w = math.cos(0.05 * math.exp(-t))
                 odom.twist.twist.linear.x = 1.0 + math.exp(-t)
-                bag.write("/odom", odom, bt)
+                bag.write("/ground_truth", odom, bt)  # the true state (issue 16)
+                encoders = copy.deepcopy(odom)
+                encoders.pose.pose.position.x += 0.5  # the encoders' dead reckoning, off by 0.5 m
+                bag.write("/odom", encoders, bt)
                 des = DesiredVelocity()
                 des.header.stamp = st
                 des.v, des.omega = 1.0 + 1.2 * math.exp(-t), -0.1 * math.exp(-t)
@@ -259,6 +263,9 @@ class AnalyzeBag(unittest.TestCase):
         code, out, err = run_script(path, "--plots", plots, "--markdown", md, "--thesis")
         self.assertEqual(code, 0, err)
         self.assertEqual(err, "")
+        data = ab.load_bag(path)
+        self.assertFalse(data.truth_from_odom())
+        self.assertEqual(data.truth()["pose.pose.position.x"][0], -1.0, "the robot's state is not /ground_truth")
         self.assertIn("| metric | axis | atsmc | PSO-ATSMC (thesis) | TSMC (thesis) |", out)
         self.assertIn("saturated: 5 control periods (1 episodes)", out)
         self.assertIn("max |torque|: right 10 N·m, left 12 N·m", out)
@@ -287,6 +294,26 @@ class AnalyzeBag(unittest.TestCase):
         self.assertIn(needle, lines[0])
         self.assertTrue(lines[0].startswith("analyze_bag: "), lines[0])
         return lines[0]
+
+    def test_old_bag_falls_back_to_odom_and_says_so(self):
+        # Bags recorded before issue 16 have no /ground_truth: their /odom was the true state.
+        path = self.path("old.bag")
+        with rosbag.Bag(path, "w") as bag:
+            for k in range(0, 200):
+                st = stamp(k)
+                odom = Odometry()
+                odom.header.stamp = st
+                odom.pose.pose.position.x = 2.0 + k * 1e-3
+                odom.pose.pose.orientation.w = 1.0
+                bag.write("/odom", odom, bag_time(st))
+                bag.write("/tracking_error", error_msg(k, 0.1, 0.2, 0.01), bag_time(st))
+        data = ab.load_bag(path)
+        self.assertTrue(data.truth_from_odom())
+        self.assertEqual(data.truth()["pose.pose.position.x"][0], 2.0)
+        code, out, err = run_script(path, "--no-plots")
+        self.assertEqual(code, 0, err)
+        self.assertIn("no /ground_truth", err)
+        self.assertIn("read from /odom", err)
 
     def test_missing_file(self):
         self.assertOneLineError([self.path("nope.bag")], 3, "no such file")

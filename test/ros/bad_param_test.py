@@ -22,6 +22,17 @@ CASES = [
     ("plant_sim", {"control_rate": "fast"}, "control_rate"),  # wrong type
     ("plant_sim", {"min_subscribers": 2.5}, "min_subscribers"),  # not an integer (roscpp would truncate)
     ("plant_sim", {"robot_description": "ZERO_RADIUS"}, "radius"),
+    # the sensors (issue 16): negative, NaN, out of range, an unknown sensor key, the feedback topic
+    ("plant_sim", {"sensors/encoder/ticks_per_turn": 0}, "/bad_%d/sensors/encoder/ticks_per_turn = 0"),
+    ("plant_sim", {"sensors/encoder/noise": -0.5}, "/bad_%d/sensors/encoder/noise = -0.5"),
+    ("plant_sim", {"sensors/imu/noise": float("nan")}, "/bad_%d/sensors/imu/noise = "),
+    ("plant_sim", {"sensors/imu/bias": 2.0}, "/bad_%d/sensors/imu/bias = 2"),
+    ("plant_sim", {"sensors/fix/rate": 0.0}, "/bad_%d/sensors/fix/rate = 0"),
+    ("plant_sim", {"sensors/fix/sigma": -0.02}, "/bad_%d/sensors/fix/sigma = -0.02"),
+    ("plant_sim", {"sensors/fix/latency": float("nan")}, "/bad_%d/sensors/fix/latency = "),
+    ("plant_sim", {"sensors/fix/dropout_duration": -1.0}, "/bad_%d/sensors/fix/dropout_duration = -1"),
+    ("plant_sim", {"sensors/fix/ratee": 5.0}, "sensors/fix/ratee"),  # typo: unknown key
+    ("plant_sim", {"loop_topic": "fused"}, "loop_topic"),
     ("plant_sim", {"robot_description": "<robot name='x'>"}, "robot_description"),
     ("torque_controller", {"p": 4}, "p/q"),
     ("torque_controller", {"m0_min": 40.0}, "m0_min"),
@@ -56,7 +67,11 @@ class BadParameters(unittest.TestCase):
             out = proc.stdout
             self.assertEqual(proc.returncode, 1, "%s %s: exit %d\n%s" % (node, params, proc.returncode, out))
             self.assertIn("refusing to start", out, "%s %s:\n%s" % (node, params, out))
+            if "%d" in needle:
+                needle = needle % i  # the key's full name, in this case's namespace
             self.assertIn(needle, out, "%s %s: message does not name '%s':\n%s" % (node, params, needle, out))
+            fatal = [line for line in out.splitlines() if "[FATAL]" in line]
+            self.assertEqual(len(fatal), 1, "%s %s: expected one FATAL line:\n%s" % (node, params, out))
 
 
 if __name__ == "__main__":

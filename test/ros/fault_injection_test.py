@@ -24,7 +24,7 @@ class FaultInjection(unittest.TestCase):
         self.odom_count = 0
         self.last_error = None
         self.logs = []
-        rospy.Subscriber("odom", Odometry, self.on_odom, queue_size=1000)
+        rospy.Subscriber("ground_truth", Odometry, self.on_odom, queue_size=1000)
         rospy.Subscriber("tracking_error", TrackingError, self.on_error, queue_size=1000)
         rospy.Subscriber("/rosout", Log, lambda m: self.logs.append((m.name, m.level, m.msg)), queue_size=1000)
         self.torque_pub = rospy.Publisher("wheel_torque", WheelTorque, queue_size=100)

@@ -64,7 +64,7 @@ class FieldRun(unittest.TestCase):
             state["lateral"] = max(state["lateral"], abs(v * w))
             state["last"] = m
 
-        rospy.Subscriber("odom", Odometry, on_odom, queue_size=100000)
+        rospy.Subscriber("ground_truth", Odometry, on_odom, queue_size=100000)
         rospy.Subscriber("contacts", Contact, lambda m: state["contacts"].append(m), queue_size=100)
         rospy.Subscriber("seed_report", Float64MultiArray, lambda m: state.update(report=m.data), queue_size=10)
         t0 = time.time()

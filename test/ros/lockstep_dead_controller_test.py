@@ -64,7 +64,7 @@ class LockstepDeadController(unittest.TestCase):
         self.odom_v = {}  # stamp -> v of every odom received
         self.torque_states = []
         self.subs = [rospy.Subscriber("/rosout", Log, lambda m: self.logs.append((time.time(), m)), queue_size=1000),
-                     rospy.Subscriber("odom", Odometry, self.on_odom, queue_size=20000),
+                     rospy.Subscriber("ground_truth", Odometry, self.on_odom, queue_size=20000),
                      rospy.Subscriber("torque_controller/state", TorqueControllerState, self.torque_states.append,
                                       queue_size=20000)]
         self.children = []
@@ -194,7 +194,7 @@ class LockstepDeadController(unittest.TestCase):
         outs = {}
         for name in ("torque_controller", "kinematic_controller"):  # each without its input
             outs[name] = self.start(name)
-            self.wait_for(lambda: self.subscribed("/" + name, "/odom"), "%s subscribed to /odom" % name)
+            self.wait_for(lambda: self.subscribed("/" + name, "/ground_truth"), "%s subscribed to /ground_truth" % name)
             resent = self.odom_stamps.count(stalled)
             self.wait_for(lambda: self.odom_stamps.count(stalled) >= resent + 2 or self.last_odom() != stalled,
                           "the stalled state re-sent to the new %s" % name)
@@ -210,7 +210,7 @@ class LockstepDeadController(unittest.TestCase):
         node_process.set_private_params(ns + "/plant_sim", {"min_subscribers": 0,
                                                             "lockstep_timeout": LOCKSTEP_TIMEOUT})
         lonely_odom = []
-        self.subs.append(rospy.Subscriber(ns + "/odom", Odometry, lonely_odom.append, queue_size=10))
+        self.subs.append(rospy.Subscriber(ns + "/ground_truth", Odometry, lonely_odom.append, queue_size=10))
         with tempfile.TemporaryFile(mode="w+") as log:
             started_at = time.time()
             proc = node_process.start("plant_sim", "plant_sim", ns=ns, output=log)

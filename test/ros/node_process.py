@@ -21,9 +21,17 @@ def set_private_params(node_path, params):
         rospy.set_param("%s/%s" % (node_path, key), value)
 
 
+# The launch files' remap of the controllers' `feedback` (sim.launch feedback:=ground_truth, the default):
+# a controller the test starts itself closes the loop on the same topic.
+FEEDBACK_REMAP = "feedback:=ground_truth"
+
+
 def command(node, name, ns=None):
-    """Command line of `node` started as `name`, in namespace `ns` when given."""
+    """Command line of `node` started as `name`, in namespace `ns` when given (a controller with its
+    feedback remapped as the launch files do)."""
     cmd = [executable(node), "__name:=%s" % name]
+    if node in ("kinematic_controller", "torque_controller"):
+        cmd.append(FEEDBACK_REMAP)
     if ns:
         cmd.append("__ns:=%s" % ns)
     return cmd

@@ -79,7 +79,7 @@ class NodeletBadParam(unittest.TestCase):
         got = []
         sub = rospy.Subscriber("/desired_velocity", DesiredVelocity, lambda m: got.append(m.header.stamp))
         ref_pub = rospy.Publisher("/reference", ReferenceState, queue_size=10)
-        odom_pub = rospy.Publisher("/odom", Odometry, queue_size=10)
+        odom_pub = rospy.Publisher("/feedback", Odometry, queue_size=10)  # the controller's, not remapped here
         stamp = rospy.Time(1, 0)
         ref = ReferenceState()
         ref.header.stamp = stamp

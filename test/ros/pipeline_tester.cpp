@@ -49,7 +49,7 @@ TEST(Pipeline, LockstepRunTracksTheLineAndEqualsTheInProcessRunner) {
   Watch w;
   ros::Subscriber sub = nh.subscribe("tracking_error", 100000, &Watch::onError, &w, ros::TransportHints().tcpNoDelay());
   // Counted by plant_sim's min_subscribers: the run starts only once this tester is listening.
-  ros::Subscriber odom = nh.subscribe("odom", 10, &Watch::onOdom, &w);
+  ros::Subscriber odom = nh.subscribe("ground_truth", 10, &Watch::onOdom, &w);
   const ros::WallTime start = ros::WallTime::now();
   while (ros::ok() && !(w.any && w.last_stamp.toSec() >= duration - 1e-9)) {
     ros::spinOnce();

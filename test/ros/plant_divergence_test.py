@@ -66,7 +66,7 @@ class PlantDivergence(unittest.TestCase):
             v = m.twist.twist.linear.x
             seen["max_v"] = max(seen["max_v"], abs(v) if math.isfinite(v) else math.inf)
 
-        sub = rospy.Subscriber(ns + "/odom", Odometry, on_odom, queue_size=1000)
+        sub = rospy.Subscriber(ns + "/ground_truth", Odometry, on_odom, queue_size=1000)
         pub = rospy.Publisher(ns + "/wheel_torque", WheelTorque, queue_size=10)
         with tempfile.TemporaryFile(mode="w+") as log:
             proc = node_process.start("plant_sim", "plant_sim", ns=ns, output=log)
@@ -86,7 +86,7 @@ class PlantDivergence(unittest.TestCase):
             log.seek(0)
             out = log.read()
         where = "%s (torque %g N m)" % (ns, torque)
-        self.assertGreater(seen["count"], 0, "%s: plant_sim never published odom\n%s" % (where, out))
+        self.assertGreater(seen["count"], 0, "%s: plant_sim never published ground_truth\n%s" % (where, out))
         self.assertEqual(code, 2, "%s: exit %s, expected 2 (stopped after %.0f s if it did not exit)\n%s"
                          % (where, code, EXIT_LIMIT, out))
         fatal = [line for line in out.splitlines() if "[FATAL]" in line]
@@ -105,11 +105,11 @@ class PlantDivergence(unittest.TestCase):
         node_process.set_private_params(diverging + "/plant_sim", dict(COMMON, max_speed=2.0))
         node_process.set_private_params(healthy + "/plant_sim", COMMON)  # no torque: it runs at rest
         seen = {diverging: [], healthy: []}  # odom |v| received, per plant
-        subs = [rospy.Subscriber(ns + "/odom", Odometry, lambda m, ns=ns: seen[ns].append(abs(m.twist.twist.linear.x)),
+        subs = [rospy.Subscriber(ns + "/ground_truth", Odometry, lambda m, ns=ns: seen[ns].append(abs(m.twist.twist.linear.x)),
                                  queue_size=1000) for ns in seen]
         pub = rospy.Publisher(diverging + "/wheel_torque", WheelTorque, queue_size=10)
         stamp = {"last": None}
-        subs.append(rospy.Subscriber(diverging + "/odom", Odometry, lambda m: stamp.update(last=m.header.stamp),
+        subs.append(rospy.Subscriber(diverging + "/ground_truth", Odometry, lambda m: stamp.update(last=m.header.stamp),
                                      queue_size=10))
         nodelet = roslib.packages.find_node("nodelet", "nodelet")[0]
         with tempfile.TemporaryFile(mode="w+") as log:

@@ -3,7 +3,7 @@
 headless:=true record:=true field:=line duration:=5` with the recorder slowed down on its receiving side
 (bag_recorder ~receive_delay: it reads its connections slowly, so the backlog stays with the publishers, as
 on a machine that starves it of CPU). (1) The run waits for it (run_monitor says so) and the bag holds
-every period: 5001 /odom messages (duration * rate + 1), the last stamped 5.0, and as many of every other
+every period: 5001 /ground_truth messages (duration * rate + 1), the last stamped 5.0, and as many of every other
 per-period topic. (2) With a recorder_timeout too short for it, the run ends with exit 3 and a last line
 saying that the bag lacks the end of the run.
 
@@ -21,7 +21,7 @@ import rosbag
 import rostest
 
 DURATION, RATE = 5.0, 1000
-PERIOD_TOPICS = ["/odom", "/desired_velocity", "/wheel_torque", "/torque_controller/state", "/tracking_error"]
+PERIOD_TOPICS = ["/ground_truth", "/odom", "/desired_velocity", "/wheel_torque", "/torque_controller/state", "/tracking_error"]
 
 
 def run_sim(port, tmp, overlay, *args):
@@ -56,10 +56,11 @@ class RecordSlow(unittest.TestCase):
         with rosbag.Bag(bag) as b:
             stamps = {t: [m.header.stamp.to_nsec() for _, m, _ in b.read_messages(topics=[t])] for t in PERIOD_TOPICS}
         n = int(DURATION * RATE) + 1
-        odom = stamps["/odom"]
-        self.assertEqual(len(odom), n, "odom: %d messages, last at %s" % (len(odom), odom[-1] * 1e-9 if odom else None))
-        self.assertEqual(odom[-1], int(DURATION * 1e9))
-        self.assertEqual(sorted(set(odom)), odom, "odom stamps repeat or go back")
+        truth = stamps["/ground_truth"]
+        self.assertEqual(len(truth), n, "ground_truth: %d messages, last at %s"
+                         % (len(truth), truth[-1] * 1e-9 if truth else None))
+        self.assertEqual(truth[-1], int(DURATION * 1e9))
+        self.assertEqual(sorted(set(truth)), truth, "ground_truth stamps repeat or go back")
         for topic in PERIOD_TOPICS:
             self.assertEqual(len(set(stamps[topic])), n, "%s: %d distinct stamps" % (topic, len(set(stamps[topic]))))
         self.assertEqual(out.rstrip().splitlines()[-1], "sim: the run ended normally")

@@ -122,7 +122,7 @@ class EncoderOdometry {
     std::int64_t r, l;
     double dt;
   };
-  std::deque<Past> window_;  // the counts of the readings within velocity_window, oldest first
+  std::deque<Past> window_;   // the counts of the readings within velocity_window, oldest first
   double window_time_ = 0.0;  // sum of window_'s dt after its first entry
   Odometry2D out_;
 };

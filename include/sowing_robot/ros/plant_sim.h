@@ -51,7 +51,8 @@ class PlantSim {
     double lockstep_retry = 0.5;      // [s] wall: republish the state if no torque came
     double lockstep_timeout = 5.0;    // [s] wall: report the missing input
     double lockstep_give_up = 120.0;  // [s] wall: exit 3 when an input stays missing this long; 0 = wait forever
-    int min_subscribers = 3;          // odom subscribers to wait for before step 0 (lockstep)
+    int min_subscribers = 3;          // state subscribers to wait for before step 0 (lockstep)
+    bool loop_on_odom = false;        // the controllers' feedback is odom: its subscribers count too
     double startup_delay = 0.5;       // [s] wall, lockstep: let every connection settle before step 0
     double max_speed = 20.0;          // [m/s]; beyond it (or NaN) the run is stopped as diverged
     bool exit_at_end = false;         // lockstep: exit when the scenario ends

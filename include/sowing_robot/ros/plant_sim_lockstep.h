@@ -26,8 +26,9 @@ class LockstepDriver : public PlantSimDriver {
  public:
   struct Config {
     core::LockstepTiming timing;
-    double duration = 25.0;   // [s] sim; <= 0 runs forever
-    int min_subscribers = 3;  // odom subscribers to wait for before step 0
+    double duration = 25.0;     // [s] sim; <= 0 runs forever
+    int min_subscribers = 3;    // subscribers of ground_truth (+ odom with loop_on_odom) to wait for before step 0
+    bool loop_on_odom = false;  // the controllers' feedback comes from odom (the encoders), not ground_truth
   };
   LockstepDriver(ros::NodeHandle nh, SimulatedPlant& plant, const Config& config);
   /// Unsubscribes first: returns only when no torque callback is running.
@@ -41,8 +42,10 @@ class LockstepDriver : public PlantSimDriver {
   void torqueCallback(const WheelTorque::ConstPtr& msg);
   /// The state of step k; visuals at publish_rate and at the final step.
   void publishStep(std::int64_t k);
-  /// The odom subscribers and a wheel_torque publisher are there: step 0 can be answered.
+  /// The loop's state subscribers and a wheel_torque publisher are there: step 0 can be answered.
   bool loopConnected() const;
+  /// Subscribers of the state topics the loop uses: ground_truth, and odom when the feedback is odom.
+  unsigned stateSubscribers() const;
   /// "N publisher(s) on <wheel_torque topic>", asking whether torque_controller runs when N is 0: what
   /// the stall and give-up reports say about the missing input.
   std::string torqueSources() const;

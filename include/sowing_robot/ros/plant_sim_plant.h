@@ -1,5 +1,6 @@
 // The part of plant_sim that both drivers share: the simulated DDMR (core::Plant) with its health check,
-// and the messages that show its state (odom, /clock, tf, joint_states, the travelled path). Which step
+// and the messages that show its state (ground_truth, /clock, tf, joint_states, the travelled path) and
+// what its sensors read of it (odom, imu, fix: plant_sensors.h). Which step
 // comes when, and with which torque, is the drivers' business (plant_sim_realtime.h, plant_sim_lockstep.h).
 #pragma once
 
@@ -14,9 +15,11 @@
 
 #include "sowing_robot/core/plant.h"
 #include "sowing_robot/core/robot_params.h"
+#include "sowing_robot/core/sensors.h"
 #include "sowing_robot/core/types.h"
 #include "sowing_robot/ros/path_buffer.h"
 #include "sowing_robot/ros/plant_contacts.h"
+#include "sowing_robot/ros/plant_sensors.h"
 
 namespace sowing_robot {
 
@@ -32,7 +35,8 @@ class SimulatedPlant {
 
   /// Starts the plant at rest at `start` and advertises its topics on `nh`.
   SimulatedPlant(ros::NodeHandle nh, const core::RobotParams& robot, const core::PlantDisturbance& disturbance,
-                 const core::Pose2D& start, const Rates& rates, const core::Footprint& footprint);
+                 const core::Pose2D& start, const Rates& rates, const core::Footprint& footprint,
+                 const core::SensorParams& sensors = core::SensorParams());
   /// Prints the contact report if the run did not (a realtime run, or one stopped early).
   ~SimulatedPlant();
   /// The contact report (contacts of the body, minimum clearance) as one log line, once.
@@ -41,7 +45,8 @@ class SimulatedPlant {
   /// One control period with `torque`; false when the state is then non-finite or faster than max_speed
   /// (it must not be published: divergence() says what went wrong).
   bool step(const core::WheelTorques& torque);
-  /// The state as step k (stamped stampOf(k)): odom; tf, joint_states and the path too with `visuals`;
+  /// The state as step k (stamped stampOf(k)): ground_truth and the sensors' odom, imu and due fixes; tf
+  /// (odom -> base_link from the encoders' odom), joint_states and the true path too with `visuals`;
   /// /clock every clock_rate, with visuals, or when `clock` is set.
   void publish(std::int64_t k, bool visuals, bool clock = false);
   /// Step k is one of the publish_rate steps that carry the visuals.
@@ -50,7 +55,8 @@ class SimulatedPlant {
   ros::Time stampOf(std::int64_t k) const;
   std::int64_t periodNs() const { return rates_.period_ns; }
   double dt() const { return core::secondsFromNanos(rates_.period_ns); }
-  unsigned odomSubscribers() const { return odom_pub_.getNumSubscribers(); }
+  unsigned truthSubscribers() const { return truth_pub_.getNumSubscribers(); }
+  unsigned odomSubscribers() const { return sensors_->odomSubscribers(); }
   const core::Plant& plant() const { return plant_; }
   /// The FATAL text of a diverged state: its time and values, and max_speed.
   std::string divergence() const;
@@ -62,11 +68,12 @@ class SimulatedPlant {
   core::Plant plant_;
   std::int64_t visual_every_ = 20;  // publish visuals every n steps
   std::int64_t clock_every_ = 1;    // publish /clock every n steps
-  ros::Publisher clock_pub_, odom_pub_, joint_pub_, path_pub_;
+  ros::Publisher clock_pub_, truth_pub_, joint_pub_, path_pub_;
+  std::unique_ptr<PlantSensors> sensors_;    // encoders, gyro, fix: read every step()
   std::unique_ptr<PlantContacts> contacts_;  // the body against the plan's obstacles, every step
   bool contacts_reported_ = false;
   tf2_ros::TransformBroadcaster tf_;
-  nav_msgs::Odometry odom_msg_;
+  nav_msgs::Odometry truth_msg_;
   sensor_msgs::JointState joint_msg_;
   PathBuffer path_{"odom", 0.05, 10};  // a point every 5 cm, re-sent every 10th point
 };

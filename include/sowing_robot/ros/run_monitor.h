@@ -1,9 +1,13 @@
 // run_monitor: accumulates the tracking-error metrics of a run (Tables 5.5/5.6) and prints them when
-// the scenario ends; optionally writes them to YAML and ends the launch (headless runs). With a recorder
+// the scenario ends. The errors are the TRUE ones: ground_truth against the reference of the same stamp
+// (core::worldErrors, as kinematic_controller computes its tracking_error from its feedback, so with
+// feedback:=ground_truth the numbers are the same bit for bit), whatever the controllers are fed;
+// optionally writes them to YAML and ends the launch (headless runs). With a recorder
 // (`~recorder`: its recorded_until topic) it ends the launch only once the recorder has written the
 // run's last period, or, after `~recorder_timeout` wall seconds without that, with a failure (exit 3).
 #pragma once
 
+#include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
 #include <std_msgs/Time.h>
 
@@ -13,9 +17,10 @@
 #include <string>
 #include <thread>
 
-#include "sowing_robot/TrackingError.h"
+#include "sowing_robot/ReferenceState.h"
 #include "sowing_robot/core/metrics.h"
 #include "sowing_robot/ros/node_failure.h"
+#include "sowing_robot/ros/stamp_pair.h"
 
 namespace sowing_robot {
 
@@ -28,7 +33,10 @@ class RunMonitor {
   int exitCode() const;
 
  private:
-  void errorCallback(const TrackingError::ConstPtr& msg);
+  void truthCallback(const nav_msgs::Odometry::ConstPtr& msg);
+  void referenceCallback(const ReferenceState::ConstPtr& msg);
+  /// The true error of the state and reference paired for one stamp.
+  void addPair();
   void recordedCallback(const std_msgs::Time::ConstPtr& msg);
   void waitForRecorder();
   void finish();
@@ -41,7 +49,8 @@ class RunMonitor {
   core::MetricsAccumulator metrics_;
   ros::Time last_;
   ros::NodeHandle pnh_;
-  ros::Subscriber sub_, recorder_sub_;
+  StampPair<nav_msgs::Odometry, ReferenceState> inputs_;  // the reference is sent ahead of the state
+  ros::Subscriber truth_sub_, ref_sub_, recorder_sub_;
 
   // The wait for the recorder: a thread of its own with a bounded wait, not a ros::WallTimer: roscpp's
   // timer thread queues a callback while holding its timer lock, and InlineCallbackQueue runs it right

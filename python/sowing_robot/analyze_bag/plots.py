@@ -27,7 +27,7 @@ def projection_bounds():
 
 
 def _yaw(odom):
-    """Yaw of /odom's orientation quaternions (array)."""
+    """Yaw of an Odometry series' orientation quaternions (array)."""
     qx, qy, qz, qw = (odom["pose.pose.orientation." + c] for c in "xyzw")
     return np.arctan2(2.0 * (qw * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz))
 
@@ -104,7 +104,7 @@ def write_plots(datas, out_dir, prefix):
     if len(ref):
         ax.plot(*thin(ref["x"], ref["y"]), "k--", lw=1.5, label="reference")
     for i, d in enumerate(datas):
-        odom = d.get("/odom")
+        odom = d.truth()
         if len(odom):
             xs, ys = odom["pose.pose.position.x"], odom["pose.pose.position.y"]
             ax.plot(*thin(xs, ys), label="robot, %s" % d.label, **sty(i, lw=1.6))
@@ -131,7 +131,7 @@ def write_plots(datas, out_dir, prefix):
         for a in range(3):
             plot(axs[a], t, vals[a], "k--", lw=1.5, label="reference")
     for i, d in enumerate(datas):
-        odom = d.get("/odom")
+        odom = d.truth()
         if not len(odom):
             continue
         t = odom.stamps
@@ -159,7 +159,7 @@ def write_plots(datas, out_dir, prefix):
     fig, axs = plt.subplots(2, 2, figsize=(13, 8), sharex=True)
     for i, d in enumerate(datas):
         c = colors[i % len(colors)]
-        odom, des, st = d.get("/odom"), d.get("/desired_velocity"), d.get("/torque_controller/state")
+        odom, des, st = d.truth(), d.get("/desired_velocity"), d.get("/torque_controller/state")
         if len(des):
             t, v = arr(des, "v")
             plot(axs[0, 0], t, v, color=c, lw=4, alpha=0.3, label="desired v_d, %s" % d.label)
