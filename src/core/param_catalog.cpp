@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <sstream>
 
+#include "sowing_robot/core/ekf.h"
 #include "sowing_robot/core/field.h"
 #include "sowing_robot/core/node_settings.h"
 #include "sowing_robot/core/traction.h"
@@ -125,6 +126,11 @@ const std::vector<CatalogSection>& parameterCatalog() {
       {"seed_drill",
        "the seed drill: spacing and scoring of the seeds against the plan",
        infos(SeedDrillSettings::table()),
+       {}},
+      {"state_estimator",
+       "the EKF of feedback:=fused (core/ekf.h): pose and yaw-rate bias from the encoders, the yaw rate and the "
+       "late position fix",
+       infos(ekfTable()),
        {}},
       {"run_monitor", "the metric table at the end of a run", infos(RunMonitorSettings::table()), {}},
       {"pso_tuner",

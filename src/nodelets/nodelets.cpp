@@ -24,6 +24,7 @@
 #include "sowing_robot/ros/reference_generator.h"
 #include "sowing_robot/ros/run_monitor.h"
 #include "sowing_robot/ros/seed_drill.h"
+#include "sowing_robot/ros/state_estimator.h"
 #include "sowing_robot/ros/torque_controller.h"
 
 namespace sowing_robot {
@@ -86,6 +87,7 @@ using TorqueControllerNodelet = WrapperNodelet<TorqueController>;
 using ReferenceGeneratorNodelet = WrapperNodelet<ReferenceGenerator>;
 using RunMonitorNodelet = WrapperNodelet<RunMonitor>;
 using SeedDrillNodelet = WrapperNodelet<SeedDrillNode>;
+using StateEstimatorNodelet = WrapperNodelet<StateEstimator>;
 
 /// The plant's run() on a thread of its own: in lockstep it only supervises (the torque callback steps);
 /// in realtime it paces the steps and serves the wheel_torque queue. A run that cannot go on (the state
@@ -128,3 +130,4 @@ PLUGINLIB_EXPORT_CLASS(sowing_robot::TorqueControllerNodelet, nodelet::Nodelet)
 PLUGINLIB_EXPORT_CLASS(sowing_robot::ReferenceGeneratorNodelet, nodelet::Nodelet)
 PLUGINLIB_EXPORT_CLASS(sowing_robot::RunMonitorNodelet, nodelet::Nodelet)
 PLUGINLIB_EXPORT_CLASS(sowing_robot::SeedDrillNodelet, nodelet::Nodelet)
+PLUGINLIB_EXPORT_CLASS(sowing_robot::StateEstimatorNodelet, nodelet::Nodelet)

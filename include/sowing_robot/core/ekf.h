@@ -1,0 +1,175 @@
+// State estimator for the DDMR (issue 16, item 4): an extended Kalman filter over the pose of the axle
+// midpoint and the gyro's bias, s = (x, y, theta, b), fed by the wheel encoders and the yaw rate, and
+// corrected by a position fix that arrives late.
+//
+// Prediction, one plant step (duration dt):
+//   the encoders give the step's distance and heading change (u_m, d_m) with a covariance C (the
+//   caller's, plus the process noise of the table: distance_noise^2 |u_m| and heading_noise^2 |u_m|,
+//   which stand for slip and wheel-radius errors, growing with the distance rolled). These are the
+//   prior of the step's true (u, d), independent of s. The gyro's rate r is a measurement of them:
+//   r dt = d + b dt + n dt (n: the rate's noise, variance per sample as sensor_msgs/Imu gives it),
+//   linear in the augmented vector a = (s, d, u), so one exact Kalman update fuses both heading
+//   sources and makes the bias observable (standing still, d is known to the tick and r - d/dt is b).
+//   Then the motion (midpoint heading, as the encoder odometry integrates):
+//     x' = x + u cos(theta + d/2),  y' = y + u sin(theta + d/2),  theta' = theta + d,  b' = b
+//   with P' = F Pa F^T + Q, F = df/da (4x6), Q the bias random walk bias_walk^2 dt.
+//   Why the bias is in the state: the yaw-rate sensor's bias (sensors/imu/bias) integrates into a
+//   heading error that grows without bound through a fix dropout; estimated, it is cancelled, and the
+//   covariance says how well. bias/estimate false pins b at 0 with zero variance (a 3-state filter).
+//
+// Fix update: z = (x, y) + v, v ~ N(0, R); the innovation's squared Mahalanobis distance is gated
+// (gate > 0: refused above it) and the update uses the Joseph form. A fix is stamped with its
+// MEASUREMENT time: the filter keeps the last history_length steps (state, covariance, the step's
+// inputs and the fixes applied there), applies the fix to the newest kept state not after its stamp
+// (1 us tolerance; fixes are sampled on plant steps) and propagates again from there with the kept
+// inputs, re-applying the later fixes. So a late fix ends in exactly the estimate a filter would have
+// had with the fix applied at its stamp (test_ekf checks it). A fix older than the history, stamped
+// after the newest state, or with a non-finite or non-positive-definite value, is refused and counted.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <deque>
+#include <string>
+#include <vector>
+
+#include "sowing_robot/core/param_table.h"
+#include "sowing_robot/core/types.h"
+
+namespace sowing_robot {
+namespace core {
+
+/// Parameters of the estimator, under estimator/ on state_estimator's private namespace. Defaults,
+/// ranges, units and meanings: ekfTable().
+struct EkfParams {
+  EkfParams();
+  double distance_noise;        ///< [m/sqrt(m)] encoder distance error per sqrt(metre rolled)
+  double heading_noise;         ///< [rad/sqrt(m)] encoder heading error per sqrt(metre rolled)
+  double bias_walk;             ///< [rad/s/sqrt(s)] random walk of the gyro bias
+  bool estimate_bias;           ///< bias in the state; false: b = 0, no variance
+  double initial_sigma_xy;      ///< [m]
+  double initial_sigma_theta;   ///< [rad]
+  double initial_sigma_bias;    ///< [rad/s]
+  int history_length;           ///< steps kept for late fixes
+  double gate;                  ///< squared Mahalanobis distance above which a fix is refused; 0: no gate
+  double fix_delay;             ///< [s] the ROS node applies a fix once its state is this much newer (determinism)
+
+  /// checkRanges(): the first bad value as one line naming its key ("" when all are good).
+  std::string validate() const;
+};
+/// estimator/{odometry/distance_noise, odometry/heading_noise, bias/walk, bias/estimate,
+/// initial/sigma_xy, initial/sigma_theta, initial/sigma_bias, history/length, fix/gate, fix/delay}.
+const ParamTable<EkfParams>& ekfTable();
+
+/// One plant step's measurements.
+struct EkfStepInput {
+  double distance = 0.0;  ///< [m] encoder distance of the axle midpoint over the step
+  double dtheta = 0.0;    ///< [rad] encoder heading change over the step
+  /// Covariance of (distance, dtheta) as the odometry states it (the table's process noise is added).
+  Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();
+  bool has_rate = false;       ///< a yaw rate for this step
+  double rate = 0.0;           ///< [rad/s] measured yaw rate (true rate + bias + noise)
+  double rate_variance = 0.0;  ///< [(rad/s)^2] of one sample
+};
+
+/// Covariance of (distance, dtheta) of one step when each wheel's travel d_i has the variance
+/// variance_per_metre |d_i| (Siegwart's odometry model, as core/sensors.h's travel_variance states it):
+/// distance = (d_r + d_l) / 2, dtheta = (d_r - d_l) / (2 half_track).
+Eigen::Matrix2d wheelTravelCovariance(double d_right, double d_left, double half_track, double variance_per_metre);
+
+/// A position fix of the axle midpoint, stamped with its measurement time.
+struct EkfFix {
+  double stamp = 0.0;  ///< [s]
+  Eigen::Vector2d xy = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d covariance = Eigen::Matrix2d::Identity();
+};
+
+enum class FixOutcome { APPLIED, REFUSED_INVALID, REFUSED_TOO_OLD, REFUSED_FUTURE, REFUSED_GATE };
+const char* fixOutcomeName(FixOutcome o);
+
+/// Counts of what happened to the fixes offered to fuse().
+struct FixCounts {
+  long applied = 0, invalid = 0, too_old = 0, future = 0, gated = 0;
+  long refused() const { return invalid + too_old + future + gated; }
+};
+
+class Ekf {
+ public:
+  using Vector = Eigen::Matrix<double, 4, 1>;
+  using Matrix = Eigen::Matrix<double, 4, 4>;
+  enum Index { X = 0, Y = 1, THETA = 2, BIAS = 3 };
+
+  /// Throws std::invalid_argument when the parameters do not validate.
+  explicit Ekf(const EkfParams& params);
+
+  /// Start at time t from a pose (and bias) with the table's initial covariance; clears the history
+  /// (the counts stay). Throws std::invalid_argument for a non-finite value.
+  void reset(double t, const Pose2D& pose, double bias = 0.0);
+  /// Start from a given mean and covariance (must be finite and symmetric).
+  void reset(double t, const Vector& mean, const Matrix& covariance);
+  bool initialised() const { return !history_.empty(); }
+
+  /// Advance to time t (> time()) over one step's measurements. Returns false, changing nothing, for
+  /// a non-finite input, a negative variance, t <= time() or before reset().
+  bool predict(double t, const EkfStepInput& in);
+
+  /// Apply a fix at its stamp (see the file comment). Counted in counts().
+  FixOutcome fuse(const EkfFix& fix);
+
+  double time() const { return history_.back().t; }
+  const Vector& mean() const { return history_.back().mean; }
+  const Matrix& covariance() const { return history_.back().cov; }
+  Pose2D pose() const { return {mean()(X), mean()(Y), mean()(THETA)}; }
+  /// Oldest stamp a fix may have to be applied (history_length steps back).
+  double oldestTime() const { return history_.front().t; }
+  std::size_t historySize() const { return history_.size(); }
+  const FixCounts& counts() const { return counts_; }
+  const EkfParams& params() const { return params_; }
+
+  // The pieces of one step, public for the tests (Jacobians against finite differences).
+  /// Augmented vector a = (x, y, theta, b, d, u) -> next state.
+  static Vector motion(const Eigen::Matrix<double, 6, 1>& a);
+  /// d motion / d a.
+  static Eigen::Matrix<double, 4, 6> motionJacobian(const Eigen::Matrix<double, 6, 1>& a);
+  /// One whole prediction of (mean, covariance) over `in` lasting dt, with these parameters.
+  static void propagate(const EkfParams& p, double dt, const EkfStepInput& in, Vector& mean, Matrix& cov);
+  /// The fix update of (mean, covariance); returns the squared Mahalanobis distance of the innovation.
+  /// `apply` false only computes it.
+  static double update(const EkfFix& fix, Vector& mean, Matrix& cov, bool apply = true);
+
+ private:
+  struct Entry {
+    double t;
+    Vector mean;
+    Matrix cov;
+    EkfStepInput input;  ///< the step that led here from the previous entry
+    std::vector<EkfFix> fixes;  ///< applied here, in the order they came
+  };
+  void pinBias(Vector& mean, Matrix& cov) const;
+
+  EkfParams params_;
+  std::deque<Entry> history_;
+  FixCounts counts_;
+};
+
+/// Holds fixes until the filter's time has passed stamp + delay, so that which fixes an estimate
+/// includes depends on the stamps only, not on the order in which the fix and the odometry arrived.
+class FixQueue {
+ public:
+  explicit FixQueue(double delay, std::size_t capacity = 64) : delay_(delay), capacity_(capacity) {}
+  /// Keeps the fix (the oldest goes when full: counted in dropped()).
+  void push(const EkfFix& fix);
+  /// The fixes with stamp + delay <= t (1 us tolerance), oldest stamp first, removed from the queue.
+  std::vector<EkfFix> due(double t);
+  std::size_t size() const { return fixes_.size(); }
+  long dropped() const { return dropped_; }
+
+ private:
+  double delay_;
+  std::size_t capacity_;
+  std::deque<EkfFix> fixes_;
+  long dropped_ = 0;
+};
+
+}  // namespace core
+}  // namespace sowing_robot

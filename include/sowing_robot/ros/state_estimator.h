@@ -1,0 +1,46 @@
+// state_estimator: the EKF of core/ekf.h between the sensors and the controllers (feedback:=fused).
+// odom (encoder dead reckoning) + imu (yaw rate) paired by stamp -> one odometry/filtered per odom
+// stamp; fix (late position fixes) applied at their measurement stamp once the estimate is
+// estimator/fix/delay newer, so which fixes an estimate holds depends on stamps only (repeatable runs).
+#pragma once
+
+#include <geometry_msgs/PoseWithCovarianceStamped.h>
+#include <nav_msgs/Odometry.h>
+#include <ros/ros.h>
+#include <sensor_msgs/Imu.h>
+
+#include "sowing_robot/core/ekf.h"
+#include "sowing_robot/ros/stamp_pair.h"
+#include "sowing_robot/ros/ready_roster.h"
+
+namespace sowing_robot {
+
+class StateEstimator {
+ public:
+  /// Throws NodeFailure (badParameter) for a bad estimator/... value.
+  StateEstimator(ros::NodeHandle nh, ros::NodeHandle pnh);
+  ~StateEstimator();
+
+ private:
+  void odomCallback(const nav_msgs::Odometry::ConstPtr& msg);
+  void imuCallback(const sensor_msgs::Imu::ConstPtr& msg);
+  void fixCallback(const geometry_msgs::PoseWithCovarianceStamped::ConstPtr& msg);
+  /// One step for the paired odom and imu: predict, apply the fixes due, publish.
+  void step();
+  void publish(const nav_msgs::Odometry& odom, double rate);
+
+  core::Ekf ekf_;
+  core::FixQueue fixes_;
+  ros::Subscriber odom_sub_, imu_sub_, fix_sub_;
+  ros::Publisher filtered_pub_;
+  // Both streams come from the plant at the same rate on separate connections, either may run ahead
+  // (a burst from a recorder replay, a busy core in realtime): hold up to a few seconds of either.
+  StampPair<nav_msgs::Odometry, sensor_msgs::Imu, 8192, 8192> inputs_;
+  nav_msgs::Odometry last_odom_;  // the previous step's odom: the increments are taken from it
+  nav_msgs::Odometry filtered_;   // the last answer (republished when the plant asks again)
+  long rejected_inputs_ = 0, late_fixes_ = 0;
+  core::FixCounts reported_;      // counts already warned about
+  ReadyAnnouncer ready_;          // plant_sim waits for it before step 0
+};
+
+}  // namespace sowing_robot

@@ -1,0 +1,148 @@
+#include "sowing_robot/ros/state_estimator.h"
+
+#include <cmath>
+
+#include "sowing_robot/core/types.h"
+#include "sowing_robot/ros/component_params.h"
+#include "sowing_robot/ros/msg_checks.h"
+#include "sowing_robot/ros/node_failure.h"
+
+namespace sowing_robot {
+namespace {
+
+core::EkfParams loadParams(ros::NodeHandle nh, ros::NodeHandle pnh) {
+  ParamReader p(pnh);
+  loadRunSettings(nh, p);
+  core::EkfParams params;
+  loadTable(p, core::ekfTable(), params);
+  requireValid(p, params.validate());
+  logSettings("state_estimator", core::ekfTable(), params);
+  return params;
+}
+
+/// Variance of a message's covariance entry; "unknown" (negative, or not finite) as 0 (the estimator's
+/// process noise then stands alone).
+double knownVariance(double v) { return std::isfinite(v) && v > 0.0 ? v : 0.0; }
+
+}  // namespace
+
+StateEstimator::StateEstimator(ros::NodeHandle nh, ros::NodeHandle pnh)
+    : ekf_(loadParams(nh, pnh)), fixes_(ekf_.params().fix_delay) {
+  filtered_pub_ = nh.advertise<nav_msgs::Odometry>("odometry/filtered", kLockstepQueue);
+  const auto hints = ros::TransportHints().tcpNoDelay();
+  odom_sub_ = nh.subscribe("odom", kLockstepQueue, &StateEstimator::odomCallback, this, hints);
+  imu_sub_ = nh.subscribe("imu", kLockstepQueue, &StateEstimator::imuCallback, this, hints);
+  fix_sub_ = nh.subscribe("fix", 1000, &StateEstimator::fixCallback, this, hints);
+  ready_ = ReadyAnnouncer(nh, pnh);  // last: everything is subscribed (ready_roster.h)
+}
+
+StateEstimator::~StateEstimator() {
+  const core::FixCounts& c = ekf_.counts();
+  ROS_INFO("state_estimator: fixes applied %ld, refused %ld (older than the history %ld, newer than the estimate "
+           "%ld, invalid %ld, gated %ld), applied late %ld, lost from a full queue %ld; inputs rejected %ld",
+           c.applied, c.refused(), c.too_old, c.future, c.invalid, c.gated, late_fixes_, fixes_.dropped(),
+           rejected_inputs_);
+}
+
+void StateEstimator::odomCallback(const nav_msgs::Odometry::ConstPtr& msg) {
+  if (!odomIsFinite(*msg)) {
+    ROS_WARN_THROTTLE(1.0, "state_estimator: rejected non-finite odom (%ld so far)", ++rejected_inputs_);
+    return;
+  }
+  if (inputs_.isRepeat(msg->header.stamp)) {  // the plant asked again: answer with the same numbers
+    publishShared(filtered_pub_, filtered_);
+    return;
+  }
+  if (inputs_.setFirst(*msg)) step();
+}
+
+void StateEstimator::imuCallback(const sensor_msgs::Imu::ConstPtr& msg) {
+  if (!std::isfinite(msg->angular_velocity.z)) {
+    ROS_WARN_THROTTLE(1.0, "state_estimator: rejected non-finite imu (%ld so far)", ++rejected_inputs_);
+    return;
+  }
+  if (inputs_.setSecond(*msg)) step();
+}
+
+void StateEstimator::fixCallback(const geometry_msgs::PoseWithCovarianceStamped::ConstPtr& msg) {
+  core::EkfFix fix;
+  fix.stamp = msg->header.stamp.toSec();
+  fix.xy << msg->pose.pose.position.x, msg->pose.pose.position.y;
+  const auto& c = msg->pose.covariance;
+  fix.covariance << c[0], c[1], c[6], c[7];
+  // A fix the estimate has passed already (it came later than estimator/fix/delay): still applied at
+  // its stamp, at the next step, but that step could have gone either way: say so.
+  if (ekf_.initialised() && fix.stamp + ekf_.params().fix_delay < ekf_.time() - 1e-6) {
+    ++late_fixes_;
+    ROS_WARN_THROTTLE(5.0,
+                      "state_estimator: fix stamped %.3f s came after the estimate passed stamp + fix/delay (%.3f s); "
+                      "raise estimator/fix/delay above the fix latency (%ld late so far)",
+                      fix.stamp, ekf_.time(), late_fixes_);
+  }
+  fixes_.push(fix);
+}
+
+void StateEstimator::step() {
+  const nav_msgs::Odometry& odom = inputs_.first();
+  const sensor_msgs::Imu& imu = inputs_.second();
+  const double t = odom.header.stamp.toSec();
+  const double rate = imu.angular_velocity.z;
+  if (!ekf_.initialised()) {
+    // Start where the odometry starts (the plant resets it to the start pose), with the initial
+    // covariance of the table.
+    ekf_.reset(t, poseOf(odom));
+  } else {
+    const core::Pose2D a = poseOf(last_odom_), b = poseOf(odom);
+    core::EkfStepInput in;
+    // The increments that odometry's midpoint integration turns into this pose change.
+    in.dtheta = core::wrapAngle(b.theta - a.theta);
+    const double mid = a.theta + 0.5 * in.dtheta;
+    in.distance = (b.x - a.x) * std::cos(mid) + (b.y - a.y) * std::sin(mid);
+    in.has_rate = imu.angular_velocity_covariance[0] >= 0.0;  // -1: no rate in this message
+    in.rate = rate;
+    in.rate_variance = knownVariance(imu.angular_velocity_covariance[8]);
+    if (!ekf_.predict(t, in)) {
+      // Never silently: the estimate stays at the last step (its covariance still says how old).
+      ROS_WARN_THROTTLE(1.0, "state_estimator: step at t=%.6f s refused (non-finite input or stamp not after %.6f s)",
+                        t, ekf_.time());
+      ++rejected_inputs_;
+    }
+  }
+  for (const core::EkfFix& f : fixes_.due(ekf_.time())) ekf_.fuse(f);
+  const core::FixCounts& c = ekf_.counts();
+  if (c.refused() != reported_.refused()) {
+    ROS_WARN_THROTTLE(1.0,
+                      "state_estimator: fixes refused so far: %ld older than the history, %ld newer than the "
+                      "estimate, %ld invalid, %ld outside the gate (%ld applied)",
+                      c.too_old, c.future, c.invalid, c.gated, c.applied);
+    reported_ = c;
+  }
+  last_odom_ = odom;
+  publish(odom, rate);
+}
+
+void StateEstimator::publish(const nav_msgs::Odometry& odom, double rate) {
+  const core::Ekf::Vector& m = ekf_.mean();
+  const core::Ekf::Matrix& p = ekf_.covariance();
+  filtered_.header = odom.header;
+  filtered_.child_frame_id = odom.child_frame_id;
+  filtered_.pose.pose.position.x = m(core::Ekf::X);
+  filtered_.pose.pose.position.y = m(core::Ekf::Y);
+  filtered_.pose.pose.position.z = 0.0;
+  filtered_.pose.pose.orientation = yawQuaternion(m(core::Ekf::THETA));
+  // Row-major 6x6 over (x, y, z, roll, pitch, yaw); the planar filter does not know z, roll, pitch.
+  auto& pc = filtered_.pose.covariance;
+  pc.fill(0.0);
+  const int idx[3] = {0, 1, 5};
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) pc[6 * idx[i] + idx[j]] = p(i, j);
+  pc[6 * 2 + 2] = pc[6 * 3 + 3] = pc[6 * 4 + 4] = 1e6;
+  // Twist: the encoders' speed (slip biases it, as it does the odometry) and the gyro's rate less the
+  // estimated bias.
+  filtered_.twist = odom.twist;
+  filtered_.twist.twist.angular.z = rate - m(core::Ekf::BIAS);
+  filtered_.twist.covariance[35] = p(core::Ekf::BIAS, core::Ekf::BIAS) + knownVariance(inputs_.second().angular_velocity_covariance[8]);
+  publishShared(filtered_pub_, filtered_);
+}
+
+}  // namespace sowing_robot

@@ -1,0 +1,104 @@
+#!/usr/bin/env python3
+"""rostest: state_estimator on its own, fed by this test. 400 steps at 1 kHz of a straight drive along x
+(odom and imu, the two published in alternating order), and one fix stamped at step 100, 5 cm to the
+side, published at step 150 (50 ms latency; estimator/fix/delay is 0.15 s).
+
+Checked: one odometry/filtered per odom stamp, in order, with its stamp (pairing by stamp, not by
+arrival); the covariance is filled (x, y, yaw from the filter, z/roll/pitch 1e6) and grows between
+fixes; the fix is applied exactly at stamp + fix/delay (step 250), not before, and moves y towards it.
+Verified to fail: with the FixQueue bypassed (fixes fused on arrival) the 'not before' check fails;
+publishing nothing for one imu (no pairing) fails the count."""
+import math
+import time
+import unittest
+
+import rospy
+import rostest
+from geometry_msgs.msg import PoseWithCovarianceStamped
+from nav_msgs.msg import Odometry
+from sensor_msgs.msg import Imu
+
+WALL_LIMIT = 60.0
+STEPS = 400
+DT = 0.001
+T0 = 10.0
+V = 0.5
+
+
+def stamp(k):
+    return rospy.Time(T0) + rospy.Duration.from_sec(k * DT)
+
+
+class StateEstimatorTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        rospy.init_node("state_estimator_test")
+
+    def wait_for(self, condition, what):
+        deadline = time.time() + WALL_LIMIT
+        while not condition():
+            if time.time() > deadline:
+                self.fail("no %s after %.0f s wall" % (what() if callable(what) else what, WALL_LIMIT))
+            time.sleep(0.01)
+
+    def test_pairing_covariance_and_late_fix(self):
+        delay = rospy.get_param("/state_estimator/estimator/fix/delay")
+        self.assertAlmostEqual(delay, 0.15)
+        out = []
+        sub = rospy.Subscriber("odometry/filtered", Odometry, out.append, queue_size=10000)
+        odom_pub = rospy.Publisher("odom", Odometry, queue_size=10000)
+        imu_pub = rospy.Publisher("imu", Imu, queue_size=10000)
+        fix_pub = rospy.Publisher("fix", PoseWithCovarianceStamped, queue_size=10)
+        pubs = (odom_pub, imu_pub, fix_pub)
+        self.wait_for(lambda: all(p.get_num_connections() > 0 for p in pubs) and sub.get_num_connections() > 0,
+                      "connections")
+        for k in range(STEPS):
+            o = Odometry()
+            o.header.stamp = stamp(k)
+            o.header.frame_id = "odom"
+            o.child_frame_id = "base_link"
+            o.pose.pose.position.x = V * k * DT
+            o.pose.pose.orientation.w = 1.0
+            o.twist.twist.linear.x = V
+            i = Imu()
+            i.header.stamp = stamp(k)
+            i.angular_velocity.z = 0.0
+            i.angular_velocity_covariance[8] = 0.005 ** 2
+            i.orientation_covariance[0] = -1.0
+            i.linear_acceleration_covariance[0] = -1.0
+            first, second = ((odom_pub, o), (imu_pub, i)) if k % 2 == 0 else ((imu_pub, i), (odom_pub, o))
+            first[0].publish(first[1])
+            second[0].publish(second[1])
+            if k == 150:
+                f = PoseWithCovarianceStamped()
+                f.header.stamp = stamp(100)
+                f.header.frame_id = "odom"
+                f.pose.pose.position.x = V * 100 * DT
+                f.pose.pose.position.y = 0.05
+                f.pose.covariance[0] = f.pose.covariance[7] = 0.02 ** 2
+                for j in (14, 21, 28, 35):
+                    f.pose.covariance[j] = 1e6
+                fix_pub.publish(f)
+        self.wait_for(lambda: len(out) >= STEPS, lambda: "%d filtered messages (have %d)" % (STEPS, len(out)))
+        time.sleep(0.2)  # (only to see a duplicate, were there one; not a synchronisation)
+        sub.unregister()
+        self.assertEqual([m.header.stamp for m in out], [stamp(k) for k in range(STEPS)])
+        for m in out:
+            c = m.pose.covariance
+            self.assertGreater(c[0], 0.0)
+            self.assertGreater(c[7], 0.0)
+            self.assertGreater(c[35], 0.0)
+            self.assertEqual(c[14], 1e6)
+            self.assertEqual(m.header.frame_id, "odom")
+            self.assertTrue(all(math.isfinite(x) for x in c))
+        due = int(round(100 + delay / DT))  # step 250
+        self.assertEqual(out[due - 1].pose.pose.position.y, 0.0, "fix applied before stamp + delay")
+        self.assertGreater(out[due].pose.pose.position.y, 0.01, "fix not applied at stamp + delay")
+        self.assertLess(out[due].pose.pose.position.y, 0.05)
+        self.assertGreater(out[due - 1].pose.covariance[7], out[1].pose.covariance[7])  # grows without fixes
+        self.assertLess(out[due].pose.covariance[7], out[due - 1].pose.covariance[7])   # and drops at one
+        self.assertAlmostEqual(out[-1].pose.pose.position.x, V * (STEPS - 1) * DT, delta=0.01)
+
+
+if __name__ == "__main__":
+    rostest.rosrun("sowing_robot", "state_estimator", StateEstimatorTest)
