@@ -4,6 +4,9 @@
 // BM_ControlStep             one period of runClosedLoop's loop: reference next + Kanayama + SMC + plant
 // BM_ThesisRun25s            runClosedLoop of the 25 s thesis scenario at 1 kHz (keep_samples = false);
 //                            items/s = control steps/s
+// BM_ThesisRun25sTimeDomain  same with the time-domain figures (keep_samples = true: streaming, O(1) memory)
+// BM_MonteCarlo1000Runs/threads:N  runMonteCarlo of 1,000 seeded runs of the thesis line, kanayama+atsmc,
+//                            every metric (mc_benchmark's work without the files), N threads; wall time
 // BM_ThesisRun25sTraction    same with the traction plant (TractionParams defaults), issue 16's cost case
 // BM_ThesisRunPotentialField same with the potential-field reference (obstacles (20,3), (50,3), (80,3))
 // BM_PsoIteration/threads:N  one PSO iteration: 20 particles evaluated on the thesis scenario (ITAE,
@@ -12,6 +15,7 @@
 
 #include <vector>
 
+#include "sowing_robot/core/benchmark.h"
 #include "sowing_robot/core/plant.h"
 #include "sowing_robot/core/pso.h"
 #include "sowing_robot/core/runner.h"
@@ -81,6 +85,47 @@ void BM_ThesisRun25s(benchmark::State& state) {
   thesisRun(state, ref);
 }
 BENCHMARK(BM_ThesisRun25s)->Unit(benchmark::kMillisecond);
+
+void BM_ThesisRun25sTimeDomain(benchmark::State& state) {
+  const Scenario sc = bench::thesisScenario();
+  LineReference ref = bench::thesisLine();
+  volatile double settling = 0.0;
+  for (auto _ : state) {
+    const RunResult r = runClosedLoop(sc, ref, true);
+    settling = r.metrics[AXIS_Y].settling_time;
+  }
+  state.SetItemsProcessed(state.iterations() * sc.steps());
+  state.counters["settling_y"] = benchmark::Counter(settling, benchmark::Counter::kDefaults);
+}
+BENCHMARK(BM_ThesisRun25sTimeDomain)->Unit(benchmark::kMillisecond);
+
+// The issue-17 target: 1,000 runs of the 25 s line in under 3 s wall on 2 cores, >= 1.8x from 1 to 2
+// threads. The Monte-Carlo runner's own scenario (Scenario defaults: the thesis line, start (-1, 0, 0))
+// and spec (MonteCarloSpec defaults: mismatch, disturbance, noise and start drawn per run), as
+// `mc_benchmark --controllers kanayama+atsmc --seeds 1000` runs it.
+void BM_MonteCarlo1000Runs(benchmark::State& state) {
+  const int threads = static_cast<int>(state.range(0));
+  const Scenario sc;
+  const LineReference ref(1.0, 3.0, 0.0);
+  const MonteCarloSpec spec;
+  constexpr std::int64_t runs = 1000;
+  volatile double ise = 0.0;
+  for (auto _ : state) {
+    const std::vector<RunRow> rows = runMonteCarlo(sc, ref, spec, runs, threads);
+    ise = rows.back().metrics[AXIS_Y].ise;
+  }
+  state.SetItemsProcessed(state.iterations() * runs * sc.steps());
+  state.counters["runs/s"] =
+      benchmark::Counter(static_cast<double>(state.iterations() * runs), benchmark::Counter::kIsRate);
+  state.counters["ise_y_last"] = benchmark::Counter(ise, benchmark::Counter::kDefaults);
+}
+BENCHMARK(BM_MonteCarlo1000Runs)
+    ->ArgName("threads")
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
 
 // The same run with the traction plant (issue 16: at most 2x BM_ThesisRun25s). Default soil (loose moist
 // soil, mu 0.6, 4 sub-steps, rolling resistance 0.05): the thesis start's 100 N·m spins the wheels.

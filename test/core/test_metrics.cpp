@@ -107,8 +107,8 @@ void expectStreamingEqualsStored(const std::vector<double>& t, const std::vector
   timeDomainMetrics(t, neg, stored_neg);
   const AxisMetrics* want[AXIS_COUNT] = {&stored, &stored_neg, &stored_half};
   for (int a = 0; a < AXIS_COUNT; ++a) {
-    EXPECT_TRUE(sameBits(r[a].rise_time, want[a]->rise_time)) << what << " axis " << a << " rise " << r[a].rise_time
-                                                               << " vs " << want[a]->rise_time;
+    EXPECT_TRUE(sameBits(r[a].rise_time, want[a]->rise_time))
+        << what << " axis " << a << " rise " << r[a].rise_time << " vs " << want[a]->rise_time;
     EXPECT_TRUE(sameBits(r[a].settling_time, want[a]->settling_time))
         << what << " axis " << a << " settling " << r[a].settling_time << " vs " << want[a]->settling_time;
     EXPECT_TRUE(sameBits(r[a].overshoot, want[a]->overshoot))
