@@ -1,7 +1,10 @@
 #include "sowing_robot/core/node_settings.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <functional>
+#include <sstream>
 
 #include "sowing_robot/core/validation.h"
 
@@ -53,6 +56,9 @@ const ParamTable<PlantSimSettings>& PlantSimSettings::table() {
                "lockstep: exit 3 naming the missing input after waiting this long (wall time); 0 = never"),
         integer("min_subscribers", &S::min_subscribers, 3, Limits::closed(0, 100), "",
                 "lockstep: odom subscribers to wait for before step 0"),
+        text("wait_for", &S::wait_for, "",
+             "lockstep: space-separated names of the nodes (or nodelets) that must have announced themselves "
+             "on `ready` before step 0; empty = none"),
         number("startup_delay", &S::startup_delay, 0.5, Limits::nonNegative(), "s",
                "lockstep: settle time before step 0 (wall time)"),
         number("max_speed", &S::max_speed, 20.0, Limits::positive(), "m/s",
@@ -66,8 +72,27 @@ const ParamTable<PlantSimSettings>& PlantSimSettings::table() {
 
 PlantSimSettings::PlantSimSettings() { table().applyDefaults(*this); }
 
+std::vector<std::string> PlantSimSettings::waitForNames() const {
+  std::vector<std::string> names;
+  std::istringstream words(wait_for);
+  for (std::string name; words >> name;) names.push_back(name);
+  return names;
+}
+
 std::string PlantSimSettings::validate() const {
-  return firstError({table().checkRanges(*this), disturbance.validate()});
+  std::string names_error;
+  for (const std::string& name : waitForNames()) {
+    // A node's base name (ros/ready_roster.h announcedName): a letter, then letters, digits, '_'.
+    const bool valid = std::isalpha(static_cast<unsigned char>(name[0])) &&
+                       std::all_of(name.begin(), name.end(), [](char c) {
+                         return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
+                       });
+    if (!valid) {
+      names_error = "wait_for: '" + name + "' is not a node base name (a letter, then letters, digits or _)";
+      break;
+    }
+  }
+  return firstError({table().checkRanges(*this), names_error, disturbance.validate()});
 }
 
 namespace {

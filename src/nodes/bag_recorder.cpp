@@ -31,6 +31,7 @@
 
 #include "sowing_robot/ros/failure_log.h"
 #include "sowing_robot/ros/param_reader.h"
+#include "sowing_robot/ros/ready_roster.h"
 
 namespace {
 volatile std::sig_atomic_t g_stop = 0;
@@ -179,6 +180,7 @@ int record(ros::NodeHandle& nh, ros::NodeHandle& pnh, const Options& o) {
     if (o.receive_delay > 0.0) so.callback_queue = &delaying;
     subs.push_back(nh.subscribe(so));
   }
+  const sowing_robot::ReadyAnnouncer ready(nh, pnh);  // plant_sim's wait_for may name the recorder
   ROS_INFO(
       "bag_recorder: recording %zu topics to %s%s", o.topics.size(), o.output.c_str(),
       o.receive_delay > 0.0 ? (" (receive_delay " + std::to_string(o.receive_delay) + " s per message)").c_str() : "");

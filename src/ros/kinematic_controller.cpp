@@ -40,6 +40,7 @@ KinematicController::KinematicController(ros::NodeHandle nh, ros::NodeHandle pnh
   const auto hints = ros::TransportHints().tcpNoDelay();
   odom_sub_ = nh.subscribe("odom", kLockstepQueue, &KinematicController::odomCallback, this, hints);
   ref_sub_ = nh.subscribe("reference", kLockstepQueue, &KinematicController::referenceCallback, this, hints);
+  ready_ = ReadyAnnouncer(nh, pnh);  // last: everything is subscribed (ready_roster.h)
 }
 
 void KinematicController::reconfigure(KinematicControllerConfig& config, uint32_t) {

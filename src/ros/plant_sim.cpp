@@ -34,6 +34,7 @@ PlantSim::PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh) {
   cfg_.lockstep_timeout = settings.lockstep_timeout;
   cfg_.lockstep_give_up = settings.lockstep_give_up;
   cfg_.min_subscribers = settings.min_subscribers;
+  cfg_.wait_for = settings.waitForNames();
   cfg_.startup_delay = settings.startup_delay;
   cfg_.max_speed = settings.max_speed;
   cfg_.exit_at_end = settings.exit_at_end;
@@ -62,6 +63,7 @@ PlantSim::PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh) {
     c.timing.startup_delay = cfg_.startup_delay;
     c.duration = cfg_.duration;
     c.min_subscribers = cfg_.min_subscribers;
+    c.wait_for = cfg_.wait_for;
     driver_ = std::make_unique<LockstepDriver>(nh, *plant_, c);
   } else {
     RealtimeDriver::Config c;

@@ -18,7 +18,8 @@ std::int64_t lastStep(double duration, std::int64_t period_ns) {
 LockstepDriver::LockstepDriver(ros::NodeHandle nh, SimulatedPlant& plant, const Config& config)
     : plant_(plant),
       cfg_(config),
-      protocol_(plant.periodNs(), lastStep(config.duration, plant.periodNs()), config.timing) {
+      protocol_(plant.periodNs(), lastStep(config.duration, plant.periodNs()), config.timing),
+      roster_(nh, config.wait_for) {
   torque_sub_ = subscribeTorque(nh, &queue_, [this](const WheelTorque::ConstPtr& m) { torqueCallback(m); });
 }
 
@@ -75,7 +76,8 @@ void LockstepDriver::reportFinished() {
 }
 
 bool LockstepDriver::loopConnected() const {
-  return static_cast<int>(plant_.odomSubscribers()) >= cfg_.min_subscribers && torque_sub_.getNumPublishers() >= 1;
+  return static_cast<int>(plant_.odomSubscribers()) >= cfg_.min_subscribers && torque_sub_.getNumPublishers() >= 1 &&
+         roster_.complete();
 }
 
 std::string LockstepDriver::torqueSources() const {
@@ -88,8 +90,9 @@ void LockstepDriver::report(const core::LockstepProtocol::Supervision& s) const 
   if (s.step < 0) {
     ROS_WARN(
         "plant_sim: lockstep waiting for the loop for %.1f s wall: %u/%d odom subscribers, %u wheel_torque "
-        "publishers",
-        s.waited, plant_.odomSubscribers(), cfg_.min_subscribers, torque_sub_.getNumPublishers());
+        "publishers, not announced on ready: %s",
+        s.waited, plant_.odomSubscribers(), cfg_.min_subscribers, torque_sub_.getNumPublishers(),
+        roster_.missing().empty() ? "none" : roster_.missing().c_str());
   } else {
     ROS_ERROR(
         "plant_sim: lockstep stalled at t=%.6f s: no wheel_torque stamped for it after %.1f s wall (%s); "
@@ -99,12 +102,14 @@ void LockstepDriver::report(const core::LockstepProtocol::Supervision& s) const 
 }
 
 std::string LockstepDriver::giveUpReason(const core::LockstepProtocol::Supervision& s) const {
-  const char* what = s.step < 0 ? "the loop to connect (odom subscribers, a wheel_torque publisher)"
-                                : "a wheel_torque stamped for the current state";
+  const std::string missing = roster_.missing();
+  const std::string what = s.step < 0 ? "the loop to connect (odom subscribers, a wheel_torque publisher" +
+                                            (missing.empty() ? std::string(")") : "; not announced: " + missing + ")")
+                                      : "a wheel_torque stamped for the current state";
   char text[200];
   std::snprintf(text, sizeof text, "lockstep gave up at t=%.6f s after %.1f s wall (lockstep_give_up) waiting for ",
                 s.step < 0 ? 0.0 : plant_.stampOf(s.step).toSec(), cfg_.timing.give_up);
-  return text + std::string(what) + "; " + torqueSources();
+  return text + what + "; " + torqueSources();
 }
 
 void LockstepDriver::run() {

@@ -108,6 +108,7 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
       "reference_generator: references on a %.6f s grid (run/control_rate), sent %.3f s ahead of /clock "
       "(lookahead)",
       core::secondsFromNanos(period_ns_), lookahead_);
+  ready_ = ReadyAnnouncer(nh, pnh);  // last: everything is subscribed (ready_roster.h)
 }
 
 void ReferenceGenerator::obstaclesCallback(const visualization_msgs::MarkerArray::ConstPtr& msg) {

@@ -30,6 +30,7 @@ RunMonitor::RunMonitor(ros::NodeHandle nh, ros::NodeHandle pnh) : pnh_(pnh) {
   if (!recorder_topic_.empty()) recorder_sub_ = nh.subscribe(recorder_topic_, 10, &RunMonitor::recordedCallback, this);
   sub_ = nh.subscribe("tracking_error", kLockstepQueue, &RunMonitor::errorCallback, this,
                       ros::TransportHints().tcpNoDelay());
+  ready_ = ReadyAnnouncer(nh, pnh);  // last: everything is subscribed (ready_roster.h)
 }
 
 void RunMonitor::errorCallback(const TrackingError::ConstPtr& msg) {

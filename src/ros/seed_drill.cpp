@@ -53,6 +53,7 @@ SeedDrillNode::SeedDrillNode(ros::NodeHandle nh, ros::NodeHandle pnh) {
   const auto hints = ros::TransportHints().tcpNoDelay();
   odom_sub_ = nh.subscribe("odom", kLockstepQueue, &SeedDrillNode::odomCallback, this, hints);
   ref_sub_ = nh.subscribe("reference", kLockstepQueue, &SeedDrillNode::referenceCallback, this, hints);
+  ready_ = ReadyAnnouncer(nh, pnh);  // last: everything is subscribed (ready_roster.h)
 }
 
 void SeedDrillNode::planCallback(const FieldPlan::ConstPtr& msg) {

@@ -47,6 +47,7 @@ TorqueController::TorqueController(ros::NodeHandle nh, ros::NodeHandle pnh) {
   const auto hints = ros::TransportHints().tcpNoDelay();
   odom_sub_ = nh.subscribe("odom", kLockstepQueue, &TorqueController::odomCallback, this, hints);
   desired_sub_ = nh.subscribe("desired_velocity", kLockstepQueue, &TorqueController::desiredCallback, this, hints);
+  ready_ = ReadyAnnouncer(nh, pnh);  // last: everything is subscribed (ready_roster.h)
 }
 
 void TorqueController::reconfigure(TorqueControllerConfig& config, uint32_t) {

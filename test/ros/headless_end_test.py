@@ -57,9 +57,8 @@ class HeadlessEnd(unittest.TestCase):
     def test_normal_end(self):
         self.check_normal_end(11671)
 
-    @unittest.skip("known start-up hang of a full nodelet run (1 in ~10 under load, 2 of 2 in clean-clone "
-                   "CI runs): the plant can start stepping while seed_drill and run_monitor still load into "
-                   "the manager; see README, known limitations. Re-enable once the plant waits for them.")
+    # Hung 1 in ~10 under load before plant_sim waited for every node by name (ros/ready_roster.h): a
+    # 25 s line run could end before run_monitor had loaded into the manager.
     def test_normal_end_nodelets(self):
         self.check_normal_end(11672, "nodelets:=true")
 

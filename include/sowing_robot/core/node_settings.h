@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "sowing_robot/core/controllers.h"
 #include "sowing_robot/core/field.h"
@@ -40,9 +41,12 @@ struct PlantSimSettings {
   double realtime_factor, torque_timeout, publish_rate, clock_rate;
   double lockstep_retry, lockstep_timeout, lockstep_give_up, startup_delay, max_speed;
   int min_subscribers;
+  std::string wait_for;  ///< space-separated node names (ros/ready_roster.h)
   bool exit_at_end;
   PlantDisturbance disturbance;
   std::string validate() const;
+  /// wait_for split at white space.
+  std::vector<std::string> waitForNames() const;
   static const ParamTable<PlantSimSettings>& table();
 };
 

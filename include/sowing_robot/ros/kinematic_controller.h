@@ -17,6 +17,7 @@
 #include "sowing_robot/core/controllers.h"
 #include "sowing_robot/core/kanayama.h"
 #include "sowing_robot/ros/stamp_pair.h"
+#include "sowing_robot/ros/ready_roster.h"
 
 namespace sowing_robot {
 
@@ -45,6 +46,7 @@ class KinematicController {
   bool lockstep_;                // run/mode: wait for the paired reference, never time out
   double input_timeout_ = 0.05;  // [s] sim (shorter than torque_controller's: see config/controllers.yaml)
   std::unique_ptr<dynamic_reconfigure::Server<KinematicControllerConfig>> reconfigure_;
+  ReadyAnnouncer ready_;  // plant_sim waits for it before step 0
 };
 
 }  // namespace sowing_robot

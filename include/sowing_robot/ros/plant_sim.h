@@ -52,6 +52,7 @@ class PlantSim {
     double lockstep_timeout = 5.0;    // [s] wall: report the missing input
     double lockstep_give_up = 120.0;  // [s] wall: exit 3 when an input stays missing this long; 0 = wait forever
     int min_subscribers = 3;          // odom subscribers to wait for before step 0 (lockstep)
+    std::vector<std::string> wait_for;  // nodes that must have announced on `ready` before step 0 (lockstep)
     double startup_delay = 0.5;       // [s] wall, lockstep: let every connection settle before step 0
     double max_speed = 20.0;          // [m/s]; beyond it (or NaN) the run is stopped as diverged
     bool exit_at_end = false;         // lockstep: exit when the scenario ends

@@ -19,6 +19,7 @@
 #include "sowing_robot/ros/inline_callback_queue.h"
 #include "sowing_robot/ros/plant_sim_driver.h"
 #include "sowing_robot/ros/plant_sim_plant.h"
+#include "sowing_robot/ros/ready_roster.h"
 
 namespace sowing_robot {
 
@@ -28,6 +29,7 @@ class LockstepDriver : public PlantSimDriver {
     core::LockstepTiming timing;
     double duration = 25.0;   // [s] sim; <= 0 runs forever
     int min_subscribers = 3;  // odom subscribers to wait for before step 0
+    std::vector<std::string> wait_for;  // and the nodes that must have announced on `ready` (ready_roster.h)
   };
   LockstepDriver(ros::NodeHandle nh, SimulatedPlant& plant, const Config& config);
   /// Unsubscribes first: returns only when no torque callback is running.
@@ -41,7 +43,8 @@ class LockstepDriver : public PlantSimDriver {
   void torqueCallback(const WheelTorque::ConstPtr& msg);
   /// The state of step k; visuals at publish_rate and at the final step.
   void publishStep(std::int64_t k);
-  /// The odom subscribers and a wheel_torque publisher are there: step 0 can be answered.
+  /// The odom subscribers, a wheel_torque publisher and every node of wait_for are there: step 0 can be
+  /// answered and nobody misses the run.
   bool loopConnected() const;
   /// "N publisher(s) on <wheel_torque topic>", asking whether torque_controller runs when N is 0: what
   /// the stall and give-up reports say about the missing input.
@@ -55,6 +58,7 @@ class LockstepDriver : public PlantSimDriver {
   std::atomic<bool> stop_{false};
   InlineCallbackQueue queue_;  // its mutex guards plant_ and protocol_
   core::LockstepProtocol protocol_;
+  ReadyRoster roster_;
   ros::Subscriber torque_sub_;  // last: unsubscribed before the members its callback uses go
 };
 

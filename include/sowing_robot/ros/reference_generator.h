@@ -27,6 +27,7 @@
 #include "sowing_robot/core/field.h"
 #include "sowing_robot/core/reference.h"
 #include "sowing_robot/ros/path_buffer.h"
+#include "sowing_robot/ros/ready_roster.h"
 
 namespace sowing_robot {
 
@@ -70,6 +71,7 @@ class ReferenceGenerator {
   std::unique_ptr<PathBuffer> path_;  // reference_path (spacing from the parameters)
   double path_spacing_ = 0.1;         // [m] between stored reference path points
   std::unique_ptr<dynamic_reconfigure::Server<ReferenceGeneratorConfig>> reconfigure_;  // type field only
+  ReadyAnnouncer ready_;  // plant_sim waits for it before step 0
 };
 
 }  // namespace sowing_robot

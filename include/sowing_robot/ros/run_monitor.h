@@ -16,6 +16,7 @@
 #include "sowing_robot/TrackingError.h"
 #include "sowing_robot/core/metrics.h"
 #include "sowing_robot/ros/node_failure.h"
+#include "sowing_robot/ros/ready_roster.h"
 
 namespace sowing_robot {
 
@@ -52,6 +53,7 @@ class RunMonitor {
   bool waiting_ = false, stop_ = false;  // under wait_mutex_
   std::optional<NodeFailure> failure_;   // under wait_mutex_
   std::thread waiter_;
+  ReadyAnnouncer ready_;  // plant_sim waits for it before step 0
 };
 
 }  // namespace sowing_robot

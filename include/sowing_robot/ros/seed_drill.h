@@ -15,6 +15,7 @@
 #include "sowing_robot/core/node_settings.h"
 #include "sowing_robot/core/seeding.h"
 #include "sowing_robot/ros/stamp_pair.h"
+#include "sowing_robot/ros/ready_roster.h"
 
 namespace sowing_robot {
 
@@ -42,6 +43,7 @@ class SeedDrillNode {
   visualization_msgs::Marker chunk_;  // the current SPHERE_LIST of up to kChunk seeds
   int chunk_id_ = 0;
   std::size_t seeds_ = 0;
+  ReadyAnnouncer ready_;  // plant_sim waits for it before step 0
 };
 
 }  // namespace sowing_robot

@@ -19,6 +19,7 @@
 #include "sowing_robot/core/controllers.h"
 #include "sowing_robot/core/sliding_mode.h"
 #include "sowing_robot/ros/stamp_pair.h"
+#include "sowing_robot/ros/ready_roster.h"
 
 namespace sowing_robot {
 
@@ -49,6 +50,7 @@ class TorqueController {
   WheelTorque torque_;
   TorqueControllerState state_;
   long rejected_ = 0, saturated_ = 0;
+  ReadyAnnouncer ready_;  // plant_sim waits for it before step 0
 };
 
 }  // namespace sowing_robot
