@@ -19,6 +19,7 @@
 #include "sowing_robot/core/plant.h"
 #include "sowing_robot/core/pure_pursuit.h"
 #include "sowing_robot/core/sliding_mode.h"
+#include "sowing_robot/core/tuning.h"
 #include "sowing_robot/core/validation.h"
 #include "sowing_robot/core/wheel_pid.h"
 
@@ -88,6 +89,24 @@ ParamValue toParamValue(const YAML::Node& n, const ParamValue& like, const std::
     return static_cast<int>(v);
   }
   if (std::holds_alternative<double>(like)) return toDouble(n, file, key);
+  return t;
+}
+
+/// A scalar whose parameter type is not known here (setControllerParam checks it against its table): a
+/// bool, an integer (a table that wants a double takes it as one), a finite number, or else text.
+ParamValue toParamValue(const YAML::Node& n, const std::string& file, const std::string& key) {
+  if (!n.IsScalar()) fail(file, key + " must be a single value");
+  const std::string t = n.Scalar();
+  if (t == "true" || t == "True") return true;
+  if (t == "false" || t == "False") return false;
+  char* end = nullptr;
+  const long i = std::strtol(t.c_str(), &end, 10);
+  if (!t.empty() && *end == '\0') return static_cast<int>(i);
+  const double v = std::strtod(t.c_str(), &end);
+  if (!t.empty() && *end == '\0') {
+    if (!std::isfinite(v)) fail(file, key + " = '" + t + "' is not a finite number");
+    return v;
+  }
   return t;
 }
 
@@ -348,21 +367,27 @@ core::BenchScenario loadScenario(const std::string& name_or_path, const std::str
 
 void applyTunedGainsImpl(const std::string& path, core::Scenario& sc) {
   const YAML::Node root = loadYaml(path);
-  onlyKeys(root, {"kinematic_controller", "torque_controller", "pure_pursuit", "pid"}, path, "");
-  if (const YAML::Node g = root["kinematic_controller"])
-    applyGroup(core::kanayamaTable(), g, sc.kanayama, path, "kinematic_controller");
-  if (const YAML::Node g = root["torque_controller"]) {
-    const bool adaptive = sc.sliding.adaptive;
-    applyGroup(core::slidingModeTable(), g, sc.sliding, path, "torque_controller");
-    // The pair names the controller; a file tuned for the other mode is a mix-up, not a choice.
-    if (sc.inner == core::InnerKind::sliding_mode && sc.sliding.adaptive != adaptive)
-      fail(path, "torque_controller/mode is " + std::string(sc.sliding.adaptive ? "atsmc" : "tsmc") +
-                     " but the pair is " + sc.controllerName());
-    sc.sliding.adaptive = adaptive;
+  onlyKeys(root, {"kinematic_controller", "torque_controller"}, path, "");
+  // The nodes' keys (what sim.launch gains:= loads): each node's parameters flat, Kanayama's beside pure
+  // pursuit's and the sliding-mode controller's beside the PID's, all set through the tables
+  // (core::setControllerParam: unknown keys and values out of range refused).
+  const bool adaptive = sc.sliding.adaptive;
+  for (const char* node : {"kinematic_controller", "torque_controller"}) {
+    const YAML::Node g = root[node];
+    if (!g) continue;
+    if (!g.IsMap()) fail(path, std::string(node) + " must be a mapping");
+    std::vector<std::pair<std::string, YAML::Node>> keys;
+    flatten(g, "", keys);
+    for (const auto& kv : keys) {
+      const std::string error = core::setControllerParam(sc, node, kv.first, toParamValue(kv.second, path, kv.first));
+      if (!error.empty()) fail(path, error);
+    }
   }
-  if (const YAML::Node g = root["pure_pursuit"])
-    applyGroup(core::purePursuitTable(), g, sc.pure_pursuit, path, "pure_pursuit");
-  if (const YAML::Node g = root["pid"]) applyGroup(core::wheelPidTable(), g, sc.pid, path, "pid");
+  // The pair names the controller; a file tuned for the other mode is a mix-up, not a choice.
+  if (sc.inner == core::InnerKind::sliding_mode && sc.sliding.adaptive != adaptive)
+    fail(path, "torque_controller/mode is " + std::string(sc.sliding.adaptive ? "atsmc" : "tsmc") +
+                   " but the pair is " + sc.controllerName());
+  sc.sliding.adaptive = adaptive;
   const std::string e = sc.validate();
   if (!e.empty()) fail(path, e);
 }

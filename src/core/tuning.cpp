@@ -75,9 +75,12 @@ namespace {
 
 const char* const kKinematicNode = "kinematic_controller";
 const char* const kTorqueNode = "torque_controller";
-// Where the baselines' tables nest under their node (the nodes' namespaces and the gains YAML).
-const char* const kPurePursuitPrefix = "pure_pursuit/";
-const char* const kPidPrefix = "pid/";
+// The baselines' parameters sit flat under their node, beside Kanayama's and the sliding-mode
+// controller's (the nodes' keys: kinematic_controller/lookahead_dist, torque_controller/kp), so a gains
+// YAML loads into the nodes as it is (sim.launch gains:=). No key of one table is in the other's, except
+// max_torque: the motor's one limit, which sets both (as in the torque_controller node).
+const char* const kPurePursuitPrefix = "";
+const char* const kPidPrefix = "";
 
 /// A tunable gain of the scenario's pair: its table entry, node, key prefix and the struct it sets.
 struct GainRef {
@@ -216,18 +219,17 @@ double getGain(const Scenario& sc, const std::string& name) {
 }
 
 std::string setControllerParam(Scenario& sc, const std::string& node, const std::string& key, const ParamValue& value) {
-  auto under = [&key](const char* prefix) { return key.rfind(prefix, 0) == 0; };
   if (node == kKinematicNode) {
-    if (under(kPurePursuitPrefix))
-      return setEntry(purePursuitTable(), sc.pure_pursuit, node + "/" + kPurePursuitPrefix,
-                      key.substr(std::string(kPurePursuitPrefix).size()), value);
-    return setEntry(kanayamaTable(), sc.kanayama, node, key, value);
+    if (kanayamaTable().find(key)) return setEntry(kanayamaTable(), sc.kanayama, node, key, value);
+    return setEntry(purePursuitTable(), sc.pure_pursuit, node, key, value);
   }
   if (node == kTorqueNode) {
-    if (under(kPidPrefix))
-      return setEntry(wheelPidTable(), sc.pid, node + "/" + kPidPrefix, key.substr(std::string(kPidPrefix).size()),
-                      value);
-    return setEntry(slidingModeTable(), sc.sliding, node, key, value);
+    if (key == "max_torque") {
+      const std::string e = setEntry(slidingModeTable(), sc.sliding, node, key, value);
+      return e.empty() ? setEntry(wheelPidTable(), sc.pid, node, key, value) : e;
+    }
+    if (slidingModeTable().find(key)) return setEntry(slidingModeTable(), sc.sliding, node, key, value);
+    return setEntry(wheelPidTable(), sc.pid, node, key, value);
   }
   return "unknown controller node '" + node + "' (kinematic_controller, torque_controller)";
 }

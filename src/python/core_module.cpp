@@ -175,8 +175,8 @@ ParamValue toParamValue(const py::handle& v, const std::string& where) {
   throw py::type_error(where + ": a bool, int, float or str is needed, got " + std::string(py::str(v.get_type())));
 }
 
-/// params: {node: {key: value}} as in a gains YAML (yaml.safe_load of config/tuned/*.yaml; nested maps
-/// such as pure_pursuit: {...} are keys joined by '/'), or {"node/key": value}.
+/// params: {node: {key: value}} as in a gains YAML (yaml.safe_load of config/tuned/*.yaml), or
+/// {"node/key": value}.
 void applyParams(Scenario& sc, const std::string& node, const std::string& key, const py::handle& v) {
   if (py::isinstance<py::dict>(v)) {
     for (const auto& kv : v.cast<py::dict>()) {

@@ -113,8 +113,8 @@ TEST(TunableGains, SetAndGetReachThePairsOwnParameters) {
   EXPECT_FALSE(setGain(sc, "kx", 2.0));  // not a gain of rpp+pid
   EXPECT_TRUE(std::isnan(getGain(sc, "k1")));
   EXPECT_EQ(gainNode(sc, "kp"), "torque_controller");
-  EXPECT_EQ(gainKey(sc, "kp"), "pid/kp");
-  EXPECT_EQ(gainKey(sc, "lookahead_dist"), "pure_pursuit/lookahead_dist");
+  EXPECT_EQ(gainKey(sc, "kp"), "kp");  // flat under the node, as the nodes read it
+  EXPECT_EQ(gainKey(sc, "lookahead_dist"), "lookahead_dist");
   EXPECT_NE(validateGainBounds(sc, {{"kx", 0.1, 10.0}}).find("no tunable gain of rpp+pid"), std::string::npos);
 }
 
@@ -122,20 +122,23 @@ TEST(TunableGains, ControllerParamsByNodeKey) {
   Scenario sc;
   EXPECT_EQ(setControllerParam(sc, "torque_controller", "adaptation", std::string("eq_4_22")), "");
   EXPECT_EQ(sc.sliding.adaptation, Adaptation::eq_4_22);
-  EXPECT_EQ(setControllerParam(sc, "torque_controller", "pid/ki", 3), "");  // an int for a double
+  EXPECT_EQ(setControllerParam(sc, "torque_controller", "ki", 3), "");  // an int for a double
   EXPECT_EQ(sc.pid.ki, 3.0);
-  EXPECT_EQ(setControllerParam(sc, "kinematic_controller", "pure_pursuit/k_along", 1.5), "");
+  EXPECT_EQ(setControllerParam(sc, "kinematic_controller", "k_along", 1.5), "");
   EXPECT_EQ(sc.pure_pursuit.k_along, 1.5);
   EXPECT_NE(setControllerParam(sc, "kinematic_controller", "kz", 1.0), "");
   EXPECT_NE(setControllerParam(sc, "torque_controller", "k1", -1.0), "");
   EXPECT_NE(setControllerParam(sc, "plant_sim", "k1", 1.0), "");
+  EXPECT_EQ(setControllerParam(sc, "torque_controller", "max_torque", 50.0), "");  // the one motor limit
+  EXPECT_EQ(sc.sliding.max_torque, 50.0);
+  EXPECT_EQ(sc.pid.max_torque, 50.0);
 }
 
-TEST(GainsYaml, NestsTheBaselinesAndNamesTheVariant) {
+TEST(GainsYaml, KeysAreTheNodesAndNamesTheVariant) {
   Scenario sc = pair("rpp+pid");
   const std::string y = gainsYaml(sc, {{"kp", 0.0, 50.0}});
-  EXPECT_NE(y.find("kinematic_controller:\n  pure_pursuit:\n    lookahead_dist: 0.6"), std::string::npos) << y;
-  EXPECT_NE(y.find("torque_controller:\n  pid:\n    kp: 2.0"), std::string::npos) << y;
+  EXPECT_NE(y.find("kinematic_controller:\n  lookahead_dist: 0.6"), std::string::npos) << y;
+  EXPECT_NE(y.find("torque_controller:\n  kp: 2.0"), std::string::npos) << y;
   EXPECT_NE(y.find("# tuned in [0, 50]"), std::string::npos) << y;
   Scenario a = pair("kanayama+atsmc");
   EXPECT_EQ(gainsYaml(a, {}).find("adaptation"), std::string::npos);  // default reading: gains only
