@@ -89,7 +89,8 @@ void Ekf::reset(double t, const Pose2D& pose, double bias) {
 void Ekf::reset(double t, const Vector& mean, const Matrix& covariance) {
   if (!std::isfinite(t) || !mean.allFinite() || !covariance.allFinite())
     throw std::invalid_argument("Ekf::reset: non-finite time, mean or covariance");
-  if ((covariance - covariance.transpose()).cwiseAbs().maxCoeff() > 1e-12 * std::max(1.0, covariance.cwiseAbs().maxCoeff()))
+  if ((covariance - covariance.transpose()).cwiseAbs().maxCoeff() >
+      1e-12 * std::max(1.0, covariance.cwiseAbs().maxCoeff()))
     throw std::invalid_argument("Ekf::reset: covariance is not symmetric");
   Entry e{t, mean, covariance, EkfStepInput{}, {}};
   e.mean(THETA) = wrapAngle(e.mean(THETA));

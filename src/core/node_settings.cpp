@@ -88,9 +88,8 @@ std::string PlantSimSettings::validate() const {
   for (const std::string& name : waitForNames()) {
     // A node's base name (ros/ready_roster.h announcedName): a letter, then letters, digits, '_'.
     const bool valid = std::isalpha(static_cast<unsigned char>(name[0])) &&
-                       std::all_of(name.begin(), name.end(), [](char c) {
-                         return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
-                       });
+                       std::all_of(name.begin(), name.end(),
+                                   [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; });
     if (!valid) {
       names_error = "wait_for: '" + name + "' is not a node base name (a letter, then letters, digits or _)";
       break;

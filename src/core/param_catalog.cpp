@@ -9,8 +9,8 @@
 #include "sowing_robot/core/ekf.h"
 #include "sowing_robot/core/field.h"
 #include "sowing_robot/core/node_settings.h"
-#include "sowing_robot/core/traction.h"
 #include "sowing_robot/core/sensors.h"
+#include "sowing_robot/core/traction.h"
 
 namespace sowing_robot {
 namespace core {

@@ -38,10 +38,10 @@ StateEstimator::StateEstimator(ros::NodeHandle nh, ros::NodeHandle pnh)
 
 StateEstimator::~StateEstimator() {
   const core::FixCounts& c = ekf_.counts();
-  ROS_INFO("state_estimator: fixes applied %ld, refused %ld (older than the history %ld, newer than the estimate "
-           "%ld, invalid %ld, gated %ld), applied late %ld, lost from a full queue %ld; inputs rejected %ld",
-           c.applied, c.refused(), c.too_old, c.future, c.invalid, c.gated, late_fixes_, fixes_.dropped(),
-           rejected_inputs_);
+  ROS_INFO(
+      "state_estimator: fixes applied %ld, refused %ld (older than the history %ld, newer than the estimate "
+      "%ld, invalid %ld, gated %ld), applied late %ld, lost from a full queue %ld; inputs rejected %ld",
+      c.applied, c.refused(), c.too_old, c.future, c.invalid, c.gated, late_fixes_, fixes_.dropped(), rejected_inputs_);
 }
 
 void StateEstimator::odomCallback(const nav_msgs::Odometry::ConstPtr& msg) {
@@ -141,7 +141,8 @@ void StateEstimator::publish(const nav_msgs::Odometry& odom, double rate) {
   // estimated bias.
   filtered_.twist = odom.twist;
   filtered_.twist.twist.angular.z = rate - m(core::Ekf::BIAS);
-  filtered_.twist.covariance[35] = p(core::Ekf::BIAS, core::Ekf::BIAS) + knownVariance(inputs_.second().angular_velocity_covariance[8]);
+  filtered_.twist.covariance[35] =
+      p(core::Ekf::BIAS, core::Ekf::BIAS) + knownVariance(inputs_.second().angular_velocity_covariance[8]);
   publishShared(filtered_pub_, filtered_);
 }
 

@@ -190,9 +190,9 @@ double nees(const Ekf& ekf, const Ekf::Vector& truth) {
 }
 
 struct NeesRun {
-  std::vector<double> nees;        // at each checkpoint
-  std::vector<double> sigma_xy;    // sqrt(trace of the position covariance / 2) at each checkpoint
-  std::vector<double> error_xy;    // position error at each checkpoint
+  std::vector<double> nees;      // at each checkpoint
+  std::vector<double> sigma_xy;  // sqrt(trace of the position covariance / 2) at each checkpoint
+  std::vector<double> error_xy;  // position error at each checkpoint
 };
 
 /// One seeded run of `seconds` at 1 kHz, fixes at 10 Hz stamped at measurement and applied
@@ -308,7 +308,7 @@ TEST(Ekf, LateFixEqualsTheFixAppliedAtItsStamp) {
   a.fuse(fixes[1]);
   b.fuse(fixes[1]);
   b.fuse(fixes[0]);
-  EXPECT_LT((a.mean() - b.mean()).cwiseAbs().maxCoeff(), 1e-3);  // the order of two updates: not exact,
+  EXPECT_LT((a.mean() - b.mean()).cwiseAbs().maxCoeff(), 1e-3);              // the order of two updates: not exact,
   EXPECT_LT((a.covariance() - b.covariance()).cwiseAbs().maxCoeff(), 1e-6);  // but the same information
 }
 
@@ -384,9 +384,10 @@ TEST(Ekf, NeesWithinChiSquareBoundsOverLongRuns) {
   double grand = 0.0;
   const int outside = checkNees(runs, grand);
   const NeesBounds b = neesBounds(runs.size());
-  std::printf("mean NEES %.3f over %zu runs x %zu checkpoints (95 %% interval [%.3f, %.3f]), %d checkpoints "
-              "outside their 99 %% interval\n",
-              grand, runs.size(), runs[0].nees.size(), b.lo, b.hi, outside);
+  std::printf(
+      "mean NEES %.3f over %zu runs x %zu checkpoints (95 %% interval [%.3f, %.3f]), %d checkpoints "
+      "outside their 99 %% interval\n",
+      grand, runs.size(), runs[0].nees.size(), b.lo, b.hi, outside);
   EXPECT_LE(outside, 2) << "checkpoints whose mean NEES is outside the 99 % interval";
   EXPECT_GT(grand, b.lo);
   EXPECT_LT(grand, b.hi);
@@ -438,7 +439,7 @@ TEST(Ekf, ThroughAFixDropoutTheCovarianceGrowsHoldsTheErrorAndConvergesAfter) {
   EXPECT_GT(end_of_dropout, 3.0 * before);  // it grows
   for (const NeesRun& r : runs)
     for (int c = 20; c < 39; ++c) EXPECT_LE(r.sigma_xy[c], r.sigma_xy[c + 1] * (1.0 + 1e-9));  // monotonically
-  EXPECT_LT(after, 1.5 * before);  // and comes back
+  EXPECT_LT(after, 1.5 * before);                                                              // and comes back
   // The position error through the dropout is of the size the covariance says (RMS ratio near 1).
   const double ratio = std::sqrt(err_in / (2.0 * sig_in));
   EXPECT_GT(ratio, 0.8);
@@ -485,7 +486,8 @@ SensorRun runWithSensors(std::uint64_t seed, double seconds, double dropout_star
     const double wr = (v + L * omega) * dt, wl = (v - L * omega) * dt;  // wheel travels R dphi
     phi_r += wr / R;
     phi_l += wl / R;
-    const double ur = wr + std::sqrt(k * std::fabs(wr)) * n(slip_rng), ul = wl + std::sqrt(k * std::fabs(wl)) * n(slip_rng);
+    const double ur = wr + std::sqrt(k * std::fabs(wr)) * n(slip_rng),
+                 ul = wl + std::sqrt(k * std::fabs(wl)) * n(slip_rng);
     const double ds = 0.5 * (ur + ul), dth = (ur - ul) / (2.0 * L), mid = truth.theta + 0.5 * dth;
     truth = {truth.x + ds * std::cos(mid), truth.y + ds * std::sin(mid), wrapAngle(truth.theta + dth)};
     const Odometry2D odo = encoders.update(phi_r, phi_l, dt);
@@ -553,9 +555,10 @@ TEST(EkfWithSensors, LateFixesAllAppliedErrorBoundedSeedsReproduce) {
     runs.push_back({r.nees, r.sigma_xy, r.error_xy});
   }
   checkNees(runs, grand);
-  std::printf("with core/sensors.h: worst position error %.4f m over 10 runs of 60 s; mean NEES %.2f (see the "
-              "disabled bound test)\n",
-              worst, grand);
+  std::printf(
+      "with core/sensors.h: worst position error %.4f m over 10 runs of 60 s; mean NEES %.2f (see the "
+      "disabled bound test)\n",
+      worst, grand);
   EXPECT_LT(worst, 0.06);  // 3 fix sigmas
   EXPECT_EQ(runWithSensors(4, 60.0).nees, runs[3].nees);
 }
@@ -577,9 +580,10 @@ TEST(EkfWithSensors, ThroughTheSensorsDropoutTheCovarianceGrowsAndComesBack) {
       worst_in = std::max(worst_in, r.error_xy[c]);
     }
   }
-  std::printf("with core/sensors.h, dropout 20-40 s: position sigma %.4f m before, %.4f m at its end, %.4f m 5 s "
-              "after; worst error in it %.4f m\n",
-              before, end_of_dropout, after, worst_in);
+  std::printf(
+      "with core/sensors.h, dropout 20-40 s: position sigma %.4f m before, %.4f m at its end, %.4f m 5 s "
+      "after; worst error in it %.4f m\n",
+      before, end_of_dropout, after, worst_in);
   EXPECT_GT(end_of_dropout, 3.0 * before);
   EXPECT_LT(after, 1.5 * before);
   EXPECT_LT(worst_in, 0.25);  // 0.19 m seen: about 5 of its sigmas (the overconfidence of the disabled test)

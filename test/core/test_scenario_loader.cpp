@@ -174,7 +174,8 @@ TEST(ScenarioLoader, TunedGainsGoThroughTheParameterTables) {
   refused("pid:\n  kp: 3.0\n", "pid");  // the nodes' groups only: the PID's keys sit under torque_controller
   core::Scenario pid;
   ASSERT_EQ(core::parseControllerPair("rpp+pid", pid.outer, pid.inner, pid.sliding.adaptive), "");
-  bench::applyTunedGains(dir.write("rpp+pid.yaml", "kinematic_controller:\n  lookahead_dist: 0.8\ntorque_controller:\n  kp: 3.0\n"), pid);
+  bench::applyTunedGains(
+      dir.write("rpp+pid.yaml", "kinematic_controller:\n  lookahead_dist: 0.8\ntorque_controller:\n  kp: 3.0\n"), pid);
   EXPECT_EQ(pid.pure_pursuit.lookahead_dist, 0.8);
   EXPECT_EQ(pid.pid.kp, 3.0);
 }

@@ -43,16 +43,16 @@ namespace core {
 /// ranges, units and meanings: ekfTable().
 struct EkfParams {
   EkfParams();
-  double distance_noise;        ///< [m/sqrt(m)] encoder distance error per sqrt(metre rolled)
-  double heading_noise;         ///< [rad/sqrt(m)] encoder heading error per sqrt(metre rolled)
-  double bias_walk;             ///< [rad/s/sqrt(s)] random walk of the gyro bias
-  bool estimate_bias;           ///< bias in the state; false: b = 0, no variance
-  double initial_sigma_xy;      ///< [m]
-  double initial_sigma_theta;   ///< [rad]
-  double initial_sigma_bias;    ///< [rad/s]
-  int history_length;           ///< steps kept for late fixes
-  double gate;                  ///< squared Mahalanobis distance above which a fix is refused; 0: no gate
-  double fix_delay;             ///< [s] the ROS node applies a fix once its state is this much newer (determinism)
+  double distance_noise;       ///< [m/sqrt(m)] encoder distance error per sqrt(metre rolled)
+  double heading_noise;        ///< [rad/sqrt(m)] encoder heading error per sqrt(metre rolled)
+  double bias_walk;            ///< [rad/s/sqrt(s)] random walk of the gyro bias
+  bool estimate_bias;          ///< bias in the state; false: b = 0, no variance
+  double initial_sigma_xy;     ///< [m]
+  double initial_sigma_theta;  ///< [rad]
+  double initial_sigma_bias;   ///< [rad/s]
+  int history_length;          ///< steps kept for late fixes
+  double gate;                 ///< squared Mahalanobis distance above which a fix is refused; 0: no gate
+  double fix_delay;            ///< [s] the ROS node applies a fix once its state is this much newer (determinism)
 
   /// checkRanges(): the first bad value as one line naming its key ("" when all are good).
   std::string validate() const;
@@ -142,7 +142,7 @@ class Ekf {
     double t;
     Vector mean;
     Matrix cov;
-    EkfStepInput input;  ///< the step that led here from the previous entry
+    EkfStepInput input;         ///< the step that led here from the previous entry
     std::vector<EkfFix> fixes;  ///< applied here, in the order they came
   };
   void pinBias(Vector& mean, Matrix& cov) const;

@@ -41,7 +41,7 @@ struct PlantSimSettings {
   double realtime_factor, torque_timeout, publish_rate, clock_rate;
   double lockstep_retry, lockstep_timeout, lockstep_give_up, startup_delay, max_speed;
   int min_subscribers;
-  std::string wait_for;  ///< space-separated node names (ros/ready_roster.h)
+  std::string wait_for;    ///< space-separated node names (ros/ready_roster.h)
   std::string loop_topic;  ///< plant_sim's topic the controllers' feedback comes from: ground_truth | odom
   bool exit_at_end;
   PlantDisturbance disturbance;

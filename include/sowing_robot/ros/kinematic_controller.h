@@ -16,8 +16,8 @@
 #include "sowing_robot/TrackingError.h"
 #include "sowing_robot/core/controllers.h"
 #include "sowing_robot/core/kanayama.h"
-#include "sowing_robot/ros/stamp_pair.h"
 #include "sowing_robot/ros/ready_roster.h"
+#include "sowing_robot/ros/stamp_pair.h"
 
 namespace sowing_robot {
 

@@ -43,20 +43,20 @@ class PlantSim {
   struct Config {
     bool lockstep = false;
     std::int64_t period_ns = 1000000;
-    double duration = 25.0;           // [s] sim; <= 0 runs forever
-    double realtime_factor = 1.0;     // sim seconds per wall second in realtime mode
-    double torque_timeout = 0.1;      // [s] sim, realtime mode: older torques are replaced by zero
-    double publish_rate = 50.0;       // [Hz] sim, tf / joint_states / path
-    double clock_rate = 0.0;          // [Hz] sim, /clock; 0 = every step
-    double lockstep_retry = 0.5;      // [s] wall: republish the state if no torque came
-    double lockstep_timeout = 5.0;    // [s] wall: report the missing input
-    double lockstep_give_up = 120.0;  // [s] wall: exit 3 when an input stays missing this long; 0 = wait forever
-    int min_subscribers = 3;          // state subscribers to wait for before step 0 (lockstep)
+    double duration = 25.0;             // [s] sim; <= 0 runs forever
+    double realtime_factor = 1.0;       // sim seconds per wall second in realtime mode
+    double torque_timeout = 0.1;        // [s] sim, realtime mode: older torques are replaced by zero
+    double publish_rate = 50.0;         // [Hz] sim, tf / joint_states / path
+    double clock_rate = 0.0;            // [Hz] sim, /clock; 0 = every step
+    double lockstep_retry = 0.5;        // [s] wall: republish the state if no torque came
+    double lockstep_timeout = 5.0;      // [s] wall: report the missing input
+    double lockstep_give_up = 120.0;    // [s] wall: exit 3 when an input stays missing this long; 0 = wait forever
+    int min_subscribers = 3;            // state subscribers to wait for before step 0 (lockstep)
     std::vector<std::string> wait_for;  // nodes that must have announced on `ready` before step 0 (lockstep)
-    bool loop_on_odom = false;        // the controllers' feedback is odom: its subscribers count too
-    double startup_delay = 0.5;       // [s] wall, lockstep: let every connection settle before step 0
-    double max_speed = 20.0;          // [m/s]; beyond it (or NaN) the run is stopped as diverged
-    bool exit_at_end = false;         // lockstep: exit when the scenario ends
+    bool loop_on_odom = false;          // the controllers' feedback is odom: its subscribers count too
+    double startup_delay = 0.5;         // [s] wall, lockstep: let every connection settle before step 0
+    double max_speed = 20.0;            // [m/s]; beyond it (or NaN) the run is stopped as diverged
+    bool exit_at_end = false;           // lockstep: exit when the scenario ends
   };
 
   Config cfg_;

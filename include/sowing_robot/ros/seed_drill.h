@@ -14,8 +14,8 @@
 #include "sowing_robot/ReferenceState.h"
 #include "sowing_robot/core/node_settings.h"
 #include "sowing_robot/core/seeding.h"
-#include "sowing_robot/ros/stamp_pair.h"
 #include "sowing_robot/ros/ready_roster.h"
+#include "sowing_robot/ros/stamp_pair.h"
 
 namespace sowing_robot {
 

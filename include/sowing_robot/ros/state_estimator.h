@@ -10,8 +10,8 @@
 #include <sensor_msgs/Imu.h>
 
 #include "sowing_robot/core/ekf.h"
-#include "sowing_robot/ros/stamp_pair.h"
 #include "sowing_robot/ros/ready_roster.h"
+#include "sowing_robot/ros/stamp_pair.h"
 
 namespace sowing_robot {
 
@@ -39,8 +39,8 @@ class StateEstimator {
   nav_msgs::Odometry last_odom_;  // the previous step's odom: the increments are taken from it
   nav_msgs::Odometry filtered_;   // the last answer (republished when the plant asks again)
   long rejected_inputs_ = 0, late_fixes_ = 0;
-  core::FixCounts reported_;      // counts already warned about
-  ReadyAnnouncer ready_;          // plant_sim waits for it before step 0
+  core::FixCounts reported_;  // counts already warned about
+  ReadyAnnouncer ready_;      // plant_sim waits for it before step 0
 };
 
 }  // namespace sowing_robot

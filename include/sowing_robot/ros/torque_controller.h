@@ -18,8 +18,8 @@
 #include "sowing_robot/WheelTorque.h"
 #include "sowing_robot/core/controllers.h"
 #include "sowing_robot/core/sliding_mode.h"
-#include "sowing_robot/ros/stamp_pair.h"
 #include "sowing_robot/ros/ready_roster.h"
+#include "sowing_robot/ros/stamp_pair.h"
 
 namespace sowing_robot {
 
