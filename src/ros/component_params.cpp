@@ -36,8 +36,6 @@ core::RunSettings loadRunSettings(const ros::NodeHandle& nh, ParamReader& own,
   return settings;
 }
 
-namespace {
-/// A number (int or double) from an XmlRpc value; false for any other type.
 bool xmlNumber(const XmlRpc::XmlRpcValue& v, double& out) {
   if (v.getType() == XmlRpc::XmlRpcValue::TypeDouble) {
     out = static_cast<const double&>(v);
@@ -49,7 +47,6 @@ bool xmlNumber(const XmlRpc::XmlRpcValue& v, double& out) {
   }
   return false;
 }
-}  // namespace
 
 std::string loadObstacles(ParamReader& p, const std::string& key, std::vector<core::Obstacle>& out) {
   out.clear();

@@ -7,20 +7,11 @@
 #include <cmath>
 #include <cstdio>
 
+#include "sowing_robot/ros/component_params.h"
+
 namespace sowing_robot {
 
 namespace {
-bool xmlNumber(const XmlRpc::XmlRpcValue& v, double& out) {
-  if (v.getType() == XmlRpc::XmlRpcValue::TypeDouble) {
-    out = static_cast<const double&>(v);
-    return true;
-  }
-  if (v.getType() == XmlRpc::XmlRpcValue::TypeInt) {
-    out = static_cast<const int&>(v);
-    return true;
-  }
-  return false;
-}
 
 std::string loadPolygon(XmlRpc::XmlRpcValue& list, const std::string& name, std::vector<Eigen::Vector2d>& out) {
   if (list.getType() != XmlRpc::XmlRpcValue::TypeArray) return name + " must be a list of [x, y] vertices";

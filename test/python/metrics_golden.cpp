@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "golden_file.h"
 #include "sowing_robot/core/metrics.h"
 #include "sowing_robot/core/types.h"
 
@@ -153,23 +154,4 @@ std::string golden() {
 
 }  // namespace
 
-TEST(MetricsGolden, FileMatchesTheCore) {
-  const std::string now = golden();
-  if (const char* w = std::getenv("SOWING_WRITE_GOLDEN"); w && std::string(w) == "1") {
-    std::ofstream(SOWING_GOLDEN_PATH) << now;
-    GTEST_SKIP() << "rewrote " << SOWING_GOLDEN_PATH;
-  }
-  std::ifstream f(SOWING_GOLDEN_PATH);
-  ASSERT_TRUE(f) << "cannot read " << SOWING_GOLDEN_PATH;
-  std::stringstream file;
-  file << f.rdbuf();
-  // Line by line, so that a failure names the first differing record.
-  std::istringstream a(now), b(file.str());
-  std::string la, lb;
-  for (int line = 1; std::getline(a, la); ++line) {
-    ASSERT_TRUE(static_cast<bool>(std::getline(b, lb))) << SOWING_GOLDEN_PATH << " ends at line " << line;
-    ASSERT_EQ(la, lb) << SOWING_GOLDEN_PATH << ":" << line
-                      << ": the core's metrics changed; if deliberately, rewrite it (SOWING_WRITE_GOLDEN=1)";
-  }
-  EXPECT_FALSE(static_cast<bool>(std::getline(b, lb))) << SOWING_GOLDEN_PATH << " has extra lines";
-}
+TEST(MetricsGolden, FileMatchesTheCore) { expectGoldenFile(golden(), SOWING_GOLDEN_PATH, "metrics"); }

@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "golden_file.h"
 #include "sowing_robot/core/reference.h"
 #include "sowing_robot/core/runner.h"
 #include "sowing_robot/core/tuning.h"
@@ -65,19 +66,19 @@ std::string golden() {
       {"rpp_atsmc", "rpp+atsmc", {}},
       // On the thesis line RPP's regulation with nav2's 0.9 m radius never acts (plain pure pursuit gives
       // the same run); a 3 m radius makes it act.
-      {"pure_pursuit_pid", "pure_pursuit+pid", {{"kinematic_controller", "pure_pursuit/lookahead_dist", 0.35}}},
+      {"pure_pursuit_pid", "pure_pursuit+pid", {{"kinematic_controller", "lookahead_dist", 0.35}}},
       {"rpp_pid_regulated",
        "rpp+pid",
-       {{"kinematic_controller", "pure_pursuit/lookahead_dist", 0.35},
-        {"kinematic_controller", "pure_pursuit/regulated_linear_scaling_min_radius", 3.0}}},
+       {{"kinematic_controller", "lookahead_dist", 0.35},
+        {"kinematic_controller", "regulated_linear_scaling_min_radius", 3.0}}},
       {"atsmc_eq_4_22", "kanayama+atsmc", {{"torque_controller", "adaptation", std::string("eq_4_22")}}},
       {"rpp_pid_gains",
        "rpp+pid",
-       {{"kinematic_controller", "pure_pursuit/lookahead_dist", 0.45},
-        {"kinematic_controller", "pure_pursuit/k_along", 2.0},
-        {"torque_controller", "pid/kp", 6.5},
-        {"torque_controller", "pid/kd", 0.05},
-        {"torque_controller", "pid/anti_windup", false}}},
+       {{"kinematic_controller", "lookahead_dist", 0.45},
+        {"kinematic_controller", "k_along", 2.0},
+        {"torque_controller", "kp", 6.5},
+        {"torque_controller", "kd", 0.05},
+        {"torque_controller", "anti_windup", false}}},
       {"atsmc_rates", "kanayama+atsmc", {{"torque_controller", "rate_m", 2.5}, {"kinematic_controller", "kx", 4.0}}},
   };
   std::ostringstream out;
@@ -131,22 +132,4 @@ std::string golden() {
 
 }  // namespace
 
-TEST(PairsGolden, FileMatchesTheCore) {
-  const std::string now = golden();
-  if (const char* w = std::getenv("SOWING_WRITE_GOLDEN"); w && std::string(w) == "1") {
-    std::ofstream(SOWING_GOLDEN_PATH) << now;
-    GTEST_SKIP() << "rewrote " << SOWING_GOLDEN_PATH;
-  }
-  std::ifstream f(SOWING_GOLDEN_PATH);
-  ASSERT_TRUE(f) << "cannot read " << SOWING_GOLDEN_PATH;
-  std::stringstream file;
-  file << f.rdbuf();
-  std::istringstream a(now), b(file.str());
-  std::string la, lb;
-  for (int line = 1; std::getline(a, la); ++line) {
-    ASSERT_TRUE(static_cast<bool>(std::getline(b, lb))) << SOWING_GOLDEN_PATH << " ends at line " << line;
-    ASSERT_EQ(la, lb) << SOWING_GOLDEN_PATH << ":" << line
-                      << ": the core's runs changed; if deliberately, rewrite it (SOWING_WRITE_GOLDEN=1)";
-  }
-  EXPECT_FALSE(static_cast<bool>(std::getline(b, lb))) << SOWING_GOLDEN_PATH << " has extra lines";
-}
+TEST(PairsGolden, FileMatchesTheCore) { expectGoldenFile(golden(), SOWING_GOLDEN_PATH, "runs"); }

@@ -126,8 +126,8 @@ def test_tuned_file_reproduces_its_cost(path):
 def test_params_and_gains_reach_the_controllers():
     base = core.run(controller="rpp+pid", duration=2.0)["metrics"]["y"]["ise"]
     nested = core.run(controller="rpp+pid", duration=2.0,
-                      params={"torque_controller": {"pid": {"kp": 6.0}}})["metrics"]["y"]["ise"]
-    flat = core.run(controller="rpp+pid", duration=2.0, params={"torque_controller/pid/kp": 6.0})["metrics"]["y"]["ise"]
+                      params={"torque_controller": {"kp": 6.0}})["metrics"]["y"]["ise"]
+    flat = core.run(controller="rpp+pid", duration=2.0, params={"torque_controller/kp": 6.0})["metrics"]["y"]["ise"]
     by_name = core.run(controller="rpp+pid", duration=2.0, gains={"kp": 6.0})["metrics"]["y"]["ise"]
     assert nested == flat == by_name != base
     variant = core.run(controller="kanayama+atsmc", duration=2.0, disturbance=True, mass_scale=1.5, inertia_scale=1.5,

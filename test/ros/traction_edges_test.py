@@ -46,7 +46,7 @@ class TractionEdges(unittest.TestCase):
                 with lock:
                     seen["saturated"] += 1
 
-        subs = [rospy.Subscriber("odom", Odometry, on_odom, queue_size=20000, tcp_nodelay=True),
+        subs = [rospy.Subscriber("ground_truth", Odometry, on_odom, queue_size=20000, tcp_nodelay=True),
                 rospy.Subscriber("wheel_slip", Float64MultiArray, on_slip, queue_size=1000),
                 rospy.Subscriber("torque_controller/state", TorqueControllerState, on_state, queue_size=20000)]
         self.assertTrue(done.wait(WALL_TIMEOUT), "the run did not reach t = %g s: %s" % (duration, seen))

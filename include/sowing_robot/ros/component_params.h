@@ -52,6 +52,9 @@ void logSettings(const char* node, const core::ParamTable<S>& table, const S& s,
 
 /// The list `key` of {x, y, radius} maps (radius optional, default core::Obstacle's); marks `key` as read.
 /// Returns "" or one line naming the bad entry (absent key: empty list).
+/// A number (int or double) from an XmlRpc value; false for any other type.
+bool xmlNumber(const XmlRpc::XmlRpcValue& v, double& out);
+
 std::string loadObstacles(ParamReader& p, const std::string& key, std::vector<core::Obstacle>& out);
 
 /// Everything one node needs checked: reader errors, unknown keys, then the given validate() text.
