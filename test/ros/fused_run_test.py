@@ -24,11 +24,6 @@ WALL_TIMEOUT = 500.0
 
 
 class FusedRun(unittest.TestCase):
-    # Known bug (README, known limitations): in the merged pipeline the closed-loop EKF estimate drifts
-    # ahead of the truth from the first second (0.2 m after 4 s on the line) and its fixes are gated out
-    # from ~2 s, although its inputs (odom, imu, fix) match the truth and the filter passes its own tests
-    # (test_ekf, state_estimator.test). Skipped until found, so that it does not block every landing.
-    @unittest.skip("known bug: the closed-loop fused estimate drifts (README, known limitations)")
     def test_fused_run(self):
         rospy.init_node("fused_run_test")
         duration = rospy.get_param("/run/duration")
