@@ -449,8 +449,8 @@ errors ex, ey, etheta). Raises ValueError for an invalid scenario.)doc");
         R"doc(core::runClosedLoop of any controller pair on the line (None: the thesis's row).
 
 controller: "outer+inner", outer kanayama|pure_pursuit|rpp, inner atsmc|tsmc|pid.
-params: controller parameters by node as in a gains YAML, {"kinematic_controller": {"kx": 2.0,
-"pure_pursuit": {"lookahead_dist": 0.5}}, "torque_controller": {"adaptation": "eq_4_22", "pid": {"kp": 3}}}
+params: controller parameters by node, in the nodes' keys, as in a gains YAML: {"kinematic_controller":
+{"kx": 2.0, "lookahead_dist": 0.5}, "torque_controller": {"adaptation": "eq_4_22", "kp": 3}}
 (yaml.safe_load of config/tuned/<pair>.yaml as it is), or flat {"torque_controller/k1": 400.0}.
 gains: {name: value} of the pair's tunable gains (tunable_gains()). Plant arguments as run_closed_loop's.
 Returns run_closed_loop's dict plus "controller". Raises ValueError for a bad name, key or value.)doc");
