@@ -51,7 +51,13 @@ std::string shortNumber(double v) {
 /// Lateral error in the reference's frame (cross-track for a line or a row).
 double crossTrack(const LoopSample& s) {
   const double th = s.reference->pose.theta;
-  return -std::sin(th) * s.ex + std::cos(th) * s.ey;
+  // sin(+-0) = +-0 and cos(+-0) = 1 exactly: a line or a row along x needs no sincos every period.
+  double sn = th, c = 1.0;
+  if (th != 0.0) {
+    sn = std::sin(th);
+    c = std::cos(th);
+  }
+  return -sn * s.ex + c * s.ey;
 }
 
 /// Per-run extras of a benchmark scenario: the body checked against obstacles, the cross-track series.
