@@ -121,7 +121,7 @@ bool Plant::step(double tau_right, double tau_left, double dt, double theta, dou
 }
 
 // cos0, sin0: cos and sin of state_[THETA].
-bool Plant::stepWithHeading(double tau_right, double tau_left, double dt, double cos0, double sin0) {
+inline bool Plant::stepWithHeading(double tau_right, double tau_left, double dt, double cos0, double sin0) {
   if (!allFinite(tau_right, tau_left, dt) || !(dt > 0.0)) return false;
   double noise_r = 0.0, noise_l = 0.0;
   if (disturbance_.noise_std > 0.0) {

@@ -123,8 +123,8 @@ void SlidingModeController::setParams(const SlidingModeParams& params) {
   }
 }
 
-void SlidingModeController::surface(Channel& c, double e, double xd_dot, double beta, double dt, double& s,
-                                    double& phi) const {
+inline void SlidingModeController::surface(Channel& c, double e, double xd_dot, double beta, double dt, double& s,
+                                           double& phi) const {
   c.integral += e * dt;
   // S = e + beta (int e)^(p/q)  (eq 4.7).  The derivative term uses (int e)^(p/q - 1): for 1 < p/q < 2
   // its exponent (p-q)/q lies in (0, 1), so it is finite and equals 0 at int e = 0 (no division, no

@@ -48,7 +48,7 @@ class TorqueNoise {
     // is the correctly rounded value that the standard conversion gives, without its branch.
     const double d = static_cast<double>(static_cast<std::int64_t>(u >> 32)) * 0x1p32 +
                      static_cast<double>(static_cast<std::int64_t>(u & 0xffffffffULL));
-    const double r = d * 0x1p-64;            // sum / 2^64: exact
+    const double r = d * 0x1p-64;                // sum / 2^64: exact
     return r >= 1.0 ? 0x1.fffffffffffffp-1 : r;  // nextafter(1, 0) when u rounds up to 2^64
   }
 
