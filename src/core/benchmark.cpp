@@ -51,7 +51,13 @@ std::string shortNumber(double v) {
 /// Lateral error in the reference's frame (cross-track for a line or a row).
 double crossTrack(const LoopSample& s) {
   const double th = s.reference->pose.theta;
-  return -std::sin(th) * s.ex + std::cos(th) * s.ey;
+  // sin(+-0) = +-0 and cos(+-0) = 1 exactly: a line or a row along x needs no sincos every period.
+  double sn = th, c = 1.0;
+  if (th != 0.0) {
+    sn = std::sin(th);
+    c = std::cos(th);
+  }
+  return -sn * s.ex + c * s.ey;
 }
 
 /// Per-run extras of a benchmark scenario: the body checked against obstacles, the cross-track series.
@@ -66,7 +72,7 @@ RunRow measure(const Scenario& sc, ReferenceSource& reference, const MonteCarloS
   RunRow row;
   row.draw = draw;
   const double dt = secondsFromNanos(sc.control_period_ns);
-  std::int64_t count = 0;
+  std::int64_t count = 0, until_series = 0;  // periods to the next cross-track sample (no % per period)
   WheelTorques prev, prev2;
   double worst = 0.0, last = 0.0;
   if (extras.series_every > 0)
@@ -77,7 +83,13 @@ RunRow measure(const Scenario& sc, ReferenceSource& reference, const MonteCarloS
     if (count >= 1) row.effort += dt * (prev.right * prev.right + prev.left * prev.left);
     if (count >= 2) row.chattering += std::fabs(prev.right - prev2.right) + std::fabs(prev.left - prev2.left);
     const double e = crossTrack(s);
-    if (extras.series_every > 0 && count % extras.series_every == 0) row.cross_track_series.push_back(e);
+    if (extras.series_every > 0) {  // at count = 0, series_every, 2 series_every, ...
+      if (until_series == 0) {
+        row.cross_track_series.push_back(e);
+        until_series = extras.series_every;
+      }
+      --until_series;
+    }
     if (extras.contacts) extras.contacts->update(s.t, {(*s.state)[X], (*s.state)[Y], (*s.state)[THETA]});
     if (extras.last_reference) *extras.last_reference = s.reference->pose;
     prev2 = prev;

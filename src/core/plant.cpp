@@ -40,7 +40,7 @@ Plant::Plant(const RobotParams& nominal, const PlantDisturbance& disturbance)
       m0_(nominal.m0() * disturbance.mass_scale),
       i0_(nominal.I0() * disturbance.inertia_scale),
       mcd_(nominal.mc * nominal.d * disturbance.mass_scale),
-      rng_(disturbance.seed) {
+      noise_(disturbance.seed) {
   const std::string error = firstError({nominal.validate(), disturbance.validate()});
   if (!error.empty()) throw std::invalid_argument(error);
 }
@@ -49,8 +49,7 @@ void Plant::reset(const State& initial, double t) {
   if (!initial.allFinite() || !std::isfinite(t)) throw std::invalid_argument("plant reset: non-finite state or time");
   state_ = initial;
   time_ = t;
-  rng_.seed(disturbance_.seed);
-  noise_.reset();
+  noise_.seed(disturbance_.seed);
   cached_disturbance_time_ = std::numeric_limits<double>::quiet_NaN();
 }
 
@@ -122,12 +121,12 @@ bool Plant::step(double tau_right, double tau_left, double dt, double theta, dou
 }
 
 // cos0, sin0: cos and sin of state_[THETA].
-bool Plant::stepWithHeading(double tau_right, double tau_left, double dt, double cos0, double sin0) {
+inline bool Plant::stepWithHeading(double tau_right, double tau_left, double dt, double cos0, double sin0) {
   if (!allFinite(tau_right, tau_left, dt) || !(dt > 0.0)) return false;
   double noise_r = 0.0, noise_l = 0.0;
   if (disturbance_.noise_std > 0.0) {
-    noise_r = disturbance_.noise_std * noise_(rng_);
-    noise_l = disturbance_.noise_std * noise_(rng_);
+    noise_r = disturbance_.noise_std * noise_.next();
+    noise_l = disturbance_.noise_std * noise_.next();
   }
   // The sinusoid is evaluated at each RK4 stage time; command and noise are held over the step.
   // Stages 2 and 3 share t + h/2, and stage 4's t + h is the next step's stage 1.

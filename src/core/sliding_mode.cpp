@@ -123,8 +123,8 @@ void SlidingModeController::setParams(const SlidingModeParams& params) {
   }
 }
 
-void SlidingModeController::surface(Channel& c, double e, double xd_dot, double beta, double dt, double& s,
-                                    double& phi) const {
+inline void SlidingModeController::surface(Channel& c, double e, double xd_dot, double beta, double dt, double& s,
+                                           double& phi) const {
   c.integral += e * dt;
   // S = e + beta (int e)^(p/q)  (eq 4.7).  The derivative term uses (int e)^(p/q - 1): for 1 < p/q < 2
   // its exponent (p-q)/q lies in (0, 1), so it is finite and equals 0 at int e = 0 (no division, no
@@ -132,8 +132,15 @@ void SlidingModeController::surface(Channel& c, double e, double xd_dot, double 
   double power_p, power_p_minus_q;  // (int e)^(p/q) and (int e)^((p-q)/q)
   if (params_.q == 3) {             // one cube root serves both powers (same values as realPower)
     const double root = std::cbrt(std::fabs(c.integral));
-    power_p = powerOfRoot(root, params_.p, c.integral < 0.0);
-    power_p_minus_q = powerOfRoot(root, params_.p - params_.q, c.integral < 0.0);
+    // powerOfRoot's products, shared: root^p is root^(p-q) times root, q more times, in that order.
+    const int p_minus_q = params_.p - params_.q;
+    double mag = 1.0;
+    for (int i = 0; i < p_minus_q; ++i) mag *= root;
+    const double mag_p_minus_q = mag;
+    mag = mag * root * root * root;
+    const bool negative = c.integral < 0.0;
+    power_p = (params_.p % 2 == 0 || !negative) ? mag : -mag;
+    power_p_minus_q = (p_minus_q % 2 == 0 || !negative) ? mag_p_minus_q : -mag_p_minus_q;
   } else {
     power_p = realPower(c.integral, params_.p, params_.q);
     power_p_minus_q = realPower(c.integral, params_.p - params_.q, params_.q);

@@ -99,7 +99,10 @@ class MetricsAccumulator {
   bool keep_;
   std::size_t count_ = 0, rejected_ = 0;
   double last_t_ = 0.0;
-  std::array<double, AXIS_COUNT> last_e_{};
+  struct Terms {
+    double sq, t_sq, abs, t_abs;  // e^2, t e^2, |e|, t |e| of one sample
+  };
+  std::array<Terms, AXIS_COUNT> last_terms_{};  // of the last sample
   std::array<AxisMetrics, AXIS_COUNT> acc_{};
   std::array<StreamingTimeDomain, AXIS_COUNT> time_domain_{};
 };

@@ -5,11 +5,11 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <limits>
-#include <random>
 #include <string>
 
 #include "sowing_robot/core/param_table.h"
 #include "sowing_robot/core/robot_params.h"
+#include "sowing_robot/core/torque_noise.h"
 
 namespace sowing_robot {
 namespace core {
@@ -81,8 +81,7 @@ class Plant {
   double m0_, i0_, mcd_;  // true effective inertias and the coupling mc·d
   State state_ = State::Zero();
   double time_ = 0.0;
-  std::mt19937_64 rng_;
-  std::normal_distribution<double> noise_{0.0, 1.0};
+  TorqueNoise noise_;  // std::normal_distribution<double> over std::mt19937_64, to the bit
   // Last disturbance evaluated (NaN time: none yet). Never compares equal to NaN, so reset() clears it.
   double cached_disturbance_time_ = std::numeric_limits<double>::quiet_NaN();
   double cached_disturbance_right_ = 0.0, cached_disturbance_left_ = 0.0;
