@@ -15,6 +15,7 @@
 #include <map>
 
 #include "sowing_robot/core/estimated_run.h"
+#include "sowing_robot/core/validation.h"
 #include "sowing_robot/ros/component_params.h"
 #include "sowing_robot/ros/msg_checks.h"
 #include "sowing_robot/ros/param_reader.h"
