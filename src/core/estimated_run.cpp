@@ -96,6 +96,8 @@ EstimatedRunResult loop(const Scenario& sc, const EstimatedRunConfig& cfg, P& pl
   // What the messages carry: the gyro's variance (sensor_msgs/Imu), the fix's (PoseWithCovarianceStamped).
   const double rate_variance = cfg.sensors.imu.noise > 0.0 ? cfg.sensors.imu.noise * cfg.sensors.imu.noise : 0.0;
   const double fix_variance = cfg.sensors.fix.sigma * cfg.sensors.fix.sigma;
+  // state_estimator's increment_covariance_: the encoders' quantisation per step, with the nominal half track.
+  const Eigen::Matrix2d increment_covariance = encoderIncrementCovariance(cfg.estimator.increment_sigma, sc.robot.L);
 
   const bool fused = cfg.feedback == Feedback::fused;
   std::unique_ptr<Ekf> ekf;
@@ -151,6 +153,7 @@ EstimatedRunResult loop(const Scenario& sc, const EstimatedRunConfig& cfg, P& pl
         in.dtheta = wrapAngle(odom_pose.theta - last_odom.theta);
         const double mid = last_odom.theta + 0.5 * in.dtheta;
         in.distance = (odom_pose.x - last_odom.x) * std::cos(mid) + (odom_pose.y - last_odom.y) * std::sin(mid);
+        in.covariance = increment_covariance;
         in.has_rate = true;
         in.rate = yaw_rate;
         in.rate_variance = rate_variance;
