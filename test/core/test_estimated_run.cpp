@@ -78,9 +78,10 @@ TEST(EstimatedRun, FedTheTruthOnTheTractionPlantItIsRunTractionClosedLoopBitForB
   t.mu_peak = 0.35;
   t.mu_slide = 0.26;
   SoilPatch wet;
-  wet.polygon = {{1.0, -5.0}, {3.0, -5.0}, {3.0, 10.0}, {1.0, 10.0}};
+  wet.polygon = {{-5.0, -5.0}, {0.0, -5.0}, {0.0, 10.0}, {-5.0, 10.0}};  // round the start (x = -1)
   wet.mu_peak = 0.2;
   wet.mu_slide = 0.15;
+  wet.rolling_resistance = 0.15;  // soft: the patch changes the run (within the curve's linear part grip alone would not)
   LineReference ref;
   const TractionRunResult today = runTractionClosedLoop(sc, t, ref, true, {}, [&](TractionPlant& p) {
     p.setSoil(SoilMap({wet}));
@@ -92,6 +93,10 @@ TEST(EstimatedRun, FedTheTruthOnTheTractionPlantItIsRunTractionClosedLoopBitForB
   expectSameRun(est.run, today.run);
   EXPECT_TRUE(sameBits(est.max_abs_slip, today.max_abs_slip));
   EXPECT_GT(est.max_abs_slip, 0.0);
+  // The patch is on the ground (without it the run differs).
+  EstimatedRunConfig bare = cfg;
+  bare.patches.clear();
+  EXPECT_FALSE(sameBits(runEstimatedLoop(sc, bare, ref, true).run.metrics[AXIS_X].ise, today.run.metrics[AXIS_X].ise));
 }
 
 TEST(EstimatedRun, FedTheEkfOnTheLineItsErrorStaysBounded) {
@@ -253,6 +258,14 @@ TEST(EstimatedBench, TheSensorSeedIsANewDrawThatLeavesTheOthersAlone) {
   const std::vector<RunRow> one = runBenchmark(f, 3, 1), two = runBenchmark(f, 3, 2);
   expectSameRows(one, two);
   EXPECT_EQ(estimatedBenchRow(f, 2).fed_error_rms, one[2].fed_error_rms);
+  // Run 2's sensors are seeded by its draw 8: the same run alone with that seed, not with the table's seed 1.
+  const RunDraw d2 = drawRun(f.spec, f.base, 2);
+  EstimatedRunConfig alone = cfg;
+  alone.sensors.seed = d2.sensor_seed;
+  LineReference ref(f.line_v_r, f.line_y, f.line_x0);
+  EXPECT_EQ(runEstimatedLoop(applyDraw(f.base, f.spec, d2), alone, ref, false).fed_error_rms, one[2].fed_error_rms);
+  alone.sensors.seed = 1;
+  EXPECT_NE(runEstimatedLoop(applyDraw(f.base, f.spec, d2), alone, ref, false).fed_error_rms, one[2].fed_error_rms);
   EXPECT_GT(one[0].fed_error_rms, 0.0);
   EXPECT_NE(runsCsvLines("s", "c", one, true).find("," + std::to_string(d0.sensor_seed) + ","), std::string::npos);
 }
