@@ -207,7 +207,8 @@ void loadPatches(const YAML::Node& plant_sim, const std::string& path, std::vect
   onlyKeys(field, {"patches"}, path, "plant_sim/field/");
   const YAML::Node list = field["patches"];
   if (!list) return;
-  if (!list.IsSequence()) fail(path, "plant_sim/field/patches must be a list of {polygon, mu_peak, mu_slide, rolling_resistance}");
+  if (!list.IsSequence())
+    fail(path, "plant_sim/field/patches must be a list of {polygon, mu_peak, mu_slide, rolling_resistance}");
   for (std::size_t i = 0; i < list.size(); ++i) {
     const std::string name = "field/patches[" + std::to_string(i) + "]";
     const YAML::Node item = list[i];
@@ -413,7 +414,8 @@ core::BenchScenario loadScenarioFileImpl(const std::string& path) {
     }
     if (sensors) {
       if (!sensors.IsMap()) fail(path, "sensors must be a mapping");
-      if (sensors["seed"]) fail(path, "sensors/seed is drawn per run (draw 8 of the run's counter-based draws); leave it out");
+      if (sensors["seed"])
+        fail(path, "sensors/seed is drawn per run (draw 8 of the run's counter-based draws); leave it out");
       applyTableBlock(core::sensorsTable(), sensors, cfg.sensors, path, "sensors");
     }
     if (estimator) applyTableBlock(core::ekfTable(), estimator, cfg.estimator, path, "estimator");

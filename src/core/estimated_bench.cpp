@@ -216,8 +216,8 @@ std::string describeRealism(const BenchScenario& b) {
   } else {
     out += "no slip";
   }
-  out += "; feedback " + std::string(feedbackName(c.feedback)) + " (sensors: " +
-         std::to_string(c.sensors.encoder.ticks_per_turn) + " ticks/turn, gyro noise " +
+  out += "; feedback " + std::string(feedbackName(c.feedback)) +
+         " (sensors: " + std::to_string(c.sensors.encoder.ticks_per_turn) + " ticks/turn, gyro noise " +
          shortNumber(c.sensors.imu.noise) + " rad/s bias " + shortNumber(c.sensors.imu.bias) + " rad/s, fix " +
          shortNumber(c.sensors.fix.rate) + " Hz sigma " + shortNumber(c.sensors.fix.sigma) + " m latency " +
          shortNumber(c.sensors.fix.latency) + " s; their seed drawn per run)";

@@ -39,12 +39,14 @@ bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
 void expectSameRun(const RunResult& a, const RunResult& b) {
   for (int ax = 0; ax < AXIS_COUNT; ++ax) {
-    EXPECT_TRUE(sameBits(a.metrics[ax].ise, b.metrics[ax].ise)) << ax << ": " << a.metrics[ax].ise << " vs " << b.metrics[ax].ise;
+    EXPECT_TRUE(sameBits(a.metrics[ax].ise, b.metrics[ax].ise))
+        << ax << ": " << a.metrics[ax].ise << " vs " << b.metrics[ax].ise;
     EXPECT_TRUE(sameBits(a.metrics[ax].itae, b.metrics[ax].itae)) << ax;
     EXPECT_TRUE(sameBits(a.metrics[ax].iae, b.metrics[ax].iae)) << ax;
   }
   for (int i = 0; i < a.final_state.size(); ++i)
-    EXPECT_TRUE(sameBits(a.final_state[i], b.final_state[i])) << i << ": " << a.final_state[i] << " vs " << b.final_state[i];
+    EXPECT_TRUE(sameBits(a.final_state[i], b.final_state[i]))
+        << i << ": " << a.final_state[i] << " vs " << b.final_state[i];
   EXPECT_EQ(a.saturated_steps, b.saturated_steps);
   EXPECT_EQ(a.periods, b.periods);
   EXPECT_EQ(a.diverged, b.diverged);
@@ -81,11 +83,11 @@ TEST(EstimatedRun, FedTheTruthOnTheTractionPlantItIsRunTractionClosedLoopBitForB
   wet.polygon = {{-5.0, -5.0}, {0.0, -5.0}, {0.0, 10.0}, {-5.0, 10.0}};  // round the start (x = -1)
   wet.mu_peak = 0.2;
   wet.mu_slide = 0.15;
-  wet.rolling_resistance = 0.15;  // soft: the patch changes the run (within the curve's linear part grip alone would not)
+  wet.rolling_resistance =
+      0.15;  // soft: the patch changes the run (within the curve's linear part grip alone would not)
   LineReference ref;
-  const TractionRunResult today = runTractionClosedLoop(sc, t, ref, true, {}, [&](TractionPlant& p) {
-    p.setSoil(SoilMap({wet}));
-  });
+  const TractionRunResult today =
+      runTractionClosedLoop(sc, t, ref, true, {}, [&](TractionPlant& p) { p.setSoil(SoilMap({wet})); });
   EstimatedRunConfig cfg;
   cfg.traction = t;
   cfg.patches = {wet};

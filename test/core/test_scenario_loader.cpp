@@ -62,9 +62,8 @@ std::string loadError(const std::string& path) {
 
 TEST(ScenarioLoader, EverySuiteFileLoads) {
   const auto names = bench::scenarioNames(kSuite);
-  for (const char* expected :
-       {"thesis_line", "thesis_field", "three_row_field", "sine_rows", "heavy_robot", "disturbance_sweep", "wet_soil",
-        "estimated_pose"})
+  for (const char* expected : {"thesis_line", "thesis_field", "three_row_field", "sine_rows", "heavy_robot",
+                               "disturbance_sweep", "wet_soil", "estimated_pose"})
     EXPECT_NE(std::find(names.begin(), names.end(), expected), names.end()) << expected;
   for (const auto& n : names) {
     SCOPED_TRACE(n);
@@ -148,7 +147,7 @@ TEST(ScenarioLoader, TheNewScenariosCarryTheirPlantSensorsAndFeedback) {
   ASSERT_TRUE(wet.realism->traction.has_value());
   EXPECT_EQ(wet.realism->traction->draft_force, 10.0);
   EXPECT_EQ(wet.realism->traction->mu_peak, 0.6);  // config/traction.yaml's default
-  ASSERT_EQ(wet.realism->patches.size(), 1u);     // config/field_thesis_wet.yaml's patch
+  ASSERT_EQ(wet.realism->patches.size(), 1u);      // config/field_thesis_wet.yaml's patch
   EXPECT_EQ(wet.realism->patches[0].mu_peak, 0.2);
   EXPECT_EQ(wet.realism->patches[0].mu_slide, 0.15);
   EXPECT_EQ(wet.realism->patches[0].rolling_resistance, 0.08);

@@ -45,8 +45,8 @@ TEST(FusedLockstep, NodePipelineEqualsTheInProcessEstimatedLoop) {
   loadTable(plant, core::sensorsTable(), cfg.sensors);
   loadTable(estimator, core::ekfTable(), cfg.estimator);
   ASSERT_EQ(core::firstError({plant.error(), estimator.error(), cfg.validate()}), "");
-  std::printf("fused lockstep: pair %s, %g s, sensors seed %llu, bias state %s\n", sc.controllerName().c_str(), duration,
-              static_cast<unsigned long long>(cfg.sensors.seed), cfg.estimator.estimate_bias ? "on" : "off");
+  std::printf("fused lockstep: pair %s, %g s, sensors seed %llu, bias state %s\n", sc.controllerName().c_str(),
+              duration, static_cast<unsigned long long>(cfg.sensors.seed), cfg.estimator.estimate_bias ? "on" : "off");
 
   Recorded rec;
   const auto hints = ros::TransportHints().tcpNoDelay();
@@ -76,8 +76,8 @@ TEST(FusedLockstep, NodePipelineEqualsTheInProcessEstimatedLoop) {
     const core::State& x = *s.loop->state;
     const double dt = std::max({std::fabs(t->second.x - x[core::X]), std::fabs(t->second.y - x[core::Y]),
                                 std::fabs(t->second.theta - core::yawThroughQuaternion(x[core::THETA]))});
-    const double de = std::max({std::fabs(e->second.x - s.fed.x), std::fabs(e->second.y - s.fed.y),
-                                std::fabs(e->second.theta - s.fed.theta)});
+    const double de = std::max(
+        {std::fabs(e->second.x - s.fed.x), std::fabs(e->second.y - s.fed.y), std::fabs(e->second.theta - s.fed.theta)});
     truth_diff = std::max(truth_diff, dt);
     estimate_diff = std::max(estimate_diff, de);
     fed_max = std::max(fed_max, std::hypot(s.fed.x - x[core::X], s.fed.y - x[core::Y]));

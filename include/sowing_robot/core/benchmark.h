@@ -88,7 +88,7 @@ struct RunRow {
   double fed_error_rms = std::numeric_limits<double>::quiet_NaN();
   double fed_error_max = std::numeric_limits<double>::quiet_NaN();
   double odometry_error_max = std::numeric_limits<double>::quiet_NaN();  ///< the encoders' dead reckoning [m]
-  long fixes_applied = 0, fixes_refused = 0;                              ///< feedback fused
+  long fixes_applied = 0, fixes_refused = 0;                             ///< feedback fused
 };
 
 /// Runs base (its controller pair, plant, timing) on `reference` for seeds 0..runs-1 with `threads`

@@ -71,23 +71,23 @@ struct EstimatedRunConfig {
 /// what the controllers were fed.
 struct EstimatedSample {
   const LoopSample* loop;
-  Pose2D fed;                 ///< the pose the controllers got (truth, odometry or estimate), yaw through the quaternion
-  double fed_v, fed_omega;    ///< the twist they got
+  Pose2D fed;               ///< the pose the controllers got (truth, odometry or estimate), yaw through the quaternion
+  double fed_v, fed_omega;  ///< the twist they got
   double slip_right = 0.0, slip_left = 0.0;  ///< traction: the wheels' slip ratios at this state
-  bool tool_down = false;     ///< traction with a draft: the tool is down over the next step
+  bool tool_down = false;                    ///< traction with a draft: the tool is down over the next step
 };
 
 struct EstimatedRunResult {
-  RunResult run;                 ///< metrics on the truth
-  double max_abs_slip = 0.0;     ///< traction: largest |slip ratio| of either wheel after a step
-  double tool_down_time = 0.0;   ///< traction with a draft: time the tool was down [s]
+  RunResult run;                ///< metrics on the truth
+  double max_abs_slip = 0.0;    ///< traction: largest |slip ratio| of either wheel after a step
+  double tool_down_time = 0.0;  ///< traction with a draft: time the tool was down [s]
   /// Position error of the fed pose against the truth over the periods run [m] (0 for ground_truth).
   double fed_error_rms = 0.0, fed_error_max = 0.0;
   /// Heading error of the fed pose [rad], largest |.| over the run.
   double fed_heading_error_max = 0.0;
   /// Position error of the encoder odometry alone [m] at the end and its largest (any feedback).
   double odometry_error_final = 0.0, odometry_error_max = 0.0;
-  FixCounts fixes;              ///< fused: what happened to the fixes
+  FixCounts fixes;  ///< fused: what happened to the fixes
   long fixes_lost_from_queue = 0;
 };
 
