@@ -45,6 +45,9 @@ const ParamTable<EkfParams>& ekfTable() {
       number("estimator/fix/gate", &P::gate, 25.0, Limits::closed(0.0, 1e12), "",
              "squared Mahalanobis distance of a fix's innovation above which it is refused (chi-square, 2 dof: "
              "13.8 = 0.1 %); 0: no gate"),
+      integer("estimator/fix/reanchor_after", &P::reanchor_after, 5, Limits::closed(0.0, 1000000.0), "",
+              "gated fixes in a row after which the next gated fix is taken as the position (x, y and their "
+              "covariance from it; heading and bias kept): the way back after wheel slip; 0: never"),
       number("estimator/fix/delay", &P::fix_delay, 0.15, Limits::closed(0.0, 100.0), "s",
              "a fix is applied once the estimate is this much newer than its stamp, so runs are repeatable; >= "
              "the fix's latency plus two control periods, and within history/length"),
@@ -59,6 +62,7 @@ std::string EkfParams::validate() const { return ekfTable().checkRanges(*this); 
 const char* fixOutcomeName(FixOutcome o) {
   switch (o) {
     case FixOutcome::APPLIED: return "applied";
+    case FixOutcome::REANCHORED: return "re-anchored";
     case FixOutcome::REFUSED_INVALID: return "invalid";
     case FixOutcome::REFUSED_TOO_OLD: return "older than the history";
     case FixOutcome::REFUSED_FUTURE: return "newer than the estimate";
@@ -174,6 +178,13 @@ double Ekf::update(const EkfFix& fix, Vector& mean, Matrix& cov, bool apply) {
   return d2;
 }
 
+void Ekf::reanchor(const EkfFix& fix, Vector& mean, Matrix& cov) {
+  mean.head<2>() = fix.xy;
+  cov.topRows<2>().setZero();
+  cov.leftCols<2>().setZero();
+  cov.topLeftCorner<2, 2>() = fix.covariance;
+}
+
 bool Ekf::predict(double t, const EkfStepInput& in) {
   if (history_.empty() || !std::isfinite(t) || !(t > time())) return false;
   if (!allFinite(in.distance, in.dtheta, in.rate, in.rate_variance) || !finiteMatrix(in.covariance)) return false;
@@ -201,11 +212,21 @@ FixOutcome Ekf::fuse(const EkfFix& fix) {
   std::size_t k = history_.size() - 1;
   while (k > 0 && history_[k].t > fix.stamp + kStampTolerance) --k;
   Entry& at = history_[k];
-  if (params_.gate > 0.0 && update(fix, at.mean, at.cov, false) > params_.gate)
-    return refuse(counts_.gated, FixOutcome::REFUSED_GATE);
-  update(fix, at.mean, at.cov);
+  bool anchor = false;
+  if (params_.gate > 0.0 && update(fix, at.mean, at.cov, false) > params_.gate) {
+    if (params_.reanchor_after <= 0 || gated_in_a_row_ < params_.reanchor_after) {
+      ++gated_in_a_row_;
+      return refuse(counts_.gated, FixOutcome::REFUSED_GATE);
+    }
+    anchor = true;
+  }
+  gated_in_a_row_ = 0;
+  if (anchor)
+    reanchor(fix, at.mean, at.cov);
+  else
+    update(fix, at.mean, at.cov);
   pinBias(at.mean, at.cov);
-  at.fixes.push_back(fix);
+  at.fixes.push_back({fix, anchor});
   // Propagate again from there, with the kept inputs and the fixes already applied later on (in the
   // order a filter applying each at its stamp would have met them; accepted then, not gated again).
   for (std::size_t i = k + 1; i < history_.size(); ++i) {
@@ -214,11 +235,18 @@ FixOutcome Ekf::fuse(const EkfFix& fix) {
     e.cov = history_[i - 1].cov;
     propagate(params_, e.t - history_[i - 1].t, e.input, e.mean, e.cov);
     pinBias(e.mean, e.cov);
-    for (const EkfFix& f : e.fixes) update(f, e.mean, e.cov);
+    for (const Entry::Applied& f : e.fixes) {
+      if (f.reanchor)
+        reanchor(f.fix, e.mean, e.cov);
+      else
+        update(f.fix, e.mean, e.cov);
+    }
     pinBias(e.mean, e.cov);
   }
   ++counts_.applied;
-  return FixOutcome::APPLIED;
+  if (!anchor) return FixOutcome::APPLIED;
+  ++counts_.reanchored;
+  return FixOutcome::REANCHORED;
 }
 
 Eigen::Matrix2d wheelTravelCovariance(double d_right, double d_left, double half_track, double variance_per_metre) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 
 #include "sowing_robot/core/rotation.h"
@@ -162,6 +163,19 @@ double TractionPlant::kineticEnergy() const {
 }
 
 bool TractionPlant::step(double tau_right, double tau_left, double dt) {
+  return stepWithHeading(tau_right, tau_left, dt, std::cos(state_[THETA]), std::sin(state_[THETA]));
+}
+
+bool TractionPlant::step(double tau_right, double tau_left, double dt, double theta, double cos_theta,
+                         double sin_theta) {
+  // Bit pattern, not ==: -0.0 == 0.0, but their sines differ in sign.
+  if (std::memcmp(&theta, &state_[THETA], sizeof theta) == 0)
+    return stepWithHeading(tau_right, tau_left, dt, cos_theta, sin_theta);
+  return step(tau_right, tau_left, dt);
+}
+
+// cos_th, sin_th: cos and sin of state_[THETA].
+bool TractionPlant::stepWithHeading(double tau_right, double tau_left, double dt, double cos_th, double sin_th) {
   if (!allFinite(tau_right, tau_left, dt) || !(dt > 0.0)) return false;
   double noise_r = 0.0, noise_l = 0.0;
   if (disturbance_.noise_std > 0.0) {
@@ -170,7 +184,6 @@ bool TractionPlant::step(double tau_right, double tau_left, double dt) {
   }
   const int n = traction_.substeps;
   const double h = dt / n;
-  double cos_th = std::cos(state_[THETA]), sin_th = std::sin(state_[THETA]);
   // The sinusoid at each sub-step's midpoint (second order in the impulse), turned from one sincos.
   double dist_s = 0.0, dist_c = 0.0;
   const double dist_step = disturbance_.frequency * h;

@@ -54,8 +54,9 @@ StateEstimator::~StateEstimator() {
   const core::FixCounts& c = ekf_.counts();
   ROS_INFO(
       "state_estimator: fixes applied %ld, refused %ld (older than the history %ld, newer than the estimate "
-      "%ld, invalid %ld, gated %ld), applied late %ld, lost from a full queue %ld; inputs rejected %ld",
-      c.applied, c.refused(), c.too_old, c.future, c.invalid, c.gated, late_fixes_, fixes_.dropped(), rejected_inputs_);
+      "%ld, invalid %ld, gated %ld), re-anchored %ld, applied late %ld, lost from a full queue %ld; inputs rejected %ld",
+      c.applied, c.refused(), c.too_old, c.future, c.invalid, c.gated, c.reanchored, late_fixes_, fixes_.dropped(),
+      rejected_inputs_);
 }
 
 void StateEstimator::odomCallback(const nav_msgs::Odometry::ConstPtr& msg) {
@@ -125,11 +126,12 @@ void StateEstimator::step() {
   }
   for (const core::EkfFix& f : fixes_.due(ekf_.time())) ekf_.fuse(f);
   const core::FixCounts& c = ekf_.counts();
-  if (c.refused() != reported_.refused()) {
+  if (c.refused() != reported_.refused() || c.reanchored != reported_.reanchored) {
     ROS_WARN_THROTTLE(1.0,
                       "state_estimator: fixes refused so far: %ld older than the history, %ld newer than the "
-                      "estimate, %ld invalid, %ld outside the gate (%ld applied)",
-                      c.too_old, c.future, c.invalid, c.gated, c.applied);
+                      "estimate, %ld invalid, %ld outside the gate (%ld applied, %ld of them re-anchoring the "
+                      "position after estimator/fix/reanchor_after gated in a row)",
+                      c.too_old, c.future, c.invalid, c.gated, c.applied, c.reanchored);
     reported_ = c;
   }
   last_odom_ = odom;

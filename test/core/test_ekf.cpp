@@ -605,3 +605,96 @@ TEST(EkfInputs, EncoderIncrementCovarianceIsThatOfTheTwoWheels) {
   EXPECT_GT(c(1, 1), 0.0);
   EXPECT_EQ(encoderIncrementCovariance(0.0, L), Eigen::Matrix2d::Zero());
 }
+
+namespace {
+
+/// A filter whose encoders count 50 % more distance than the robot travels (spinning wheels) for 10 s,
+/// with a fix of the truth every 0.1 s (applied 0.1 s late, as the node does): the largest position
+/// error over the last 5 s, and the counts.
+struct SlipRun {
+  double late_error = 0.0;
+  FixCounts counts;
+};
+
+SlipRun runThroughSlip(int reanchor_after) {
+  EkfParams p;
+  p.reanchor_after = reanchor_after;
+  Ekf ekf(p);
+  const double dt = 1e-3, v = 1.0;
+  ekf.reset(0.0, Pose2D{0.0, 0.0, 0.0});
+  std::deque<EkfFix> pending;
+  SlipRun out;
+  for (int i = 1; i <= 10000; ++i) {
+    const double t = i * dt, x = v * t;
+    EkfStepInput in;
+    in.distance = 1.5 * v * dt;  // the encoders' distance under slip
+    in.covariance = encoderIncrementCovariance(p.increment_sigma, 0.24);
+    in.has_rate = true;
+    in.rate = 0.0;
+    in.rate_variance = 1e-4;
+    EXPECT_TRUE(ekf.predict(t, in));
+    if (i % 100 == 0) {
+      EkfFix f;
+      f.stamp = t;
+      f.xy << x, 0.0;
+      f.covariance = 0.02 * 0.02 * Eigen::Matrix2d::Identity();
+      pending.push_back(f);
+    }
+    while (!pending.empty() && pending.front().stamp + 0.1 <= t + 1e-9) {
+      ekf.fuse(pending.front());
+      pending.pop_front();
+    }
+    if (t >= 5.0) out.late_error = std::max(out.late_error, std::hypot(ekf.mean()(Ekf::X) - x, ekf.mean()(Ekf::Y)));
+  }
+  out.counts = ekf.counts();
+  return out;
+}
+
+}  // namespace
+
+// Slip makes the estimate outrun its covariance; the gate then refuses every fix of the truth for ever,
+// unless the filter re-anchors after fix/reanchor_after gated fixes in a row.
+TEST(EkfReanchor, AfterGatedFixesInARowTheFixBecomesThePosition) {
+  const SlipRun never = runThroughSlip(0), after5 = runThroughSlip(5);
+  std::printf("through 10 s of 50 %% slip: without re-anchoring %ld of %ld fixes gated, error %.2f m late on; "
+              "re-anchoring after 5: %ld re-anchored, %ld gated, error %.3f m\n",
+              never.counts.gated, never.counts.gated + never.counts.applied, never.late_error,
+              after5.counts.reanchored, after5.counts.gated, after5.late_error);
+  EXPECT_EQ(never.counts.reanchored, 0);
+  EXPECT_GT(never.late_error, 1.0);   // lost
+  EXPECT_GT(after5.counts.reanchored, 0);
+  // At most ~(5 gated + 1) fix intervals + the 0.1 s delay of 0.5 m/s drift: 0.35 m, plus the drift that
+  // the fixes applied after an anchor only partly correct.
+  EXPECT_LT(after5.late_error, 0.5);
+  EXPECT_LE(after5.counts.gated, 5 * (after5.counts.reanchored + 1));
+}
+
+// A fix stamped before a re-anchoring one but arriving after it makes the filter propagate its history
+// again: the re-anchoring is replayed as a re-anchoring (not as an ordinary update), so it still holds.
+TEST(EkfReanchor, ReplayedAsAReanchorWhenAnEarlierStampedFixComesLate) {
+  EkfParams p;
+  p.reanchor_after = 1;
+  p.gate = 25.0;
+  Ekf ekf(p);
+  ekf.reset(0.0, Pose2D{0.0, 0.0, 0.0});
+  EkfStepInput in;
+  in.distance = 1e-3;  // 1 m/s along x
+  for (int i = 1; i <= 50; ++i) ASSERT_TRUE(ekf.predict(i * 1e-3, in));
+  EkfFix far;
+  far.xy << 5.0, 5.0;
+  far.covariance = 1e-4 * Eigen::Matrix2d::Identity();
+  far.stamp = 0.01;
+  EXPECT_EQ(ekf.fuse(far), FixOutcome::REFUSED_GATE);
+  far.stamp = 0.02;
+  EXPECT_EQ(ekf.fuse(far), FixOutcome::REANCHORED);
+  EXPECT_NEAR(ekf.mean()(Ekf::X), 5.03, 1e-9);  // the fix, then 30 steps of 1 mm
+  EXPECT_NEAR(ekf.mean()(Ekf::Y), 5.0, 1e-9);
+  EkfFix earlier;  // where the estimate was at 0.015 s: inside the gate there
+  earlier.stamp = 0.015;
+  earlier.xy << 0.015, 0.0;
+  earlier.covariance = far.covariance;
+  EXPECT_EQ(ekf.fuse(earlier), FixOutcome::APPLIED);
+  EXPECT_NEAR(ekf.mean()(Ekf::X), 5.03, 1e-9);
+  EXPECT_NEAR(ekf.mean()(Ekf::Y), 5.0, 1e-9);
+  EXPECT_EQ(ekf.counts().reanchored, 1);
+}

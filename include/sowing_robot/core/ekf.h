@@ -25,6 +25,13 @@
 // inputs, re-applying the later fixes. So a late fix ends in exactly the estimate a filter would have
 // had with the fix applied at its stamp (test_ekf checks it). A fix older than the history, stamped
 // after the newest state, or with a non-finite or non-positive-definite value, is refused and counted.
+//
+// Re-anchoring (fix/reanchor_after = n > 0): once n fixes in a row were gated, the next gated fix is not
+// refused but taken as the position: x, y := the fix, their covariance := the fix's, their correlation
+// with heading and bias dropped (heading and bias kept: a spinning wheel corrupts the encoders'
+// distance, not the gyro's heading). Why: when the wheels slip (wet soil) the encoders count distance
+// the robot does not travel; the estimate leaves the truth faster than its covariance says, every
+// later fix lies outside the gate, and without this the filter never comes back. Counted (reanchored).
 #pragma once
 
 #include <Eigen/Core>
@@ -53,13 +60,15 @@ struct EkfParams {
   double initial_sigma_bias;   ///< [rad/s]
   int history_length;          ///< steps kept for late fixes
   double gate;                 ///< squared Mahalanobis distance above which a fix is refused; 0: no gate
+  int reanchor_after;          ///< gated fixes in a row after which the next gated one re-anchors x, y; 0: never
   double fix_delay;            ///< [s] the ROS node applies a fix once its state is this much newer (determinism)
 
   /// checkRanges(): the first bad value as one line naming its key ("" when all are good).
   std::string validate() const;
 };
 /// estimator/{odometry/distance_noise, odometry/heading_noise, odometry/increment_sigma, bias/walk, bias/estimate,
-/// initial/sigma_xy, initial/sigma_theta, initial/sigma_bias, history/length, fix/gate, fix/delay}.
+/// initial/sigma_xy, initial/sigma_theta, initial/sigma_bias, history/length, fix/gate, fix/reanchor_after,
+/// fix/delay}.
 const ParamTable<EkfParams>& ekfTable();
 
 /// One plant step's measurements.
@@ -93,12 +102,13 @@ struct EkfFix {
   Eigen::Matrix2d covariance = Eigen::Matrix2d::Identity();
 };
 
-enum class FixOutcome { APPLIED, REFUSED_INVALID, REFUSED_TOO_OLD, REFUSED_FUTURE, REFUSED_GATE };
+enum class FixOutcome { APPLIED, REANCHORED, REFUSED_INVALID, REFUSED_TOO_OLD, REFUSED_FUTURE, REFUSED_GATE };
 const char* fixOutcomeName(FixOutcome o);
 
 /// Counts of what happened to the fixes offered to fuse().
 struct FixCounts {
   long applied = 0, invalid = 0, too_old = 0, future = 0, gated = 0;
+  long reanchored = 0;  ///< gated fixes taken as the position (fix/reanchor_after); also counted in applied
   long refused() const { return invalid + too_old + future + gated; }
 };
 
@@ -145,20 +155,27 @@ class Ekf {
   /// The fix update of (mean, covariance); returns the squared Mahalanobis distance of the innovation.
   /// `apply` false only computes it.
   static double update(const EkfFix& fix, Vector& mean, Matrix& cov, bool apply = true);
+  /// Re-anchoring (file comment): x, y and their covariance from the fix, their cross terms zero.
+  static void reanchor(const EkfFix& fix, Vector& mean, Matrix& cov);
 
  private:
   struct Entry {
     double t;
     Vector mean;
     Matrix cov;
-    EkfStepInput input;         ///< the step that led here from the previous entry
-    std::vector<EkfFix> fixes;  ///< applied here, in the order they came
+    EkfStepInput input;  ///< the step that led here from the previous entry
+    struct Applied {
+      EkfFix fix;
+      bool reanchor;
+    };
+    std::vector<Applied> fixes;  ///< applied here, in the order they came
   };
   void pinBias(Vector& mean, Matrix& cov) const;
 
   EkfParams params_;
   std::deque<Entry> history_;
   FixCounts counts_;
+  int gated_in_a_row_ = 0;  // for fix/reanchor_after
 };
 
 /// Holds fixes until the filter's time has passed stamp + delay, so that which fixes an estimate
