@@ -8,17 +8,23 @@
 #include <cstdlib>
 #include <functional>
 #include <map>
+#include <optional>
 #include <set>
 #include <stdexcept>
 
 #include <yaml-cpp/yaml.h>
 
+#include "sowing_robot/core/ekf.h"
+#include "sowing_robot/core/estimated_run.h"
 #include "sowing_robot/core/field.h"
 #include "sowing_robot/core/kanayama.h"
 #include "sowing_robot/core/node_settings.h"
 #include "sowing_robot/core/plant.h"
 #include "sowing_robot/core/pure_pursuit.h"
+#include "sowing_robot/core/sensors.h"
 #include "sowing_robot/core/sliding_mode.h"
+#include "sowing_robot/core/soil_map.h"
+#include "sowing_robot/core/traction.h"
 #include "sowing_robot/core/tuning.h"
 #include "sowing_robot/core/validation.h"
 #include "sowing_robot/core/wheel_pid.h"
@@ -149,6 +155,17 @@ void applyGroup(const ParamTable<S>& table, const YAML::Node& group, S& s, const
   applyKeys(table, keys, s, file, where + "/");
 }
 
+/// A block whose keys are a node's table keys under `prefix` (traction: {mu_peak: 0.2} -> "traction/mu_peak"):
+/// unknown keys and bad values refused with the table's key in the line.
+template <typename S>
+void applyTableBlock(const ParamTable<S>& table, const YAML::Node& group, S& s, const std::string& file,
+                     const std::string& prefix) {
+  if (!group.IsMap()) fail(file, prefix + " must be a mapping");
+  std::vector<std::pair<std::string, YAML::Node>> keys;
+  flatten(group, prefix + "/", keys);
+  applyKeys(table, keys, s, file, "");
+}
+
 /// [lo, hi] or a single value (fixed).
 core::Uniform toUniform(const YAML::Node& n, const std::string& file, const std::string& key) {
   if (n.IsScalar()) {
@@ -176,12 +193,77 @@ bool fileExists(const std::string& path) {
   return ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
 }
 
+/// A soil patch as the field file states it: a coefficient left out takes the traction block's value
+/// (as plant_sim's loadSoilPatches does), resolved once that block is read.
+struct PatchSpec {
+  std::vector<Eigen::Vector2d> polygon;
+  std::optional<double> mu_peak, mu_slide, rolling_resistance;
+};
+
+/// plant_sim/field/patches of a field config (config/field_thesis_wet.yaml): the keys plant_sim reads.
+void loadPatches(const YAML::Node& plant_sim, const std::string& path, std::vector<PatchSpec>& out) {
+  onlyKeys(plant_sim, {"field"}, path, "plant_sim/");
+  const YAML::Node field = plant_sim["field"];
+  onlyKeys(field, {"patches"}, path, "plant_sim/field/");
+  const YAML::Node list = field["patches"];
+  if (!list) return;
+  if (!list.IsSequence())
+    fail(path, "plant_sim/field/patches must be a list of {polygon, mu_peak, mu_slide, rolling_resistance}");
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const std::string name = "field/patches[" + std::to_string(i) + "]";
+    const YAML::Node item = list[i];
+    if (!item.IsMap()) fail(path, name + " must be a map {polygon, mu_peak, mu_slide, rolling_resistance}");
+    onlyKeys(item, {"polygon", "mu_peak", "mu_slide", "rolling_resistance"}, path, name + "/");
+    PatchSpec p;
+    const YAML::Node poly = required(item, "polygon", path, name + "/");
+    if (!poly.IsSequence()) fail(path, name + "/polygon must be a list of [x, y] vertices");
+    for (std::size_t k = 0; k < poly.size(); ++k) {
+      const std::string v = name + "/polygon[" + std::to_string(k) + "]";
+      if (!poly[k].IsSequence() || poly[k].size() != 2) fail(path, v + " must be a vertex [x, y] of two numbers");
+      p.polygon.emplace_back(toDouble(poly[k][0], path, v), toDouble(poly[k][1], path, v));
+    }
+    if (item["mu_peak"]) p.mu_peak = toDouble(item["mu_peak"], path, name + "/mu_peak");
+    if (item["mu_slide"]) p.mu_slide = toDouble(item["mu_slide"], path, name + "/mu_slide");
+    if (item["rolling_resistance"])
+      p.rolling_resistance = toDouble(item["rolling_resistance"], path, name + "/rolling_resistance");
+    out.push_back(p);
+  }
+}
+
+/// The patches with the traction block's values where a coefficient was left out, checked as plant_sim checks
+/// them (SoilPatch::validate, and the patch's grip against the field's slip curve).
+std::vector<core::SoilPatch> resolvePatches(const std::vector<PatchSpec>& specs, const core::TractionParams& ground,
+                                            const std::string& path) {
+  std::vector<core::SoilPatch> out;
+  for (std::size_t i = 0; i < specs.size(); ++i) {
+    const std::string name = "field/patches[" + std::to_string(i) + "]";
+    core::SoilPatch patch;
+    patch.polygon = specs[i].polygon;
+    patch.mu_peak = specs[i].mu_peak.value_or(ground.mu_peak);
+    patch.mu_slide = specs[i].mu_slide.value_or(ground.mu_slide);
+    patch.rolling_resistance = specs[i].rolling_resistance.value_or(ground.rolling_resistance);
+    std::string e = patch.validate(name);
+    if (!e.empty()) fail(path, e);
+    core::TractionParams t = ground;
+    t.mu_peak = patch.mu_peak;
+    t.mu_slide = patch.mu_slide;
+    t.rolling_resistance = patch.rolling_resistance;
+    e = t.validate();
+    if (!e.empty()) fail(path, name + "/mu_peak: with the field's slip curve, " + e);
+    out.push_back(patch);
+  }
+  return out;
+}
+
 /// A reference_generator config (config/field*.yaml): its field/ and potential/ keys through fieldTable(),
 /// its obstacles; type must be field. Keys of the line reference (ReferenceGeneratorSettings) are allowed
-/// and unused.
-void loadFieldConfig(const std::string& path, core::FieldParams& field, std::vector<core::Obstacle>& obstacles) {
+/// and unused. plant_sim/field/patches (soil patches) go to `patches` (used with traction on).
+void loadFieldConfig(const std::string& path, core::FieldParams& field, std::vector<core::Obstacle>& obstacles,
+                     std::vector<PatchSpec>& patches) {
   const YAML::Node root = loadYaml(path);
-  onlyKeys(root, {"reference_generator"}, path, "");
+  onlyKeys(root, {"reference_generator", "plant_sim"}, path, "");
+  patches.clear();
+  if (const YAML::Node ps = root["plant_sim"]) loadPatches(ps, path, patches);
   const YAML::Node rg = required(root, "reference_generator", path, "");
   if (!rg.IsMap()) fail(path, "reference_generator must be a mapping");
   std::vector<std::pair<std::string, YAML::Node>> keys, field_keys;
@@ -215,7 +297,9 @@ void loadFieldConfig(const std::string& path, core::FieldParams& field, std::vec
 }  // namespace
 
 const std::vector<std::string>& pendingModels() {
-  static const std::vector<std::string> pending{"wet_soil", "estimated_pose"};
+  // Empty since wet_soil and estimated_pose landed (core::availableModels()); a model announced but not
+  // built yet goes here, and `requires:` refuses it with that reason.
+  static const std::vector<std::string> pending{};
   return pending;
 }
 
@@ -223,9 +307,10 @@ core::BenchScenario loadScenarioFileImpl(const std::string& path) {
   const YAML::Node root = loadYaml(path);
   onlyKeys(root,
            {"name", "description", "track", "duration", "control_rate", "start", "line", "sine", "field", "plant",
-            "draws", "success", "envelope_period", "requires"},
+            "draws", "success", "envelope_period", "requires", "traction", "sensors", "estimator", "feedback"},
            path, "");
   core::BenchScenario b;
+  std::vector<PatchSpec> patch_specs;
   b.name = required(root, "name", path, "").as<std::string>();
   if (b.name != stem(path)) fail(path, "name '" + b.name + "' must be the file's name ('" + stem(path) + "')");
   required(root, "description", path, "");
@@ -267,7 +352,8 @@ core::BenchScenario loadScenarioFileImpl(const std::string& path) {
     onlyKeys(block, {"config", "finish_tolerance", "approach", "plan_detours"}, path, "field/");
     b.field = core::FieldRunSetup().field;  // with the footprint's radius, as run_scenario --field
     const std::string config = required(block, "config", path, "field/").as<std::string>();
-    loadFieldConfig(config.front() == '/' ? config : directoryOf(path) + "/" + config, b.field, b.obstacles);
+    loadFieldConfig(config.front() == '/' ? config : directoryOf(path) + "/" + config, b.field, b.obstacles,
+                    patch_specs);
     b.finish_tolerance = toDouble(required(block, "finish_tolerance", path, "field/"), path, "field/finish_tolerance");
     if (block["approach"]) b.field.approach = block["approach"].as<bool>();
     if (block["plan_detours"]) b.field.avoidance.plan_detours = block["plan_detours"].as<bool>();
@@ -312,16 +398,49 @@ core::BenchScenario loadScenarioFileImpl(const std::string& path) {
       toDouble(required(success, "cross_track_threshold", path, "success/"), path, "success/cross_track_threshold");
   if (root["envelope_period"]) b.envelope_period = toDouble(root["envelope_period"], path, "envelope_period");
 
-  // Extension point (issue 16): `requires: [wet_soil]` or `[estimated_pose]` names a model that is not built
-  // yet; such a scenario is refused with that reason. When a model lands, read its block here (e.g. a
-  // `traction:` mapping through tractionTable()), apply it in core::runBenchmark, and drop it from pendingModels().
+  // Issue 16 in the benchmark: the plant (traction:), the sensors (sensors:), the estimator (estimator:) and
+  // what the controllers are fed (feedback:), each block through the nodes' parameter table with the nodes'
+  // keys (traction/..., sensors/..., estimator/...), so a key, a range and an error read as plant_sim's and
+  // state_estimator's. Any of them puts the scenario on the estimated loop (core/estimated_bench.h).
+  const YAML::Node traction = root["traction"], sensors = root["sensors"], estimator = root["estimator"],
+                   feedback = root["feedback"];
+  if (traction || sensors || estimator || feedback) {
+    core::EstimatedRunConfig cfg;
+    core::TractionParams t;
+    if (traction) applyTableBlock(core::tractionTable(), traction, t, path, "traction");
+    if (t.enabled) {
+      cfg.traction = t;
+      cfg.patches = resolvePatches(patch_specs, t, path);
+    }
+    if (sensors) {
+      if (!sensors.IsMap()) fail(path, "sensors must be a mapping");
+      if (sensors["seed"])
+        fail(path, "sensors/seed is drawn per run (draw 8 of the run's counter-based draws); leave it out");
+      applyTableBlock(core::sensorsTable(), sensors, cfg.sensors, path, "sensors");
+    }
+    if (estimator) applyTableBlock(core::ekfTable(), estimator, cfg.estimator, path, "estimator");
+    if (feedback) {
+      if (!feedback.IsScalar()) fail(path, "feedback must be one of ground_truth, odometry, fused");
+      const std::string e = core::parseFeedback(feedback.Scalar(), cfg.feedback);
+      if (!e.empty()) fail(path, e);
+    }
+    b.realism = cfg;
+  }  // (soil patches without traction are read and unused, as in the nodes)
+  // `requires: [wet_soil, estimated_pose]`: the models the scenario needs, checked against what it switches on
+  // (core::estimatedBenchCheck). A model announced but not built yet (pendingModels()) is refused with that reason.
   if (const YAML::Node req = root["requires"]) {
     if (!req.IsSequence()) fail(path, "requires must be a list of model names");
     for (const auto& m : req) {
       const std::string model = m.as<std::string>();
       const auto& pending = pendingModels();
-      if (std::find(pending.begin(), pending.end(), model) == pending.end())
-        fail(path, "requires: unknown model '" + model + "' (announced: wet_soil, estimated_pose)");
+      const auto& available = core::availableModels();
+      if (std::find(pending.begin(), pending.end(), model) != pending.end())
+        fail(path, "requires: model '" + model + "' is not available yet");
+      if (std::find(available.begin(), available.end(), model) == available.end()) {
+        std::string list;
+        for (const auto& a : available) list += (list.empty() ? "" : ", ") + a;
+        fail(path, "requires: unknown model '" + model + "' (available: " + list + ")");
+      }
       b.requires_models.push_back(model);
     }
   }

@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "sowing_robot/core/estimated_bench.h"
 #include "sowing_robot/core/validation.h"
 
 namespace sowing_robot {
@@ -204,6 +205,7 @@ RunDraw drawRun(const MonteCarloSpec& spec, const Scenario& base, std::int64_t i
   d.start_x = base.start.x + spec.start_dx.at(unit(s, index, 5));
   d.start_y = base.start.y + spec.start_dy.at(unit(s, index, 6));
   d.start_theta = wrapAngle(base.start.theta + spec.start_dtheta.at(unit(s, index, 7)));
+  d.sensor_seed = splitmix64(splitmix64(splitmix64(s) + static_cast<std::uint64_t>(index)) + 8) >> 33;
   return d;
 }
 
@@ -238,9 +240,8 @@ std::string BenchScenario::validate() const {
   std::string e = firstError({spec.validate(), base.validate()});
   if (!e.empty()) return e;
   if (!(envelope_period > 0.0 && std::isfinite(envelope_period))) return "envelope_period must be > 0";
-  if (!requires_models.empty())
-    return "scenario " + name + " needs the " + requires_models.front() +
-           " model, which is not available yet (issue 16)";
+  e = estimatedBenchCheck(*this);
+  if (!e.empty()) return e;
   switch (track) {
     case TrackKind::line:
       if (!allFinite(line_x0, line_v_r, line_y)) return "line: x0, v_r and y must be finite";
@@ -268,6 +269,9 @@ std::vector<RunRow> runBenchmark(const BenchScenario& bench, std::int64_t runs, 
   const Scenario& base = bench.base;
   for (std::int64_t i = 0; i < runs && e.empty(); ++i) e = applyDraw(base, spec, drawRun(spec, base, i)).validate();
   if (!e.empty()) throw std::invalid_argument("a drawn run does not validate: " + e);
+  if (bench.realism)  // sensors, traction or an estimate in the loop (issue 16): estimated_bench.h
+    return parallelRows(runs, threads, progress,
+                        [&]() { return [&bench](std::int64_t i) { return estimatedBenchRow(bench, i); }; });
   const auto period_steps = static_cast<std::int64_t>(
       std::max(1.0, std::round(bench.envelope_period / secondsFromNanos(base.control_period_ns))));
   if (bench.track != TrackKind::field) {
@@ -412,14 +416,16 @@ std::vector<double> metricValues(const RunRow& r) {
   return v;
 }
 
-std::string runsCsvHeader() {
+std::string runsCsvHeader(bool realism) {
   std::string h =
       "scenario,controller,seed,mass_scale,inertia_scale,amplitude,phase,noise_seed,start_x,start_y,start_theta";
   for (const auto& c : metricColumns()) h += "," + c;
-  return h + ",contacts,min_clearance,end_distance,diverged,success,failure\n";
+  return h + ",contacts,min_clearance,end_distance,diverged,success,failure" + (realism ? estimatedCsvHeader() : "") +
+         "\n";
 }
 
-std::string runsCsvLines(const std::string& scenario, const std::string& controller, const std::vector<RunRow>& rows) {
+std::string runsCsvLines(const std::string& scenario, const std::string& controller, const std::vector<RunRow>& rows,
+                         bool realism) {
   std::string out;
   for (const RunRow& r : rows) {
     const RunDraw& d = r.draw;
@@ -429,7 +435,8 @@ std::string runsCsvLines(const std::string& scenario, const std::string& control
            number(d.start_theta);
     for (double x : metricValues(r)) out += "," + number(x);
     out += "," + std::to_string(r.contacts) + "," + number(r.min_clearance) + "," + number(r.end_distance);
-    out += std::string(",") + (r.diverged ? "1" : "0") + "," + (r.success ? "1" : "0") + "," + r.failure + "\n";
+    out += std::string(",") + (r.diverged ? "1" : "0") + "," + (r.success ? "1" : "0") + "," + r.failure;
+    out += (realism ? estimatedCsvFields(r) : "") + "\n";
   }
   return out;
 }
@@ -476,6 +483,7 @@ std::string reportSection(const std::string& scenario, const std::string& contro
     out += "body against the obstacles: runs with a contact " + std::to_string(touched) + ", smallest body clearance " +
            shortNumber(lowest) + " m\n\n";
   }
+  if (!rows.empty() && rows.front().realism) out += estimatedReportLine(rows);
   out += "| metric | mean | std | p95 | worst |\n|---|---:|---:|---:|---:|\n";
   const auto& cols = metricColumns();
   std::vector<std::vector<double>> values(cols.size());

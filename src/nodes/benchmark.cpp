@@ -25,6 +25,7 @@
 
 #include "sowing_robot/bench/scenario_loader.h"
 #include "sowing_robot/core/benchmark.h"
+#include "sowing_robot/core/estimated_bench.h"
 #include "sowing_robot/core/runner.h"
 
 using namespace sowing_robot::core;
@@ -175,14 +176,18 @@ int main(int argc, char** argv) {
   }
   std::remove((output + "/.benchmark_probe").c_str());
 
-  std::string csv = runsCsvHeader(), envelopes = envelopeCsvHeader();
+  // Scenarios with sensors, traction or an estimate in the loop add their columns (estimated_bench.h); without
+  // one, runs.csv is today's, byte for byte.
+  bool realism = false;
+  for (const auto& b : scenarios) realism = realism || b.realism.has_value();
+  std::string csv = runsCsvHeader(realism), envelopes = envelopeCsvHeader();
   std::string report = "# Controller benchmark\n\n" + std::to_string(seeds) +
                        " seeded runs per scenario and controller, in-process (`benchmark`, core/benchmark.h); every "
                        "run can be repeated alone from its row of runs.csv.\n\nGains:\n\n";
   for (std::size_t p = 0; p < pairs.size(); ++p)
     report += "- " + pairs[p].controllerName() + ": " + gains_source[p] + "\n";
   report += "\nScenarios:\n\n";
-  for (const auto& b : scenarios) report += describe(b);
+  for (const auto& b : scenarios) report += describe(b) + describeRealism(b);
   std::string summary = summaryHeader(), sections;
 
   const bool tty = ::isatty(STDERR_FILENO) != 0;
@@ -215,7 +220,7 @@ int main(int argc, char** argv) {
         return fail(b.name + " / " + name + ": " + e.what());
       }
       finished += seeds;
-      csv += runsCsvLines(b.name, name, rows);
+      csv += runsCsvLines(b.name, name, rows, realism);
       envelopes += envelopeCsvLines(b.name, name, crossTrackEnvelope(rows, b.envelope_period));
       summary += summaryLine(b.name, name, rows);
       sections += reportSection(b.name, name, rows);

@@ -62,8 +62,8 @@ std::string loadError(const std::string& path) {
 
 TEST(ScenarioLoader, EverySuiteFileLoads) {
   const auto names = bench::scenarioNames(kSuite);
-  for (const char* expected :
-       {"thesis_line", "thesis_field", "three_row_field", "sine_rows", "heavy_robot", "disturbance_sweep"})
+  for (const char* expected : {"thesis_line", "thesis_field", "three_row_field", "sine_rows", "heavy_robot",
+                               "disturbance_sweep", "wet_soil", "estimated_pose"})
     EXPECT_NE(std::find(names.begin(), names.end(), expected), names.end()) << expected;
   for (const auto& n : names) {
     SCOPED_TRACE(n);
@@ -127,15 +127,99 @@ TEST(ScenarioLoader, TyposAndMissingKeysAreRefusedNamingThem) {
   }
 }
 
-TEST(ScenarioLoader, ModelsNotBuiltYetAreRefusedWithTheirReason) {
+TEST(ScenarioLoader, RequiredModelsMustBeKnownAndSwitchedOn) {
+  // wet_soil and estimated_pose are built (nothing is pending now); a scenario that requires one must switch it on.
+  EXPECT_TRUE(bench::pendingModels().empty());
   TempDir dir;
   std::string e = loadError(variant(dir, "requires: []", "requires: [wet_soil]"));
-  EXPECT_NE(e.find("wet_soil"), std::string::npos) << e;
-  EXPECT_NE(e.find("not available yet"), std::string::npos) << e;
+  EXPECT_NE(e.find("requires wet_soil but its traction is not enabled"), std::string::npos) << e;
   e = loadError(variant(dir, "requires: []", "requires: [estimated_pose]"));
-  EXPECT_NE(e.find("estimated_pose"), std::string::npos) << e;
+  EXPECT_NE(e.find("requires estimated_pose but its feedback is ground_truth"), std::string::npos) << e;
+  e = loadError(variant(dir, "requires: []", "requires: [estimated_pose]\nfeedback: fused"));
+  EXPECT_EQ(e, "");
   e = loadError(variant(dir, "requires: []", "requires: [dry_soil]"));
-  EXPECT_NE(e.find("unknown model 'dry_soil'"), std::string::npos) << e;
+  EXPECT_NE(e.find("unknown model 'dry_soil' (available: wet_soil, estimated_pose)"), std::string::npos) << e;
+}
+
+TEST(ScenarioLoader, TheNewScenariosCarryTheirPlantSensorsAndFeedback) {
+  const BenchScenario wet = bench::loadScenario("wet_soil", kSuite);
+  ASSERT_TRUE(wet.realism.has_value());
+  ASSERT_TRUE(wet.realism->traction.has_value());
+  EXPECT_EQ(wet.realism->traction->draft_force, 10.0);
+  EXPECT_EQ(wet.realism->traction->mu_peak, 0.6);  // config/traction.yaml's default
+  ASSERT_EQ(wet.realism->patches.size(), 1u);      // config/field_thesis_wet.yaml's patch
+  EXPECT_EQ(wet.realism->patches[0].mu_peak, 0.2);
+  EXPECT_EQ(wet.realism->patches[0].mu_slide, 0.15);
+  EXPECT_EQ(wet.realism->patches[0].rolling_resistance, 0.08);
+  EXPECT_EQ(wet.realism->feedback, core::Feedback::ground_truth);
+  EXPECT_EQ(wet.obstacles.size(), 3u);
+  const BenchScenario est = bench::loadScenario("estimated_pose", kSuite);
+  ASSERT_TRUE(est.realism.has_value());
+  EXPECT_FALSE(est.realism->traction.has_value());
+  EXPECT_EQ(est.realism->feedback, core::Feedback::fused);
+  EXPECT_EQ(est.realism->sensors.fix.sigma, 0.02);
+  EXPECT_EQ(est.realism->sensors.encoder.ticks_per_turn, 2048);
+  // Today's scenarios stay on today's loop.
+  EXPECT_FALSE(bench::loadScenario("thesis_line", kSuite).realism.has_value());
+  EXPECT_FALSE(bench::loadScenario("thesis_field", kSuite).realism.has_value());
+}
+
+namespace {
+/// estimated_pose.yaml with `from` replaced by `to` (once), written as DIR/estimated_pose.yaml.
+std::string estimatedVariant(const TempDir& dir, const std::string& from, const std::string& to) {
+  std::string text = readFile(kSuite + "/estimated_pose.yaml");
+  const std::size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  return dir.write("estimated_pose.yaml", text);
+}
+}  // namespace
+
+TEST(ScenarioLoader, BadTractionSensorAndEstimatorKeysAreRefusedNamingTheKey) {
+  TempDir dir;
+  const auto oneLine = [&](const std::string& e) {
+    EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+    EXPECT_EQ(e.rfind(dir.path, 0), 0u) << e;
+  };
+  EXPECT_EQ(loadError(estimatedVariant(dir, "sensors: {}", "sensors: {}")), "");
+  std::string e = loadError(estimatedVariant(dir, "sensors: {}", "sensors: {fix: {sigmaa: 0.02}}"));
+  EXPECT_NE(e.find("unknown key 'sensors/fix/sigmaa'"), std::string::npos) << e;
+  oneLine(e);
+  e = loadError(estimatedVariant(dir, "sensors: {}", "sensors: {fix: {sigma: -0.02}}"));
+  EXPECT_NE(e.find("sensors/fix/sigma"), std::string::npos) << e;
+  oneLine(e);
+  e = loadError(estimatedVariant(dir, "sensors: {}", "sensors: {seed: 3}"));
+  EXPECT_NE(e.find("sensors/seed is drawn per run"), std::string::npos) << e;
+  e = loadError(estimatedVariant(dir, "estimator: {}", "estimator: {fix: {delay: -1}}"));
+  EXPECT_NE(e.find("estimator/fix/delay"), std::string::npos) << e;
+  oneLine(e);
+  e = loadError(estimatedVariant(dir, "estimator: {}", "estimator: {bias: {estimat: true}}"));
+  EXPECT_NE(e.find("unknown key 'estimator/bias/estimat'"), std::string::npos) << e;
+  e = loadError(estimatedVariant(dir, "feedback: fused", "feedback: fusde"));
+  EXPECT_NE(e.find("feedback 'fusde' is none of ground_truth, odometry, fused"), std::string::npos) << e;
+  oneLine(e);
+  e = loadError(estimatedVariant(dir, "sensors: {}", "sensors: {}\ntraction: {enabled: true, mu_peak: nan}"));
+  EXPECT_NE(e.find("traction/mu_peak"), std::string::npos) << e;
+  oneLine(e);
+  e = loadError(estimatedVariant(dir, "sensors: {}", "sensors: {}\ntraction: {enabled: true, mu_slide: 0.9}"));
+  EXPECT_NE(e.find("traction/mu_slide"), std::string::npos) << e;
+  e = loadError(estimatedVariant(dir, "sensors: {}", "sensors: {}\ntraction: {enabeld: true}"));
+  EXPECT_NE(e.find("unknown key 'traction/enabeld'"), std::string::npos) << e;
+  // A bad soil patch in the field file: named with its index, as plant_sim names it.
+  const std::string wet = readFile(kSource + "/config/field_thesis_wet.yaml");
+  std::string bad = std::regex_replace(wet, std::regex("mu_peak: 0.2, mu_slide: 0.15"), "mu_peak: 0.2, mu_slide: 0.3");
+  dir.write("field_thesis_wet.yaml", bad);
+  std::string scen = readFile(kSuite + "/wet_soil.yaml");
+  scen = std::regex_replace(scen, std::regex("\\.\\./field_thesis_wet\\.yaml"), "field_thesis_wet.yaml");
+  e = loadError(dir.write("wet_soil.yaml", scen));
+  EXPECT_NE(e.find("field/patches[0]"), std::string::npos) << e;
+  oneLine(e);
+  bad = std::regex_replace(wet, std::regex("rolling_resistance: 0.08"), "rolling_resistence: 0.08");
+  dir.write("field_thesis_wet.yaml", bad);
+  e = loadError(dir.path + "/wet_soil.yaml");
+  EXPECT_NE(e.find("unknown key 'field/patches[0]/rolling_resistence'"), std::string::npos) << e;
+  dir.write("field_thesis_wet.yaml", wet);  // the unmodified copy loads: each failure above was the edit's
+  EXPECT_EQ(loadError(dir.path + "/wet_soil.yaml"), "");
 }
 
 TEST(ScenarioLoader, TunedGainsGoThroughTheParameterTables) {

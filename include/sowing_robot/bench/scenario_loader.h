@@ -17,7 +17,9 @@ namespace sowing_robot {
 namespace bench {
 
 /// The scenario file at `path` (its `name` must equal the file's stem). A field scenario's `field/config`
-/// is read relative to the scenario file's directory.
+/// is read relative to the scenario file's directory (with its plant_sim/field/patches, used with traction on).
+/// Blocks traction:, sensors: (sensors/seed refused: drawn per run), estimator: and feedback: set
+/// BenchScenario::realism (docs/benchmark.md).
 core::BenchScenario loadScenarioFile(const std::string& path);
 
 /// `name_or_path`: a file path (contains '/' or ends with .yaml) or a scenario name looked up as
@@ -27,10 +29,10 @@ core::BenchScenario loadScenario(const std::string& name_or_path, const std::str
 /// The scenario names in `dir` (every *.yaml, sorted).
 std::vector<std::string> scenarioNames(const std::string& dir);
 
-/// Models a scenario may require (`requires:`) that are announced but not built yet (issue 16):
-/// "wet_soil" (traction plant on a wet field) and "estimated_pose" (the controllers see an estimated pose).
-/// Extension point: when one lands, parse its block in loadScenarioFile (see the comment there), apply it in
-/// core::runBenchmark, and take it off this list.
+/// Models a scenario may require (`requires:`) that are announced but not built yet: empty since
+/// "wet_soil" and "estimated_pose" landed (core::availableModels(); their blocks traction:, sensors:,
+/// estimator:, feedback: are read in loadScenarioFile through the nodes' tables). Extension point: a model
+/// announced before it is built goes here, and a scenario requiring it is refused with "not available yet".
 const std::vector<std::string>& pendingModels();
 
 /// Applies a tuned-gains file (results/tuned_gains.yaml's format: groups kinematic_controller (Kanayama),

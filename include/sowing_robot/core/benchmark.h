@@ -4,7 +4,8 @@
 //
 // Reproducibility: run i's k-th draw is splitmix64(splitmix64(splitmix64(base_seed) + i) + k), its top
 // 53 bits mapped to [0, 1) (k: 0 mass, 1 inertia, 2 amplitude, 3 phase, 4 noise seed (>> 33: the seed parameter is a
-// 31-bit int), 5-7 start x, y, theta offsets), a counter-based generator, so a run depends on (base_seed, i) only: the
+// 31-bit int), 5-7 start x, y, theta offsets, 8 the sensors' seed (>> 33, as 4; used by scenarios with sensors in the
+// loop, estimated_run.h)), a counter-based generator, so a run depends on (base_seed, i) only: the
 // rows are bit-identical whatever the thread count and order, and any run can be repeated alone from its row.
 #pragma once
 
@@ -12,9 +13,11 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "sowing_robot/core/estimated_run.h"
 #include "sowing_robot/core/field_run.h"
 #include "sowing_robot/core/metrics.h"
 #include "sowing_robot/core/reference.h"
@@ -53,6 +56,7 @@ struct RunDraw {
   double mass_scale = 1.0, inertia_scale = 1.0, amplitude = 0.0, phase = 0.0;
   std::uint64_t noise_seed = 0;
   double start_x = 0.0, start_y = 0.0, start_theta = 0.0;
+  std::uint64_t sensor_seed = 0;  ///< draw 8: sensors/seed of a scenario with sensors (BenchScenario::realism)
 };
 RunDraw drawRun(const MonteCarloSpec& spec, const Scenario& base, std::int64_t index);
 /// The scenario run `draw` stands for (base with the draw applied).
@@ -76,6 +80,15 @@ struct RunRow {
   std::string failure;  ///< why not a success ("" on success): diverged, contact, not finished, cross-track
   /// Signed cross-track error sampled every envelope period from t = 0 (runBenchmark only; empty otherwise).
   std::vector<double> cross_track_series;
+  /// A scenario with BenchScenario::realism (estimated_bench.h): the columns below are its (NaN otherwise).
+  bool realism = false;
+  double max_slip = std::numeric_limits<double>::quiet_NaN();        ///< largest |slip ratio| (0 without traction)
+  double tool_down_time = std::numeric_limits<double>::quiet_NaN();  ///< time the draft acted [s]
+  /// Position error of the pose fed to the controllers against the truth, RMS and max over the run [m].
+  double fed_error_rms = std::numeric_limits<double>::quiet_NaN();
+  double fed_error_max = std::numeric_limits<double>::quiet_NaN();
+  double odometry_error_max = std::numeric_limits<double>::quiet_NaN();  ///< the encoders' dead reckoning [m]
+  long fixes_applied = 0, fixes_refused = 0;                             ///< feedback fused
 };
 
 /// Runs base (its controller pair, plant, timing) on `reference` for seeds 0..runs-1 with `threads`
@@ -109,12 +122,21 @@ struct BenchScenario {
   /// (AvoidanceStatus kOk) and the axle ends within this distance of the reference's last pose [m].
   double finish_tolerance = 0.5;
   double envelope_period = 0.1;  ///< period of RunRow::cross_track_series [s] (> 0)
-  /// Extension point (issue 16): conditions not modelled yet (e.g. "wet_soil", "estimated_pose"). The loader
-  /// refuses a scenario needing one; runBenchmark refuses a non-empty list until the models land.
+  /// Issue 16 in the benchmark (scenario keys traction:, sensors:, estimator:, feedback:): set, every run goes
+  /// through runEstimatedLoop with this plant, these sensors (their seed replaced by the run's draw 8) and
+  /// this feedback, scored on the truth (estimated_bench.h); unset, today's runClosedLoop.
+  std::optional<EstimatedRunConfig> realism;
+  /// Models the scenario declares it needs (`requires:`): each must be one of availableModels() and be
+  /// switched on by the scenario ("wet_soil": realism with traction; "estimated_pose": realism with
+  /// feedback odometry or fused). The extension point for models not built yet: a name announced but
+  /// pending is refused by validate().
   std::vector<std::string> requires_models;
 
   std::string validate() const;
 };
+
+/// The models a scenario may require and the benchmark runs: "wet_soil", "estimated_pose".
+const std::vector<std::string>& availableModels();
 
 /// Runs `bench` (its base carries the controller pair) for seeds 0..runs-1 on `threads` threads (0: all
 /// cores), as runMonteCarlo does (same draws, same thread-count independence), with the body contacts
@@ -148,8 +170,11 @@ const std::vector<std::string>& metricColumns();
 std::vector<double> metricValues(const RunRow& row);
 
 /// Tidy CSV: header line, then one line per row: scenario, controller, seed, the draws, every metric.
-std::string runsCsvHeader();
-std::string runsCsvLines(const std::string& scenario, const std::string& controller, const std::vector<RunRow>& rows);
+/// realism: the columns of scenarios with sensors or traction appended (estimated_bench.h; NaN on rows
+/// without them); false gives today's columns, byte for byte.
+std::string runsCsvHeader(bool realism = false);
+std::string runsCsvLines(const std::string& scenario, const std::string& controller, const std::vector<RunRow>& rows,
+                         bool realism = false);
 /// Markdown section for one scenario and controller: success rate with failure reasons, then per metric
 /// mean, std, p95 and worst.
 std::string reportSection(const std::string& scenario, const std::string& controller, const std::vector<RunRow>& rows);

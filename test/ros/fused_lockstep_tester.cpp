@@ -1,0 +1,102 @@
+// rostest (fused_lockstep.test): the node pipeline in lockstep with feedback:=fused (plant_sim's sensors,
+// state_estimator, the controllers on odometry/filtered) against the in-process loop with the EKF in it
+// (core/estimated_run.h) on the same parameters, read from the nodes' own namespaces (the scenario and the
+// controller pair as pipeline_tester reads them; plant_sim's sensors/..., state_estimator's estimator/...).
+// Every period's true pose (ground_truth) and estimate (odometry/filtered) must equal the in-process ones
+// bit for bit. Fails without what it protects: an in-process loop that fed the controllers at another step,
+// formed the EKF's inputs otherwise (e.g. without the quaternion round trip or the increment covariance) or
+// applied the fixes at another time gives other numbers (the printed differences say how far).
+#include <gtest/gtest.h>
+#include <nav_msgs/Odometry.h>
+#include <ros/ros.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "sowing_robot/core/estimated_run.h"
+#include "sowing_robot/core/validation.h"
+#include "sowing_robot/ros/component_params.h"
+#include "sowing_robot/ros/msg_checks.h"
+#include "sowing_robot/ros/param_reader.h"
+
+using namespace sowing_robot;
+
+namespace {
+struct Recorded {
+  std::map<std::uint64_t, core::Pose2D> truth, estimate;
+  void onTruth(const nav_msgs::Odometry::ConstPtr& m) { truth[m->header.stamp.toNSec()] = poseOf(*m); }
+  void onEstimate(const nav_msgs::Odometry::ConstPtr& m) { estimate[m->header.stamp.toNSec()] = poseOf(*m); }
+  void onOdom(const nav_msgs::Odometry::ConstPtr&) {}
+};
+}  // namespace
+
+TEST(FusedLockstep, NodePipelineEqualsTheInProcessEstimatedLoop) {
+  ros::NodeHandle nh, pnh("~");
+  double timeout = 400.0;
+  pnh.getParam("wall_timeout", timeout);
+  core::Scenario sc;
+  double duration = 0;
+  const std::string err = loadPipelineScenario(sc, duration);
+  ASSERT_TRUE(err.empty()) << err;
+  core::EstimatedRunConfig cfg;
+  cfg.feedback = core::Feedback::fused;
+  ParamReader plant(ros::NodeHandle("/plant_sim")), estimator(ros::NodeHandle("/state_estimator"));
+  loadTable(plant, core::sensorsTable(), cfg.sensors);
+  loadTable(estimator, core::ekfTable(), cfg.estimator);
+  ASSERT_EQ(core::firstError({plant.error(), estimator.error(), cfg.validate()}), "");
+  std::printf("fused lockstep: pair %s, %g s, sensors seed %llu, bias state %s\n", sc.controllerName().c_str(),
+              duration, static_cast<unsigned long long>(cfg.sensors.seed), cfg.estimator.estimate_bias ? "on" : "off");
+
+  Recorded rec;
+  const auto hints = ros::TransportHints().tcpNoDelay();
+  // ground_truth and odom are counted by plant_sim's min_subscribers: the run starts once this tester listens.
+  ros::Subscriber truth = nh.subscribe("ground_truth", 100000, &Recorded::onTruth, &rec, hints);
+  ros::Subscriber odom = nh.subscribe("odom", 10, &Recorded::onOdom, &rec, hints);
+  ros::Subscriber est = nh.subscribe("odometry/filtered", 100000, &Recorded::onEstimate, &rec, hints);
+  const std::uint64_t last = static_cast<std::uint64_t>(sc.steps() * sc.control_period_ns);
+  const ros::WallTime start = ros::WallTime::now();
+  while (ros::ok() && !(rec.truth.count(last) && rec.estimate.count(last))) {
+    ros::spinOnce();
+    ros::WallDuration(0.001).sleep();
+    ASSERT_LT((ros::WallTime::now() - start).toSec(), timeout) << "the pipeline did not finish the scenario";
+  }
+
+  core::LineReference ref(1.0, 3.0, 0.0);
+  double truth_diff = 0.0, estimate_diff = 0.0, fed_max = 0.0;
+  std::int64_t compared = 0, unequal = 0, missing = 0;
+  core::runEstimatedLoop(sc, cfg, ref, false, [&](const core::EstimatedSample& s) {
+    const std::uint64_t k = static_cast<std::uint64_t>(std::llround(s.loop->t * 1e9));
+    const auto t = rec.truth.find(k);
+    const auto e = rec.estimate.find(k);
+    if (t == rec.truth.end() || e == rec.estimate.end()) {
+      ++missing;
+      return;
+    }
+    const core::State& x = *s.loop->state;
+    const double dt = std::max({std::fabs(t->second.x - x[core::X]), std::fabs(t->second.y - x[core::Y]),
+                                std::fabs(t->second.theta - core::yawThroughQuaternion(x[core::THETA]))});
+    const double de = std::max(
+        {std::fabs(e->second.x - s.fed.x), std::fabs(e->second.y - s.fed.y), std::fabs(e->second.theta - s.fed.theta)});
+    truth_diff = std::max(truth_diff, dt);
+    estimate_diff = std::max(estimate_diff, de);
+    fed_max = std::max(fed_max, std::hypot(s.fed.x - x[core::X], s.fed.y - x[core::Y]));
+    unequal += (dt != 0.0 || de != 0.0);
+    ++compared;
+  });
+  std::printf(
+      "fused lockstep: %lld periods compared (%lld missing), %lld unequal; largest difference node - in-process: "
+      "truth %.3g, estimate %.3g; estimate error %.4f m\n",
+      static_cast<long long>(compared), static_cast<long long>(missing), static_cast<long long>(unequal), truth_diff,
+      estimate_diff, fed_max);
+  EXPECT_EQ(compared, sc.steps() + 1);
+  EXPECT_EQ(unequal, 0);
+  EXPECT_EQ(truth_diff, 0.0);
+  EXPECT_EQ(estimate_diff, 0.0);
+}
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "fused_lockstep_tester");
+  return RUN_ALL_TESTS();
+}
