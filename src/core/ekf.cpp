@@ -27,6 +27,9 @@ const ParamTable<EkfParams>& ekfTable() {
              "odometry's own covariance"),
       number("estimator/odometry/heading_noise", &P::heading_noise, 0.03, Limits::closed(0.0, 10.0), "rad/√m",
              "encoder heading error per square root of the distance rolled (uneven slip, track width)"),
+      number("estimator/odometry/increment_sigma", &P::increment_sigma, 1.19e-4, Limits::closed(0.0, 1.0), "m",
+             "std of one wheel-travel increment from the encoders' quantisation, as the filter believes it "
+             "(2048 ticks per turn on R = 0.095 m: R 2π/2048/√6 = 1.19e-4)"),
       number("estimator/bias/walk", &P::bias_walk, 1e-4, Limits::closed(0.0, 1.0), "rad/s/√s",
              "random walk of the yaw-rate sensor's bias"),
       flag("estimator/bias/estimate", &P::estimate_bias, true,
@@ -224,6 +227,14 @@ Eigen::Matrix2d wheelTravelCovariance(double d_right, double d_left, double half
   c(0, 0) = 0.25 * (qr + ql);
   c(1, 1) = 0.25 * (qr + ql) / (half_track * half_track);
   c(0, 1) = c(1, 0) = 0.25 * (qr - ql) / half_track;
+  return c;
+}
+
+Eigen::Matrix2d encoderIncrementCovariance(double increment_sigma, double half_track) {
+  const double q = increment_sigma * increment_sigma;
+  Eigen::Matrix2d c = Eigen::Matrix2d::Zero();
+  c(0, 0) = 0.5 * q;
+  c(1, 1) = 0.5 * q / (half_track * half_track);
   return c;
 }
 

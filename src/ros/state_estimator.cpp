@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "sowing_robot/core/types.h"
+#include "sowing_robot/core/validation.h"
 #include "sowing_robot/ros/component_params.h"
 #include "sowing_robot/ros/msg_checks.h"
 #include "sowing_robot/ros/node_failure.h"
@@ -10,24 +11,37 @@
 namespace sowing_robot {
 namespace {
 
-core::EkfParams loadParams(ros::NodeHandle nh, ros::NodeHandle pnh) {
-  ParamReader p(pnh);
-  loadRunSettings(nh, p);
-  core::EkfParams params;
-  loadTable(p, core::ekfTable(), params);
-  requireValid(p, params.validate());
-  logSettings("state_estimator", core::ekfTable(), params);
-  return params;
-}
-
 /// Variance of a message's covariance entry; "unknown" (negative, or not finite) as 0 (the estimator's
 /// process noise then stands alone).
 double knownVariance(double v) { return std::isfinite(v) && v > 0.0 ? v : 0.0; }
 
 }  // namespace
 
-StateEstimator::StateEstimator(ros::NodeHandle nh, ros::NodeHandle pnh)
-    : ekf_(loadParams(nh, pnh)), fixes_(ekf_.params().fix_delay) {
+struct StateEstimator::Loaded {
+  core::EkfParams params;
+  double half_track = 0.0;  // [m] the URDF's nominal L: turns the wheels' increments into a heading change
+};
+
+StateEstimator::Loaded StateEstimator::loadParams(ros::NodeHandle nh, ros::NodeHandle pnh) {
+  ParamReader p(pnh);
+  p.allow("robot_description");
+  loadRunSettings(nh, p);
+  Loaded out;
+  core::RobotParams robot;
+  const std::string robot_error = loadRobotParams(pnh, robot);
+  loadTable(p, core::ekfTable(), out.params);
+  requireValid(p, core::firstError({robot_error, robot_error.empty() ? robot.validate() : "", out.params.validate()}));
+  out.half_track = robot.L;
+  logSettings("state_estimator", core::ekfTable(), out.params);
+  return out;
+}
+
+StateEstimator::StateEstimator(ros::NodeHandle nh, ros::NodeHandle pnh) : StateEstimator(nh, pnh, loadParams(nh, pnh)) {}
+
+StateEstimator::StateEstimator(ros::NodeHandle nh, ros::NodeHandle pnh, const Loaded& loaded)
+    : ekf_(loaded.params),
+      fixes_(loaded.params.fix_delay),
+      increment_covariance_(core::encoderIncrementCovariance(loaded.params.increment_sigma, loaded.half_track)) {
   filtered_pub_ = nh.advertise<nav_msgs::Odometry>("odometry/filtered", kLockstepQueue);
   const auto hints = ros::TransportHints().tcpNoDelay();
   odom_sub_ = nh.subscribe("odom", kLockstepQueue, &StateEstimator::odomCallback, this, hints);
@@ -98,6 +112,7 @@ void StateEstimator::step() {
     in.dtheta = core::wrapAngle(b.theta - a.theta);
     const double mid = a.theta + 0.5 * in.dtheta;
     in.distance = (b.x - a.x) * std::cos(mid) + (b.y - a.y) * std::sin(mid);
+    in.covariance = increment_covariance_;  // the quantisation of the two encoders (core/ekf.h says why)
     in.has_rate = imu.angular_velocity_covariance[0] >= 0.0;  // -1: no rate in this message
     in.rate = rate;
     in.rate_variance = knownVariance(imu.angular_velocity_covariance[8]);

@@ -494,7 +494,8 @@ SensorRun runWithSensors(std::uint64_t seed, double seconds, double dropout_star
     EkfStepInput in;
     in.distance = odo.delta_s;
     in.dtheta = odo.delta_theta;
-    in.covariance = wheelTravelCovariance(odo.delta_right, odo.delta_left, L, k);
+    in.covariance = wheelTravelCovariance(odo.delta_right, odo.delta_left, L, k) +
+                    encoderIncrementCovariance(ep.increment_sigma, L);  // as state_estimator adds it
     in.has_rate = true;
     in.rate = gyro.measure(dth / dt);
     in.rate_variance = gyro.noise() * gyro.noise();
@@ -523,11 +524,14 @@ SensorRun runWithSensors(std::uint64_t seed, double seconds, double dropout_star
 }  // namespace
 
 // KNOWN GAP (found with these tests, not resolved): fed by the quantised encoders of core/sensors.h
-// the filter is overconfident, mean NEES about 9 (dropout: 22) against 4, although fed by Gaussian
-// increments (NeesWithinChiSquareBoundsOverLongRuns) it is consistent, and with the quantisation made
-// negligible (ticks_per_turn 1e7) the mean NEES is 3.0. Adding incrementVariance() per increment
-// (which overstates the telescoping quantisation) still leaves 5.7. The cause is not found yet; the
-// bounds are kept here, disabled, so that whoever finds it has the failing check.
+// the filter is overconfident in position. Before the increments carried their quantisation covariance
+// (encoderIncrementCovariance, as state_estimator now adds it) the mean NEES was about 9 (dropout: 22)
+// against 4; with it, 5.7 against the 95 % interval [3.05, 5.07], and per state (squared error over the
+// marginal variance) x 1.9, y 2.1, theta 1.1, bias 0.6: the position variance is about half the error's,
+// the heading is consistent and the bias is conservative. Fed by Gaussian increments
+// (NeesWithinChiSquareBoundsOverLongRuns) the filter is consistent, and with the quantisation made
+// negligible (ticks_per_turn 1e7) the mean NEES is 3.0. The cause of the position's share is not found
+// yet; the bounds are kept here, disabled, so that whoever finds it has the failing check.
 TEST(EkfWithSensors, DISABLED_NeesWithinChiSquareBounds) {
   std::vector<NeesRun> runs;
   for (std::uint64_t seed = 1; seed <= 30; ++seed) {
@@ -587,4 +591,17 @@ TEST(EkfWithSensors, ThroughTheSensorsDropoutTheCovarianceGrowsAndComesBack) {
   EXPECT_GT(end_of_dropout, 3.0 * before);
   EXPECT_LT(after, 1.5 * before);
   EXPECT_LT(worst_in, 0.25);  // 0.19 m seen: about 5 of its sigmas (the overconfidence of the disabled test)
+}
+
+// The quantisation covariance of one step is that of (d_r + d_l)/2 and (d_r - d_l)/(2L) for two
+// independent wheel increments of std s: J diag(s², s²) Jᵀ.
+TEST(EkfInputs, EncoderIncrementCovarianceIsThatOfTheTwoWheels) {
+  const double s = 1.19e-4, L = 0.24;
+  Eigen::Matrix2d J;
+  J << 0.5, 0.5, 1.0 / (2.0 * L), -1.0 / (2.0 * L);
+  const Eigen::Matrix2d expected = J * (s * s * Eigen::Matrix2d::Identity()) * J.transpose();
+  const Eigen::Matrix2d c = encoderIncrementCovariance(s, L);
+  EXPECT_LT((c - expected).cwiseAbs().maxCoeff(), 1e-12 * expected.cwiseAbs().maxCoeff());
+  EXPECT_GT(c(1, 1), 0.0);
+  EXPECT_EQ(encoderIncrementCovariance(0.0, L), Eigen::Matrix2d::Zero());
 }

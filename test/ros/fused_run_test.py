@@ -24,13 +24,6 @@ WALL_TIMEOUT = 500.0
 
 
 class FusedRun(unittest.TestCase):
-    # Known bug (README, known limitations): the node gives the EKF zero covariance for the encoder
-    # increments, so with the gyro-bias state on, the bias absorbs the encoders' quantisation at high yaw
-    # rates (0.24 rad/s within 10 ms, true 0.002) and the estimate runs away. Worked around by
-    # estimator/bias/estimate false (config/estimator.yaml): the estimate then stays within 7.8 cm on the
-    # line (this test's bound is 5 cm) and within 0.59 m through the dropout (bound 0.25 m). Skipped until
-    # the increment covariance is passed, so that it does not block every landing.
-    @unittest.skip("known bug: zero encoder-increment covariance in state_estimator (README, known limitations)")
     def test_fused_run(self):
         rospy.init_node("fused_run_test")
         duration = rospy.get_param("/run/duration")

@@ -45,6 +45,7 @@ struct EkfParams {
   EkfParams();
   double distance_noise;       ///< [m/sqrt(m)] encoder distance error per sqrt(metre rolled)
   double heading_noise;        ///< [rad/sqrt(m)] encoder heading error per sqrt(metre rolled)
+  double increment_sigma;      ///< [m] std of one wheel-travel increment from the encoders' quantisation
   double bias_walk;            ///< [rad/s/sqrt(s)] random walk of the gyro bias
   bool estimate_bias;          ///< bias in the state; false: b = 0, no variance
   double initial_sigma_xy;     ///< [m]
@@ -57,7 +58,7 @@ struct EkfParams {
   /// checkRanges(): the first bad value as one line naming its key ("" when all are good).
   std::string validate() const;
 };
-/// estimator/{odometry/distance_noise, odometry/heading_noise, bias/walk, bias/estimate,
+/// estimator/{odometry/distance_noise, odometry/heading_noise, odometry/increment_sigma, bias/walk, bias/estimate,
 /// initial/sigma_xy, initial/sigma_theta, initial/sigma_bias, history/length, fix/gate, fix/delay}.
 const ParamTable<EkfParams>& ekfTable();
 
@@ -76,6 +77,14 @@ struct EkfStepInput {
 /// variance_per_metre |d_i| (Siegwart's odometry model, as core/sensors.h's travel_variance states it):
 /// distance = (d_r + d_l) / 2, dtheta = (d_r - d_l) / (2 half_track).
 Eigen::Matrix2d wheelTravelCovariance(double d_right, double d_left, double half_track, double variance_per_metre);
+
+/// Covariance of (distance, dtheta) of one step from the encoders' quantisation: each wheel's travel
+/// increment has the std increment_sigma, independently: diag(s²/2, s²/(2 L²)), L = half_track.
+/// Why per step although quantisation errors telescope: without it the filter takes a step's encoder
+/// heading change as exact, and at a high yaw rate (the thesis start turns at ~2 rad/s) the one-tick
+/// error of that change (R res / L in 1 ms, ~1 rad/s) goes into the gyro bias. Stated per step, the
+/// gyro (5e-6 rad per step) carries the heading between fixes and the bias is learnt from the fixes.
+Eigen::Matrix2d encoderIncrementCovariance(double increment_sigma, double half_track);
 
 /// A position fix of the axle midpoint, stamped with its measurement time.
 struct EkfFix {

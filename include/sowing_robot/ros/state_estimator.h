@@ -22,6 +22,9 @@ class StateEstimator {
   ~StateEstimator();
 
  private:
+  struct Loaded;  // the validated parameters and the URDF's half track
+  static Loaded loadParams(ros::NodeHandle nh, ros::NodeHandle pnh);
+  StateEstimator(ros::NodeHandle nh, ros::NodeHandle pnh, const Loaded& loaded);
   void odomCallback(const nav_msgs::Odometry::ConstPtr& msg);
   void imuCallback(const sensor_msgs::Imu::ConstPtr& msg);
   void fixCallback(const geometry_msgs::PoseWithCovarianceStamped::ConstPtr& msg);
@@ -31,6 +34,7 @@ class StateEstimator {
 
   core::Ekf ekf_;
   core::FixQueue fixes_;
+  Eigen::Matrix2d increment_covariance_;  // of each step's (distance, dtheta): the encoders' quantisation
   ros::Subscriber odom_sub_, imu_sub_, fix_sub_;
   ros::Publisher filtered_pub_;
   // Both streams come from the plant at the same rate on separate connections, either may run ahead
