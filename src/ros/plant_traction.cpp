@@ -38,10 +38,10 @@ std::string loadSoilPatches(ParamReader& p, const std::string& key, const core::
     const MapMember polygon{"polygon", [&patch](XmlRpc::XmlRpcValue& v, const std::string& item_name) {
                               return loadPolygon(v, item_name + "/polygon", patch.polygon);
                             }};
-    std::string e = readMembers(item, name,
-                                {polygon, numberMember("mu_peak", patch.mu_peak),
-                                 numberMember("mu_slide", patch.mu_slide),
-                                 numberMember("rolling_resistance", patch.rolling_resistance)});
+    std::string e =
+        readMembers(item, name,
+                    {polygon, numberMember("mu_peak", patch.mu_peak), numberMember("mu_slide", patch.mu_slide),
+                     numberMember("rolling_resistance", patch.rolling_resistance)});
     if (e.empty()) e = patch.validate(name);
     if (!e.empty()) return e;
     // The patch's grip must fit the field's slip curve too (slip_stiffness >= mu_peak / slip_peak).
