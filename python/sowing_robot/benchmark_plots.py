@@ -100,6 +100,15 @@ def _median(values):
     return v[n // 2] if n % 2 else 0.5 * (v[n // 2 - 1] + v[n // 2])
 
 
+def _save(fig, out_dir, name, title, written, **title_style):
+    """Titles, lays out, writes (DIR/name, 90 dpi) and closes one figure; appends its name to `written`."""
+    fig.suptitle(title, **title_style)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out_dir, name), dpi=90)
+    plt.close(fig)
+    written.append(name)
+
+
 def box_plots(rows, out_dir):
     """One PNG per metric; returns the file names written."""
     scenarios = _ordered(r["scenario"] for r in rows)
@@ -130,12 +139,7 @@ def box_plots(rows, out_dir):
                 ax.set_yscale("log")
         for j in range(len(panels), nrows * cols):
             axes[j // cols][j % cols].axis("off")
-        fig.suptitle(label)
-        fig.tight_layout()
-        name = f"box_{metric}.png"
-        fig.savefig(os.path.join(out_dir, name), dpi=90)
-        plt.close(fig)
-        written.append(name)
+        _save(fig, out_dir, f"box_{metric}.png", label, written)
     return written
 
 
@@ -161,13 +165,9 @@ def envelope_plots(envelopes, out_dir):
                 ax.set_ylim(-lim, lim)
         axes[0, 0].legend(fontsize=7, loc="upper right")
         axes[-1, 0].set_xlabel("t [s]")
-        fig.suptitle(f"{s}: cross-track envelope over the runs (y range: after the first 30 % of the run)",
-                     fontsize=9)
-        fig.tight_layout()
-        name = f"envelope_{s}.png"
-        fig.savefig(os.path.join(out_dir, name), dpi=90)
-        plt.close(fig)
-        written.append(name)
+        _save(fig, out_dir, f"envelope_{s}.png",
+              f"{s}: cross-track envelope over the runs (y range: after the first 30 % of the run)", written,
+              fontsize=9)
     return written
 
 
@@ -187,12 +187,7 @@ def sweep_plots(rows, out_dir):
             ax.set_ylabel(m)
             ax.set_yscale("log")
         axes[0].legend(fontsize=7)
-        fig.suptitle(s)
-        fig.tight_layout()
-        name = f"sweep_{s}.png"
-        fig.savefig(os.path.join(out_dir, name), dpi=90)
-        plt.close(fig)
-        written.append(name)
+        _save(fig, out_dir, f"sweep_{s}.png", s, written)
     return written
 
 

@@ -48,30 +48,56 @@ bool xmlNumber(const XmlRpc::XmlRpcValue& v, double& out) {
   return false;
 }
 
-std::string loadObstacles(ParamReader& p, const std::string& key, std::vector<core::Obstacle>& out) {
-  out.clear();
+std::string forEachMap(ParamReader& p, const std::string& key, const std::string& shape, const MapVisitor& visit) {
   p.allow(key);
   const std::string full = p.handle().resolveName(key);
   if (!p.handle().hasParam(key)) return "";
   XmlRpc::XmlRpcValue list;
   if (!p.handle().getParam(key, list) || list.getType() != XmlRpc::XmlRpcValue::TypeArray)
-    return "parameter " + full + " must be a list of {x, y, radius} maps";
+    return "parameter " + full + " must be a list of " + shape + " maps";
   for (int i = 0; i < list.size(); ++i) {
     const std::string name = full + "[" + std::to_string(i) + "]";
     XmlRpc::XmlRpcValue& item = list[i];
-    if (item.getType() != XmlRpc::XmlRpcValue::TypeStruct) return name + " must be a map {x, y, radius}";
-    core::Obstacle o;
-    for (auto it = item.begin(); it != item.end(); ++it) {
-      double* field = it->first == "x" ? &o.x : it->first == "y" ? &o.y : it->first == "radius" ? &o.radius : nullptr;
-      if (!field) return name + ": unknown key '" + it->first + "' (allowed: x, y, radius)";
-      if (!xmlNumber(it->second, *field)) return name + "/" + it->first + " must be a number";
-    }
-    if (!item.hasMember("x") || !item.hasMember("y")) return name + " needs both x and y";
-    const std::string e = o.validate();
-    if (!e.empty()) return name + ": " + e;
-    out.push_back(o);
+    if (item.getType() != XmlRpc::XmlRpcValue::TypeStruct) return name + " must be a map " + shape;
+    const std::string e = visit(name, item);
+    if (!e.empty()) return e;
   }
   return "";
+}
+
+MapMember numberMember(const std::string& key, double& out) {
+  return {key, [key, &out](XmlRpc::XmlRpcValue& value, const std::string& name) -> std::string {
+            return xmlNumber(value, out) ? "" : name + "/" + key + " must be a number";
+          }};
+}
+
+std::string readMembers(XmlRpc::XmlRpcValue& map, const std::string& name, const std::vector<MapMember>& members) {
+  for (auto it = map.begin(); it != map.end(); ++it) {
+    const auto m = std::find_if(members.begin(), members.end(), [&](const MapMember& c) { return c.key == it->first; });
+    if (m == members.end()) {
+      std::string allowed;
+      for (const MapMember& c : members) allowed += (allowed.empty() ? "" : ", ") + c.key;
+      return name + ": unknown key '" + it->first + "' (allowed: " + allowed + ")";
+    }
+    const std::string e = m->read(it->second, name);
+    if (!e.empty()) return e;
+  }
+  return "";
+}
+
+std::string loadObstacles(ParamReader& p, const std::string& key, std::vector<core::Obstacle>& out) {
+  out.clear();
+  return forEachMap(p, key, "{x, y, radius}", [&out](const std::string& name, XmlRpc::XmlRpcValue& item) {
+    core::Obstacle o;
+    const std::string e =
+        readMembers(item, name, {numberMember("x", o.x), numberMember("y", o.y), numberMember("radius", o.radius)});
+    if (!e.empty()) return e;
+    if (!item.hasMember("x") || !item.hasMember("y")) return name + " needs both x and y";
+    const std::string invalid = o.validate();
+    if (!invalid.empty()) return name + ": " + invalid;
+    out.push_back(o);
+    return std::string();
+  });
 }
 
 void requireValid(const ParamReader& p, const std::string& validate_message) {

@@ -31,7 +31,12 @@ LockstepDriver::~LockstepDriver() {
 }
 
 void LockstepDriver::publishStep(std::int64_t k) {
-  plant_.publish(k, plant_.visualStep(k) || k == protocol_.lastStep());
+  const bool last = k == protocol_.lastStep();
+  // The end-of-run report goes out before the final state, which no step follows: once that state is out,
+  // run_monitor may end the run at any moment (as nodelets it ends the whole manager, and a report made
+  // when the last torque came back was lost with it, 1 run in a few).
+  if (last) reportFinished();
+  plant_.publish(k, plant_.visualStep(k) || last);
 }
 
 void LockstepDriver::torqueCallback(const WheelTorque::ConstPtr& msg) {
@@ -45,9 +50,7 @@ void LockstepDriver::torqueCallback(const WheelTorque::ConstPtr& msg) {
       }
       publishStep(protocol_.awaited());
       return;
-    case Answer::kFinish:
-      // Reported here, at once: a headless launch may end (run_monitor is done) before run() looks again.
-      reportFinished();
+    case Answer::kFinish:  // the answer to the final state: reported when that state went out (publishStep)
       return;
     case Answer::kLate:
       ROS_WARN_THROTTLE(1.0, "plant_sim: late wheel torque for t=%.6f while at t=%.6f ignored (%ld so far)",
@@ -129,7 +132,7 @@ void LockstepDriver::run() {
     core::LockstepProtocol::Supervision s;
     bool over = false;
     {
-      std::lock_guard<std::recursive_mutex> lock(queue_.mutex());
+      DeferringInlineQueue::Hold hold(queue_);
       s = protocol_.tick(now, connected);
       if (s.start) {
         publishStep(0);  // from here on the torque callback drives the steps
@@ -146,7 +149,7 @@ void LockstepDriver::run() {
     if (over) break;
     poll.sleep();
   }
-  std::lock_guard<std::recursive_mutex> lock(queue_.mutex());
+  DeferringInlineQueue::Hold hold(queue_);
   if (protocol_.phase() == core::LockstepProtocol::Phase::kDiverged)
     throw NodeFailure(ExitCode::kDiverged, plant_.divergence());
 }

@@ -30,36 +30,19 @@ std::string loadPolygon(XmlRpc::XmlRpcValue& list, const std::string& name, std:
 std::string loadSoilPatches(ParamReader& p, const std::string& key, const core::TractionParams& ground,
                             std::vector<core::SoilPatch>& out) {
   out.clear();
-  p.allow(key);
-  const std::string full = p.handle().resolveName(key);
-  if (!p.handle().hasParam(key)) return "";
-  XmlRpc::XmlRpcValue list;
-  if (!p.handle().getParam(key, list) || list.getType() != XmlRpc::XmlRpcValue::TypeArray)
-    return "parameter " + full + " must be a list of {polygon, mu_peak, mu_slide, rolling_resistance} maps";
-  for (int i = 0; i < list.size(); ++i) {
-    const std::string name = full + "[" + std::to_string(i) + "]";
-    XmlRpc::XmlRpcValue& item = list[i];
-    if (item.getType() != XmlRpc::XmlRpcValue::TypeStruct)
-      return name + " must be a map {polygon, mu_peak, mu_slide, rolling_resistance}";
+  const auto visit = [&ground, &out](const std::string& name, XmlRpc::XmlRpcValue& item) {
     core::SoilPatch patch;
     patch.mu_peak = ground.mu_peak;
     patch.mu_slide = ground.mu_slide;
     patch.rolling_resistance = ground.rolling_resistance;
-    for (auto it = item.begin(); it != item.end(); ++it) {
-      if (it->first == "polygon") {
-        const std::string e = loadPolygon(it->second, name + "/polygon", patch.polygon);
-        if (!e.empty()) return e;
-        continue;
-      }
-      double* field = it->first == "mu_peak"              ? &patch.mu_peak
-                      : it->first == "mu_slide"           ? &patch.mu_slide
-                      : it->first == "rolling_resistance" ? &patch.rolling_resistance
-                                                          : nullptr;
-      if (!field)
-        return name + ": unknown key '" + it->first + "' (allowed: polygon, mu_peak, mu_slide, rolling_resistance)";
-      if (!xmlNumber(it->second, *field)) return name + "/" + it->first + " must be a number";
-    }
-    const std::string e = patch.validate(name);
+    const MapMember polygon{"polygon", [&patch](XmlRpc::XmlRpcValue& v, const std::string& item_name) {
+                              return loadPolygon(v, item_name + "/polygon", patch.polygon);
+                            }};
+    std::string e =
+        readMembers(item, name,
+                    {polygon, numberMember("mu_peak", patch.mu_peak), numberMember("mu_slide", patch.mu_slide),
+                     numberMember("rolling_resistance", patch.rolling_resistance)});
+    if (e.empty()) e = patch.validate(name);
     if (!e.empty()) return e;
     // The patch's grip must fit the field's slip curve too (slip_stiffness >= mu_peak / slip_peak).
     core::TractionParams t = ground;
@@ -69,8 +52,9 @@ std::string loadSoilPatches(ParamReader& p, const std::string& key, const core::
     const std::string curve = t.validate();
     if (!curve.empty()) return name + "/mu_peak: with the field's slip curve, " + curve;
     out.push_back(patch);
-  }
-  return "";
+    return std::string();
+  };
+  return forEachMap(p, key, "{polygon, mu_peak, mu_slide, rolling_resistance}", visit);
 }
 
 TractionModel::TractionModel(ros::NodeHandle nh, const core::RobotParams& robot,

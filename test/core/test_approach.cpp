@@ -7,25 +7,13 @@
 #include <vector>
 
 #include "sowing_robot/core/field_run.h"
+#include "thesis_field_fixture.h"
 
 using namespace sowing_robot::core;
 
 namespace {
 
-/// The thesis field (config/field_thesis.yaml) closed loop: ATSMC, disturbance 2.75 N m at 3 rad/s, 20 %
-/// mismatch, start (-1, 0, 0), 1 kHz; peaks over the whole run.
-FieldRunSetup thesisField() {
-  FieldRunSetup s;
-  s.scenario.duration = 110.0;
-  s.field.rows = 1;
-  s.field.row_length = 100.0;
-  s.field.start_x = 0.0;
-  s.field.start_y = 3.0;
-  s.field.potential.beta = 4.0;
-  s.obstacles = {{20.0, 3.0, 0.3}, {50.0, 3.0, 0.3}, {80.0, 3.0, 0.3}};
-  s.scenario.duration += approachExtraTime(s);
-  return s;
-}
+using test::thesisField;  // config/field_thesis.yaml's closed loop; peaks over the whole run
 
 FieldParams withStart(FieldParams f, Pose2D start) {
   f.start_pose = start;

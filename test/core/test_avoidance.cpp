@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "sowing_robot/core/field_run.h"
+#include "thesis_field_fixture.h"
 
 using namespace sowing_robot::core;
 
@@ -18,21 +19,10 @@ constexpr double kMargin = 0.1;
 /// (-1, 0, 0) to the row 3 m away and the whole-run peaks are test_approach's.
 constexpr double kOnRow = 12.0;
 
+/// The thesis field (thesis_field_fixture.h), its peaks taken once the robot is on the row.
 FieldRunSetup thesisField() {
-  FieldRunSetup s;
-  s.scenario.duration = 110.0;
-  s.field.rows = 1;
-  s.field.row_length = 100.0;
-  s.field.start_x = 0.0;
-  s.field.start_y = 3.0;
-  s.field.potential.alpha = 4.0;
-  s.field.potential.beta = 4.0;
-  s.field.potential.influence_distance = 0.5;
-  s.field.potential.gain = 5.0;
-  s.field.potential.tangential_ratio = 1.0;
-  s.obstacles = {{20.0, 3.0, 0.3}, {50.0, 3.0, 0.3}, {80.0, 3.0, 0.3}};
+  FieldRunSetup s = test::thesisField();
   s.peaks_from = kOnRow;
-  s.scenario.duration += approachExtraTime(s);  // the run ends at the row's end, as without the approach
   return s;
 }
 

@@ -61,8 +61,11 @@ class FusedRun(unittest.TestCase):
                 rospy.Subscriber("/rosout", Log, on_log, queue_size=1000)]
         self.assertTrue(done.wait(WALL_TIMEOUT), "the run did not reach t = %g s (last ground_truth %s)"
                         % (duration, max(truth) * 1e-9 if truth else None))
-        deadline = time.time() + 30.0  # the last messages of the final step, on other connections
-        while time.time() < deadline and (len(filtered) < len(odom) or not finished):
+        # The last messages of the final step come on other connections: wait until odom and
+        # odometry/filtered both have the final stamp (plant_sim reports before it publishes that step).
+        final = int(round(duration * 1e9))
+        deadline = time.time() + 30.0
+        while time.time() < deadline and (final not in odom or final not in filtered or not finished):
             time.sleep(0.05)
         for s in subs:
             s.unregister()

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -50,11 +51,34 @@ void logSettings(const char* node, const core::ParamTable<S>& table, const S& s,
   ROS_INFO("%s: %s", node, table.describe(s, prefix).c_str());
 }
 
-/// The list `key` of {x, y, radius} maps (radius optional, default core::Obstacle's); marks `key` as read.
-/// Returns "" or one line naming the bad entry (absent key: empty list).
 /// A number (int or double) from an XmlRpc value; false for any other type.
 bool xmlNumber(const XmlRpc::XmlRpcValue& v, double& out);
 
+/// Reads one map of a list-of-maps parameter: gets the map and its name for errors ("<full key>[i]");
+/// returns "" or one line naming what is wrong.
+using MapVisitor = std::function<std::string(const std::string& name, XmlRpc::XmlRpcValue& map)>;
+
+/// Walks the list-of-maps parameter `key` (relative to p; marked as read). Absent: nothing to walk, "".
+/// Not a list: "parameter <full> must be a list of <shape> maps"; an item not a map: "<full>[i] must be a
+/// map <shape>" (shape e.g. "{x, y, radius}"); else each map goes to `visit`, in order, and its first
+/// error is returned.
+std::string forEachMap(ParamReader& p, const std::string& key, const std::string& shape, const MapVisitor& visit);
+
+/// One allowed key of a map and how its value is read: read(value, map's name) returns "" or the error.
+struct MapMember {
+  std::string key;
+  std::function<std::string(XmlRpc::XmlRpcValue& value, const std::string& name)> read;
+};
+
+/// A member that is a number (int or double) into `out`; otherwise "<name>/<key> must be a number".
+MapMember numberMember(const std::string& key, double& out);
+
+/// Reads every member of `map` with its MapMember; a key with none: "<name>: unknown key 'k' (allowed:
+/// <the members' keys>)". Returns the first error ("" if none); absent members are left as they were.
+std::string readMembers(XmlRpc::XmlRpcValue& map, const std::string& name, const std::vector<MapMember>& members);
+
+/// The list `key` of {x, y, radius} maps (radius optional, default core::Obstacle's); marks `key` as read.
+/// Returns "" or one line naming the bad entry (absent key: empty list).
 std::string loadObstacles(ParamReader& p, const std::string& key, std::vector<core::Obstacle>& out);
 
 /// Everything one node needs checked: reader errors, unknown keys, then the given validate() text.

@@ -5,8 +5,9 @@
 // Threads: the wheel_torque callback runs inline where the torque is received (roscpp's network thread,
 // or in a nodelet manager the thread that published it) and steps the plant and publishes the next
 // state there, with no hand-over between threads. run()'s thread only supervises: it starts the run,
-// re-sends a state nobody answered, reports a stall, gives up. Both hold queue_.mutex() while they
-// touch the protocol or the plant.
+// re-sends a state nobody answered, reports a stall, gives up. Both hold queue_'s mutex while they
+// touch the protocol or the plant; a torque that comes while run()'s thread holds it is run by that
+// thread when it lets go (DeferringInlineQueue: waiting for it there could deadlock a nodelet run).
 #pragma once
 
 #include <ros/ros.h>
@@ -16,7 +17,7 @@
 
 #include "sowing_robot/WheelTorque.h"
 #include "sowing_robot/core/lockstep.h"
-#include "sowing_robot/ros/inline_callback_queue.h"
+#include "sowing_robot/ros/deferring_callback_queue.h"
 #include "sowing_robot/ros/plant_sim_driver.h"
 #include "sowing_robot/ros/plant_sim_plant.h"
 #include "sowing_robot/ros/ready_roster.h"
@@ -59,7 +60,7 @@ class LockstepDriver : public PlantSimDriver {
   SimulatedPlant& plant_;
   Config cfg_;
   std::atomic<bool> stop_{false};
-  InlineCallbackQueue queue_;  // its mutex guards plant_ and protocol_
+  DeferringInlineQueue queue_;  // its mutex guards plant_ and protocol_
   core::LockstepProtocol protocol_;
   ReadyRoster roster_;
   ros::Subscriber torque_sub_;  // last: unsubscribed before the members its callback uses go
