@@ -36,7 +36,8 @@ StateEstimator::Loaded StateEstimator::loadParams(ros::NodeHandle nh, ros::NodeH
   return out;
 }
 
-StateEstimator::StateEstimator(ros::NodeHandle nh, ros::NodeHandle pnh) : StateEstimator(nh, pnh, loadParams(nh, pnh)) {}
+StateEstimator::StateEstimator(ros::NodeHandle nh, ros::NodeHandle pnh)
+    : StateEstimator(nh, pnh, loadParams(nh, pnh)) {}
 
 StateEstimator::StateEstimator(ros::NodeHandle nh, ros::NodeHandle pnh, const Loaded& loaded)
     : ekf_(loaded.params),
@@ -54,7 +55,8 @@ StateEstimator::~StateEstimator() {
   const core::FixCounts& c = ekf_.counts();
   ROS_INFO(
       "state_estimator: fixes applied %ld, refused %ld (older than the history %ld, newer than the estimate "
-      "%ld, invalid %ld, gated %ld), re-anchored %ld, applied late %ld, lost from a full queue %ld; inputs rejected %ld",
+      "%ld, invalid %ld, gated %ld), re-anchored %ld, applied late %ld, lost from a full queue %ld; inputs rejected "
+      "%ld",
       c.applied, c.refused(), c.too_old, c.future, c.invalid, c.gated, c.reanchored, late_fixes_, fixes_.dropped(),
       rejected_inputs_);
 }

@@ -656,12 +656,13 @@ SlipRun runThroughSlip(int reanchor_after) {
 // unless the filter re-anchors after fix/reanchor_after gated fixes in a row.
 TEST(EkfReanchor, AfterGatedFixesInARowTheFixBecomesThePosition) {
   const SlipRun never = runThroughSlip(0), after5 = runThroughSlip(5);
-  std::printf("through 10 s of 50 %% slip: without re-anchoring %ld of %ld fixes gated, error %.2f m late on; "
-              "re-anchoring after 5: %ld re-anchored, %ld gated, error %.3f m\n",
-              never.counts.gated, never.counts.gated + never.counts.applied, never.late_error,
-              after5.counts.reanchored, after5.counts.gated, after5.late_error);
+  std::printf(
+      "through 10 s of 50 %% slip: without re-anchoring %ld of %ld fixes gated, error %.2f m late on; "
+      "re-anchoring after 5: %ld re-anchored, %ld gated, error %.3f m\n",
+      never.counts.gated, never.counts.gated + never.counts.applied, never.late_error, after5.counts.reanchored,
+      after5.counts.gated, after5.late_error);
   EXPECT_EQ(never.counts.reanchored, 0);
-  EXPECT_GT(never.late_error, 1.0);   // lost
+  EXPECT_GT(never.late_error, 1.0);  // lost
   EXPECT_GT(after5.counts.reanchored, 0);
   // At most ~(5 gated + 1) fix intervals + the 0.1 s delay of 0.5 m/s drift: 0.35 m, plus the drift that
   // the fixes applied after an anchor only partly correct.
