@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "sowing_robot/core/bench_text.h"
 #include "sowing_robot/core/estimated_bench.h"
 #include "sowing_robot/core/validation.h"
 
@@ -35,30 +36,6 @@ std::string checkUniform(const char* name, const Uniform& u) {
   if (!allFinite(u.lo, u.hi)) return std::string(name) + " bounds must be finite";
   if (u.lo > u.hi) return std::string(name) + ": lo " + formatNumber(u.lo) + " > hi " + formatNumber(u.hi);
   return "";
-}
-
-std::string number(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
-
-std::string shortNumber(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.4g", v);
-  return buf;
-}
-
-/// Lateral error in the reference's frame (cross-track for a line or a row).
-double crossTrack(const LoopSample& s) {
-  const double th = s.reference->pose.theta;
-  // sin(+-0) = +-0 and cos(+-0) = 1 exactly: a line or a row along x needs no sincos every period.
-  double sn = th, c = 1.0;
-  if (th != 0.0) {
-    sn = std::sin(th);
-    c = std::cos(th);
-  }
-  return -sn * s.ex + c * s.ey;
 }
 
 /// Per-run extras of a benchmark scenario: the body checked against obstacles, the cross-track series.
@@ -179,6 +156,18 @@ double quantile(const std::vector<double>& sorted, double q) {
 }
 
 }  // namespace
+
+std::string csvNumber(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+std::string shortNumber(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.4g", v);
+  return buf;
+}
 
 std::string MonteCarloSpec::validate() const {
   std::string e = firstError(
@@ -429,12 +418,12 @@ std::string runsCsvLines(const std::string& scenario, const std::string& control
   std::string out;
   for (const RunRow& r : rows) {
     const RunDraw& d = r.draw;
-    out += scenario + "," + controller + "," + std::to_string(d.index) + "," + number(d.mass_scale) + "," +
-           number(d.inertia_scale) + "," + number(d.amplitude) + "," + number(d.phase) + "," +
-           std::to_string(d.noise_seed) + "," + number(d.start_x) + "," + number(d.start_y) + "," +
-           number(d.start_theta);
-    for (double x : metricValues(r)) out += "," + number(x);
-    out += "," + std::to_string(r.contacts) + "," + number(r.min_clearance) + "," + number(r.end_distance);
+    out += scenario + "," + controller + "," + std::to_string(d.index) + "," + csvNumber(d.mass_scale) + "," +
+           csvNumber(d.inertia_scale) + "," + csvNumber(d.amplitude) + "," + csvNumber(d.phase) + "," +
+           std::to_string(d.noise_seed) + "," + csvNumber(d.start_x) + "," + csvNumber(d.start_y) + "," +
+           csvNumber(d.start_theta);
+    for (double x : metricValues(r)) out += "," + csvNumber(x);
+    out += "," + std::to_string(r.contacts) + "," + csvNumber(r.min_clearance) + "," + csvNumber(r.end_distance);
     out += std::string(",") + (r.diverged ? "1" : "0") + "," + (r.success ? "1" : "0") + "," + r.failure;
     out += (realism ? estimatedCsvFields(r) : "") + "\n";
   }

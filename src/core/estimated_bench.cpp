@@ -7,6 +7,7 @@
 #include <memory>
 #include <stdexcept>
 
+#include "sowing_robot/core/bench_text.h"
 #include "sowing_robot/core/seeding.h"
 
 namespace sowing_robot {
@@ -18,24 +19,6 @@ const std::vector<std::string>& availableModels() {
 }
 
 namespace {
-
-std::string number(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
-
-std::string shortNumber(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.4g", v);
-  return buf;
-}
-
-/// Lateral error in the reference's frame (benchmark.cpp's crossTrack).
-double crossTrack(const LoopSample& s) {
-  const double th = s.reference->pose.theta;
-  return -std::sin(th) * s.ex + std::cos(th) * s.ey;
-}
 
 struct Extras {
   ContactMonitor* contacts = nullptr;
@@ -176,9 +159,9 @@ std::string estimatedCsvHeader() {
 
 std::string estimatedCsvFields(const RunRow& r) {
   if (!r.realism) return ",,nan,nan,nan,nan,nan,,";
-  return "," + std::to_string(r.draw.sensor_seed) + "," + number(r.max_slip) + "," + number(r.tool_down_time) + "," +
-         number(r.fed_error_rms) + "," + number(r.fed_error_max) + "," + number(r.odometry_error_max) + "," +
-         std::to_string(r.fixes_applied) + "," + std::to_string(r.fixes_refused);
+  return "," + std::to_string(r.draw.sensor_seed) + "," + csvNumber(r.max_slip) + "," + csvNumber(r.tool_down_time) +
+         "," + csvNumber(r.fed_error_rms) + "," + csvNumber(r.fed_error_max) + "," + csvNumber(r.odometry_error_max) +
+         "," + std::to_string(r.fixes_applied) + "," + std::to_string(r.fixes_refused);
 }
 
 std::string estimatedReportLine(const std::vector<RunRow>& rows) {
