@@ -10,7 +10,7 @@
 #include <stdexcept>
 #include <thread>
 
-#include "sowing_robot/core/bench_text.h"
+#include "sowing_robot/core/bench_row.h"
 #include "sowing_robot/core/estimated_bench.h"
 #include "sowing_robot/core/validation.h"
 
@@ -38,68 +38,13 @@ std::string checkUniform(const char* name, const Uniform& u) {
   return "";
 }
 
-/// Per-run extras of a benchmark scenario: the body checked against obstacles, the cross-track series.
-struct RunExtras {
-  ContactMonitor* contacts = nullptr;  ///< field tracks: the body against the obstacles
-  std::int64_t series_every = 0;       ///< sample the cross-track every this many periods (0: none)
-  Pose2D* last_reference = nullptr;    ///< gets the last reference pose (the finish check)
-};
-
 RunRow measure(const Scenario& sc, ReferenceSource& reference, const MonteCarloSpec& spec, const RunDraw& draw,
                const RunExtras& extras = {}) {
   RunRow row;
   row.draw = draw;
-  const double dt = secondsFromNanos(sc.control_period_ns);
-  std::int64_t count = 0, until_series = 0;  // periods to the next cross-track sample (no % per period)
-  WheelTorques prev, prev2;
-  double worst = 0.0, last = 0.0;
-  if (extras.series_every > 0)
-    row.cross_track_series.reserve(static_cast<std::size_t>(sc.steps() / extras.series_every + 1));
-  const RunResult r = runClosedLoop(sc, reference, true, [&](const LoopSample& s) {
-    // A period's torque is applied over the next dt: count it when the next sample arrives, so the
-    // last one (never applied) is left out of the effort and of the total variation.
-    if (count >= 1) row.effort += dt * (prev.right * prev.right + prev.left * prev.left);
-    if (count >= 2) row.chattering += std::fabs(prev.right - prev2.right) + std::fabs(prev.left - prev2.left);
-    const double e = crossTrack(s);
-    if (extras.series_every > 0) {  // at count = 0, series_every, 2 series_every, ...
-      if (until_series == 0) {
-        row.cross_track_series.push_back(e);
-        until_series = extras.series_every;
-      }
-      --until_series;
-    }
-    if (extras.contacts) extras.contacts->update(s.t, {(*s.state)[X], (*s.state)[Y], (*s.state)[THETA]});
-    if (extras.last_reference) *extras.last_reference = s.reference->pose;
-    prev2 = prev;
-    prev = s.control->torques;
-    ++count;
-    last = std::fabs(e);
-    if (s.t >= spec.settle_time) worst = std::max(worst, last);
-  });
-  row.metrics = r.metrics;
-  row.time_at_limit = dt * static_cast<double>(r.saturated_steps);
-  row.worst_cross_track = worst;
-  row.final_cross_track = last;
-  row.diverged = r.diverged;
-  row.min_clearance = std::numeric_limits<double>::quiet_NaN();
-  if (extras.last_reference)
-    row.end_distance =
-        std::hypot(r.final_state[X] - extras.last_reference->x, r.final_state[Y] - extras.last_reference->y);
-  if (extras.contacts) {
-    extras.contacts->finish();
-    row.contacts = extras.contacts->contactCount();
-    row.min_clearance = extras.contacts->minClearance();
-  }
-  if (r.diverged) {
-    const double inf = std::numeric_limits<double>::infinity();
-    row.effort = row.chattering = row.worst_cross_track = row.final_cross_track = inf;
-    row.failure = "diverged";
-  } else if (row.contacts > 0) {
-    row.failure = "contact";
-  } else if (!(worst < spec.cross_track_threshold)) {
-    row.failure = "cross-track";
-  }
-  row.success = row.failure.empty();
+  RowMeter meter(row, sc, spec, extras);
+  const RunResult r = runClosedLoop(sc, reference, true, [&](const LoopSample& s) { meter.add(s); });
+  meter.finish(r);
   return row;
 }
 
@@ -261,8 +206,7 @@ std::vector<RunRow> runBenchmark(const BenchScenario& bench, std::int64_t runs, 
   if (bench.realism)  // sensors, traction or an estimate in the loop (issue 16): estimated_bench.h
     return parallelRows(runs, threads, progress,
                         [&]() { return [&bench](std::int64_t i) { return estimatedBenchRow(bench, i); }; });
-  const auto period_steps = static_cast<std::int64_t>(
-      std::max(1.0, std::round(bench.envelope_period / secondsFromNanos(base.control_period_ns))));
+  const std::int64_t period_steps = seriesEvery(bench);
   if (bench.track != TrackKind::field) {
     std::unique_ptr<ReferenceSource> proto;
     if (bench.track == TrackKind::line)
@@ -299,16 +243,7 @@ std::vector<RunRow> runBenchmark(const BenchScenario& bench, std::int64_t runs, 
       extras.series_every = period_steps;
       extras.last_reference = &last_ref;
       RunRow row = measure(sc, reference, spec, draw, extras);
-      // Not finished: the plan stops short of a row end, the path had not ended, or the robot is not at its end.
-      // (A contact or a divergence is the reason given before this one; a cross-track failure comes after.)
-      if (row.failure.empty() || row.failure == "cross-track") {
-        const bool stopped = reference.status().code != AvoidanceStatus::Code::kOk;
-        const bool ended = reference.finished(sc.duration);
-        if (stopped || !ended || !(row.end_distance < bench.finish_tolerance)) {
-          row.failure = "not finished";
-          row.success = false;
-        }
-      }
+      markNotFinished(row, reference, sc.duration, bench.finish_tolerance);
       return row;
     };
   });

@@ -7,7 +7,7 @@
 #include <memory>
 #include <stdexcept>
 
-#include "sowing_robot/core/bench_text.h"
+#include "sowing_robot/core/bench_row.h"
 #include "sowing_robot/core/seeding.h"
 
 namespace sowing_robot {
@@ -20,53 +20,16 @@ const std::vector<std::string>& availableModels() {
 
 namespace {
 
-struct Extras {
-  ContactMonitor* contacts = nullptr;
-  std::int64_t series_every = 0;
-  Pose2D* last_reference = nullptr;
-};
-
-/// benchmark.cpp's measure() over runEstimatedLoop: the same figures in the same order of operations (a
-/// truth-fed run without traction gives its row bit for bit: test_estimated_run), plus the loop's own.
+/// benchmark.cpp's measure() over runEstimatedLoop: the same figures (RowMeter; a truth-fed run without
+/// traction gives its row bit for bit: test_estimated_run), plus the loop's own.
 RunRow measureEstimated(const Scenario& sc, const EstimatedRunConfig& cfg, ReferenceSource& reference,
-                        const MonteCarloSpec& spec, const RunDraw& draw, const Extras& extras) {
+                        const MonteCarloSpec& spec, const RunDraw& draw, const RunExtras& extras) {
   RunRow row;
   row.draw = draw;
-  const double dt = secondsFromNanos(sc.control_period_ns);
-  std::int64_t count = 0;
-  WheelTorques prev, prev2;
-  double worst = 0.0, last = 0.0;
-  if (extras.series_every > 0)
-    row.cross_track_series.reserve(static_cast<std::size_t>(sc.steps() / extras.series_every + 1));
-  const EstimatedRunResult er = runEstimatedLoop(sc, cfg, reference, true, [&](const EstimatedSample& es) {
-    const LoopSample& s = *es.loop;
-    if (count >= 1) row.effort += dt * (prev.right * prev.right + prev.left * prev.left);
-    if (count >= 2) row.chattering += std::fabs(prev.right - prev2.right) + std::fabs(prev.left - prev2.left);
-    const double e = crossTrack(s);
-    if (extras.series_every > 0 && count % extras.series_every == 0) row.cross_track_series.push_back(e);
-    if (extras.contacts) extras.contacts->update(s.t, {(*s.state)[X], (*s.state)[Y], (*s.state)[THETA]});
-    if (extras.last_reference) *extras.last_reference = s.reference->pose;
-    prev2 = prev;
-    prev = s.control->torques;
-    ++count;
-    last = std::fabs(e);
-    if (s.t >= spec.settle_time) worst = std::max(worst, last);
-  });
-  const RunResult& r = er.run;
-  row.metrics = r.metrics;
-  row.time_at_limit = dt * static_cast<double>(r.saturated_steps);
-  row.worst_cross_track = worst;
-  row.final_cross_track = last;
-  row.diverged = r.diverged;
-  row.min_clearance = std::numeric_limits<double>::quiet_NaN();
-  if (extras.last_reference)
-    row.end_distance =
-        std::hypot(r.final_state[X] - extras.last_reference->x, r.final_state[Y] - extras.last_reference->y);
-  if (extras.contacts) {
-    extras.contacts->finish();
-    row.contacts = extras.contacts->contactCount();
-    row.min_clearance = extras.contacts->minClearance();
-  }
+  RowMeter meter(row, sc, spec, extras);
+  const EstimatedRunResult er =
+      runEstimatedLoop(sc, cfg, reference, true, [&](const EstimatedSample& es) { meter.add(*es.loop); });
+  meter.finish(er.run);
   row.realism = true;
   row.max_slip = er.max_abs_slip;
   row.tool_down_time = er.tool_down_time;
@@ -75,22 +38,7 @@ RunRow measureEstimated(const Scenario& sc, const EstimatedRunConfig& cfg, Refer
   row.odometry_error_max = er.odometry_error_max;
   row.fixes_applied = er.fixes.applied;
   row.fixes_refused = er.fixes.refused();
-  if (r.diverged) {
-    const double inf = std::numeric_limits<double>::infinity();
-    row.effort = row.chattering = row.worst_cross_track = row.final_cross_track = inf;
-    row.failure = "diverged";
-  } else if (row.contacts > 0) {
-    row.failure = "contact";
-  } else if (!(worst < spec.cross_track_threshold)) {
-    row.failure = "cross-track";
-  }
-  row.success = row.failure.empty();
   return row;
-}
-
-std::int64_t seriesEvery(const BenchScenario& bench) {
-  return static_cast<std::int64_t>(
-      std::max(1.0, std::round(bench.envelope_period / secondsFromNanos(bench.base.control_period_ns))));
 }
 
 }  // namespace
@@ -115,7 +63,7 @@ RunRow estimatedBenchRow(const BenchScenario& bench, std::int64_t index) {
   Scenario sc = applyDraw(bench.base, spec, draw);
   EstimatedRunConfig cfg = *bench.realism;
   cfg.sensors.seed = draw.sensor_seed;
-  Extras extras;
+  RunExtras extras;
   extras.series_every = seriesEvery(bench);
   if (bench.track == TrackKind::line) {
     LineReference reference(bench.line_v_r, bench.line_y, bench.line_x0);
@@ -141,14 +89,7 @@ RunRow estimatedBenchRow(const BenchScenario& bench, std::int64_t index) {
   extras.contacts = &contacts;
   extras.last_reference = &last_ref;
   RunRow row = measureEstimated(sc, cfg, reference, spec, draw, extras);
-  if (row.failure.empty() || row.failure == "cross-track") {
-    const bool stopped = reference.status().code != AvoidanceStatus::Code::kOk;
-    const bool ended = reference.finished(sc.duration);
-    if (stopped || !ended || !(row.end_distance < bench.finish_tolerance)) {
-      row.failure = "not finished";
-      row.success = false;
-    }
-  }
+  markNotFinished(row, reference, sc.duration, bench.finish_tolerance);
   return row;
 }
 

@@ -1,0 +1,136 @@
+// What the benchmark's two row writers share (benchmark.cpp for the ideal loop, estimated_bench.cpp for
+// the loop with sensors and an estimate): the numbers of the CSV and of the report, the lateral error,
+// the per-period figures of a row and its failure reasons, so that a row means the same whichever loop
+// made it.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <string>
+
+#include "sowing_robot/core/benchmark.h"
+#include "sowing_robot/core/contact.h"
+#include "sowing_robot/core/field.h"
+#include "sowing_robot/core/runner.h"
+
+namespace sowing_robot {
+namespace core {
+
+/// %.17g: a double that reads back to the same bits (runs.csv).
+std::string csvNumber(double v);
+/// %.4g (report.md).
+std::string shortNumber(double v);
+
+/// Lateral error in the reference's frame (cross-track for a line or a row).
+inline double crossTrack(const LoopSample& s) {
+  const double th = s.reference->pose.theta;
+  // sin(+-0) = +-0 and cos(+-0) = 1 exactly: a line or a row along x needs no sincos every period.
+  double sn = th, c = 1.0;
+  if (th != 0.0) {
+    sn = std::sin(th);
+    c = std::cos(th);
+  }
+  return -sn * s.ex + c * s.ey;
+}
+
+/// Periods between two samples of a scenario's cross-track series (its envelope_period, at least 1).
+inline std::int64_t seriesEvery(const BenchScenario& bench) {
+  return static_cast<std::int64_t>(
+      std::max(1.0, std::round(bench.envelope_period / secondsFromNanos(bench.base.control_period_ns))));
+}
+
+/// Per-run extras of a benchmark scenario: the body checked against obstacles, the cross-track series.
+struct RunExtras {
+  ContactMonitor* contacts = nullptr;  ///< field tracks: the body against the obstacles
+  std::int64_t series_every = 0;       ///< sample the cross-track every this many periods (0: none)
+  Pose2D* last_reference = nullptr;    ///< gets the last reference pose (the finish check)
+};
+
+/// A row's figures, fed every period's sample (add(), inline: it runs in the loop's callback), then
+/// written into the row with the failure reason (finish()).
+class RowMeter {
+ public:
+  RowMeter(RunRow& row, const Scenario& sc, const MonteCarloSpec& spec, const RunExtras& extras)
+      : row_(row), spec_(spec), extras_(extras), dt_(secondsFromNanos(sc.control_period_ns)) {
+    if (extras.series_every > 0)
+      row.cross_track_series.reserve(static_cast<std::size_t>(sc.steps() / extras.series_every + 1));
+  }
+
+  void add(const LoopSample& s) {
+    // A period's torque is applied over the next dt: count it when the next sample arrives, so the
+    // last one (never applied) is left out of the effort and of the total variation.
+    if (count_ >= 1) row_.effort += dt_ * (prev_.right * prev_.right + prev_.left * prev_.left);
+    if (count_ >= 2) row_.chattering += std::fabs(prev_.right - prev2_.right) + std::fabs(prev_.left - prev2_.left);
+    const double e = crossTrack(s);
+    if (extras_.series_every > 0) {  // at count = 0, series_every, 2 series_every, ... (no % per period)
+      if (until_series_ == 0) {
+        row_.cross_track_series.push_back(e);
+        until_series_ = extras_.series_every;
+      }
+      --until_series_;
+    }
+    if (extras_.contacts) extras_.contacts->update(s.t, {(*s.state)[X], (*s.state)[Y], (*s.state)[THETA]});
+    if (extras_.last_reference) *extras_.last_reference = s.reference->pose;
+    prev2_ = prev_;
+    prev_ = s.control->torques;
+    ++count_;
+    last_ = std::fabs(e);
+    if (s.t >= spec_.settle_time) worst_ = std::max(worst_, last_);
+  }
+
+  /// The run's metrics, time at the limit, cross-track, body and end distance into the row, and its
+  /// failure: diverged, else contact, else cross-track (the finish check comes after: markNotFinished).
+  void finish(const RunResult& r) {
+    row_.metrics = r.metrics;
+    row_.time_at_limit = dt_ * static_cast<double>(r.saturated_steps);
+    row_.worst_cross_track = worst_;
+    row_.final_cross_track = last_;
+    row_.diverged = r.diverged;
+    row_.min_clearance = std::numeric_limits<double>::quiet_NaN();
+    if (extras_.last_reference)
+      row_.end_distance =
+          std::hypot(r.final_state[X] - extras_.last_reference->x, r.final_state[Y] - extras_.last_reference->y);
+    if (extras_.contacts) {
+      extras_.contacts->finish();
+      row_.contacts = extras_.contacts->contactCount();
+      row_.min_clearance = extras_.contacts->minClearance();
+    }
+    if (r.diverged) {
+      const double inf = std::numeric_limits<double>::infinity();
+      row_.effort = row_.chattering = row_.worst_cross_track = row_.final_cross_track = inf;
+      row_.failure = "diverged";
+    } else if (row_.contacts > 0) {
+      row_.failure = "contact";
+    } else if (!(worst_ < spec_.cross_track_threshold)) {
+      row_.failure = "cross-track";
+    }
+    row_.success = row_.failure.empty();
+  }
+
+ private:
+  RunRow& row_;
+  const MonteCarloSpec& spec_;
+  const RunExtras& extras_;
+  const double dt_;
+  std::int64_t count_ = 0, until_series_ = 0;
+  WheelTorques prev_, prev2_;
+  double worst_ = 0.0, last_ = 0.0;
+};
+
+/// A field run's finish check: not finished when the plan stops short of a row end, the path had not
+/// ended, or the robot is not within `tolerance` of its end. A contact or a divergence is the reason
+/// given before this one; a cross-track failure comes after.
+inline void markNotFinished(RunRow& row, const FieldReference& reference, double duration, double tolerance) {
+  if (!row.failure.empty() && row.failure != "cross-track") return;
+  const bool stopped = reference.status().code != AvoidanceStatus::Code::kOk;
+  const bool ended = reference.finished(duration);
+  if (stopped || !ended || !(row.end_distance < tolerance)) {
+    row.failure = "not finished";
+    row.success = false;
+  }
+}
+
+}  // namespace core
+}  // namespace sowing_robot
