@@ -1,6 +1,8 @@
 #include "sowing_robot/ros/run_monitor.h"
 
 #include <chrono>
+#include <cmath>
+#include <cstdint>
 #include <cstdio>
 
 #include "sowing_robot/core/runner.h"
@@ -18,6 +20,7 @@ RunMonitor::RunMonitor(ros::NodeHandle nh, ros::NodeHandle pnh) : pnh_(pnh) {
   loadTable(p, core::RunMonitorSettings::table(), settings);
   requireValid(p, core::firstError({settings.validate(), core::checkPositive("run/duration", run.duration, "s")}));
   duration_ = run.duration;
+  if (run.lockstep) expected_samples_ = std::llround(duration_ * 1e9 / static_cast<double>(run.periodNs())) + 1;
   output_ = settings.output;
   label_ = settings.label;
   exit_at_end_ = settings.exit_at_end;
@@ -68,6 +71,16 @@ void RunMonitor::finish() {
   // The table goes to stdout once, as plain text (it used to be logged with ROS_INFO as well, so every
   // run printed it twice).
   ROS_INFO("run_monitor: %zu samples up to t = %.3f s", metrics_.samples(), last_.toSec());
+  // In lockstep every period is stepped once, so a missing one is a lost message, not timing: say so
+  // rather than hand out metrics that quietly differ from the same run's.
+  const auto samples = static_cast<std::int64_t>(metrics_.samples());
+  if (expected_samples_ > 0 && samples != expected_samples_)
+    ROS_ERROR(
+        "run_monitor: %ld of the run's %ld periods were scored (%zu messages dropped unpaired): the metrics "
+        "miss the rest",
+        samples, expected_samples_, inputs_.dropped());
+  else if (inputs_.dropped() > 0)
+    ROS_WARN("run_monitor: %zu messages dropped unpaired", inputs_.dropped());
   std::printf("%s", core::metricsTable({label_}, {m}).c_str());
   std::fflush(stdout);
   if (!output_.empty() && !core::writeMetricsYaml(output_, label_, m))

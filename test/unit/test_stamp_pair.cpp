@@ -102,3 +102,26 @@ TEST(StampPair, TellsAGridMismatchFromAReferenceOnItsWay) {
   EXPECT_TRUE(p.secondsPassed(ros::Time(0.001)));   // a newer reference, none for 0.001: off grid
   EXPECT_FALSE(p.secondsPassed(ros::Time(0.002)));  // nothing newer: still on its way
 }
+
+TEST(StampPair, HoldsStatesThatRunAheadOfTheirReferences) {
+  // A listener the plant does not wait for (run_monitor, seed_drill): the states of many periods can
+  // come before the first of their references. Every one must still pair, in turn, and none be lost.
+  sowing_robot::ListenerPair<Msg, Msg> p;
+  for (int k = 0; k < 500; ++k) EXPECT_FALSE(p.setFirst(at(0.001 * k, k)));
+  for (int k = 0; k < 500; ++k) {
+    ASSERT_TRUE(p.setSecond(at(0.001 * k, -k))) << k;
+    EXPECT_EQ(p.first().tag, k);
+    EXPECT_EQ(p.second().tag, -k);
+  }
+  EXPECT_EQ(p.dropped(), 0u);
+  EXPECT_EQ(p.heldFirsts(), 1u);  // the last pair's, until the next call
+}
+
+TEST(StampPair, CountsWhatAFullStreamDrops) {
+  StampPair<Msg, Msg, 4, 16> p;
+  for (int k = 0; k < 10; ++k) p.setFirst(at(0.001 * k, k));
+  EXPECT_EQ(p.dropped(), 6u);
+  EXPECT_TRUE(p.setSecond(at(0.009)));
+  for (int k = 10; k < 13; ++k) p.setFirst(at(0.001 * k, k));  // room again after the pair: none dropped
+  EXPECT_EQ(p.dropped(), 6u);
+}

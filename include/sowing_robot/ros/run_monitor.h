@@ -50,7 +50,10 @@ class RunMonitor {
   core::MetricsAccumulator metrics_;
   ros::Time last_;
   ros::NodeHandle pnh_;
-  StampPair<nav_msgs::Odometry, ReferenceState> inputs_;  // the reference is sent ahead of the state
+  // The reference is sent ahead of the state, but the plant does not wait for this node: under load its
+  // states can arrive seconds ahead of their references, so both streams hold a whole lookahead's worth.
+  ListenerPair<nav_msgs::Odometry, ReferenceState> inputs_;
+  std::int64_t expected_samples_ = 0;  // lockstep: every period of the run, both ends included (0: not checked)
   ros::Subscriber truth_sub_, ref_sub_, recorder_sub_;
 
   // The wait for the recorder: a thread of its own with a bounded wait, not a ros::WallTimer: roscpp's

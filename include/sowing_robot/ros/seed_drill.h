@@ -35,9 +35,11 @@ class SeedDrillNode {
   void publishReport();
 
   core::SeedDrillSettings settings_;
-  std::unique_ptr<core::SeedDrill> drill_;                ///< null until the first plan
-  double tool_x_ = 0.0, tool_y_ = 0.0;                    // tool point in base_link [m]
-  StampPair<nav_msgs::Odometry, ReferenceState> inputs_;  // the reference is sent ahead of the state
+  std::unique_ptr<core::SeedDrill> drill_;  ///< null until the first plan
+  double tool_x_ = 0.0, tool_y_ = 0.0;      // tool point in base_link [m]
+  // The reference is sent ahead of the state, but the plant does not wait for this node: its states can
+  // arrive far ahead of their references, so both streams hold a whole lookahead's worth (stamp_pair.h).
+  ListenerPair<nav_msgs::Odometry, ReferenceState> inputs_;
   ros::Subscriber plan_sub_, odom_sub_, ref_sub_;
   ros::Publisher seeds_pub_, report_pub_;
   visualization_msgs::Marker chunk_;  // the current SPHERE_LIST of up to kChunk seeds

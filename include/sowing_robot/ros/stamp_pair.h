@@ -11,8 +11,11 @@
 namespace sowing_robot {
 
 /// Each stream keeps the messages newer than the last pair handed out, up to its cap (then the oldest
-/// goes): the second stream must hold every reference the generator sends ahead of the state
-/// (lookahead / control period of them, 50 at the defaults), the first only the newest few states.
+/// goes, counted by dropped()): the second stream must hold every reference the generator sends ahead
+/// of the state (lookahead / control period of them, 50 at the defaults). The controllers, which the
+/// plant waits for, need only the newest few states in the first; a listener the plant does not wait for
+/// (run_monitor, seed_drill) can see the states run far ahead of the references (another connection,
+/// another process) and must hold them all until their references come.
 template <typename A, typename B, std::size_t kMaxFirsts = 8, std::size_t kMaxSeconds = 8192>
 class StampPair {
  public:
@@ -21,12 +24,12 @@ class StampPair {
   bool setFirst(const A& a) {
     prune();
     firsts_.push(a, kMaxFirsts);
-    return match();
+    return matchNewest(firsts_, first_index_, seconds_, second_index_);
   }
   bool setSecond(const B& b) {
     prune();
     seconds_.push(b, kMaxSeconds);
-    return match();
+    return matchNewest(seconds_, second_index_, firsts_, first_index_);
   }
   const A& first() const { return firsts_.at(first_index_); }
   const B& second() const { return seconds_.at(second_index_); }
@@ -38,6 +41,9 @@ class StampPair {
   /// Messages held (tests, diagnostics).
   std::size_t heldFirsts() const { return firsts_.count; }
   std::size_t heldSeconds() const { return seconds_.count; }
+  /// Messages pushed out by a full stream before they were paired (or passed): each is a stamp that
+  /// will never pair.
+  std::size_t dropped() const { return firsts_.dropped + seconds_.dropped; }
   /// A second stamped after `stamp` is held: a first stamped `stamp` with no second means the two
   /// streams are on different time grids (a control_rate mismatch), not a second still on its way.
   bool secondsPassed(const ros::Time& stamp) const {
@@ -51,7 +57,7 @@ class StampPair {
   template <typename T>
   struct Ring {
     std::vector<T> items = std::vector<T>(2);
-    std::size_t head = 0, count = 0;
+    std::size_t head = 0, count = 0, dropped = 0;
     const T& at(std::size_t i) const { return items[(head + i) % items.size()]; }
     void push(const T& m, std::size_t cap) {
       if (count == items.size()) {
@@ -62,6 +68,7 @@ class StampPair {
           head = 0;
         } else {
           popFront();
+          ++dropped;
         }
       }
       items[(head + count) % items.size()] = m;
@@ -85,25 +92,23 @@ class StampPair {
     seconds_.dropUpTo(last_);
   }
 
-  bool match() {
-    bool found = false;
-    ros::Time best;
-    for (std::size_t i = 0; i < firsts_.count; ++i) {
-      const ros::Time& stamp = firsts_.at(i).header.stamp;
-      if ((handed_out_ && stamp <= last_) || (found && stamp <= best)) continue;
-      for (std::size_t j = 0; j < seconds_.count; ++j) {
-        if (seconds_.at(j).header.stamp != stamp) continue;
-        found = true;
-        best = stamp;
-        first_index_ = i;
-        second_index_ = j;
-        break;
-      }
+  /// Only the message just stored (the newest of `added`) can complete a pair: after every call no
+  /// two held messages newer than the last pair share a stamp (a match hands out the newest, and what
+  /// is older goes with the next prune()), so one pass over the other stream finds it.
+  template <typename X, typename Y>
+  bool matchNewest(const Ring<X>& added, std::size_t& added_index, const Ring<Y>& other, std::size_t& other_index) {
+    const std::size_t i = added.count - 1;
+    const ros::Time& stamp = added.at(i).header.stamp;
+    if (handed_out_ && stamp <= last_) return false;
+    for (std::size_t j = 0; j < other.count; ++j) {
+      if (other.at(j).header.stamp != stamp) continue;
+      added_index = i;
+      other_index = j;
+      last_ = stamp;
+      handed_out_ = true;
+      return true;
     }
-    if (!found) return false;
-    last_ = best;
-    handed_out_ = true;
-    return true;
+    return false;
   }
 
   Ring<A> firsts_;
@@ -112,5 +117,10 @@ class StampPair {
   bool handed_out_ = false;
   ros::Time last_;
 };
+
+/// For a node the plant does not wait for (run_monitor, seed_drill) or one whose two inputs come from
+/// different processes at the same pace (state_estimator): either stream can run a whole lookahead ahead.
+template <typename A, typename B>
+using ListenerPair = StampPair<A, B, 8192, 8192>;
 
 }  // namespace sowing_robot

@@ -39,7 +39,7 @@ class StateEstimator {
   ros::Publisher filtered_pub_;
   // Both streams come from the plant at the same rate on separate connections, either may run ahead
   // (a burst from a recorder replay, a busy core in realtime): hold up to a few seconds of either.
-  StampPair<nav_msgs::Odometry, sensor_msgs::Imu, 8192, 8192> inputs_;
+  ListenerPair<nav_msgs::Odometry, sensor_msgs::Imu> inputs_;
   nav_msgs::Odometry last_odom_;  // the previous step's odom: the increments are taken from it
   nav_msgs::Odometry filtered_;   // the last answer (republished when the plant asks again)
   long rejected_inputs_ = 0, late_fixes_ = 0;
