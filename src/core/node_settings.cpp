@@ -213,6 +213,19 @@ const ParamTable<SeedDrillSettings>& SeedDrillSettings::table() {
 
 SeedDrillSettings::SeedDrillSettings() { table().applyDefaults(*this); }
 
+const ParamTable<StateEstimatorSettings>& StateEstimatorSettings::table() {
+  using S = StateEstimatorSettings;
+  static const ParamTable<S> table({
+      text("fix_source", &S::fix_source, "",
+           "lockstep only: the node (relative name) whose sensors/fix keys (rate, dropout) say when the plant "
+           "measures a fix; each step then waits for the fixes it is due to apply, so a run does not depend on "
+           "which connection delivers first (sim.launch: plant_sim). \"\": apply the fixes that have come"),
+  });
+  return table;
+}
+
+StateEstimatorSettings::StateEstimatorSettings() { table().applyDefaults(*this); }
+
 const ParamTable<RunMonitorSettings>& RunMonitorSettings::table() {
   using S = RunMonitorSettings;
   static const ParamTable<S> table({

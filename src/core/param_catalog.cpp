@@ -130,7 +130,7 @@ const std::vector<CatalogSection>& parameterCatalog() {
       {"state_estimator",
        "the EKF of feedback:=fused (core/ekf.h): pose and yaw-rate bias from the encoders, the yaw rate and the "
        "late position fix",
-       infos(ekfTable()),
+       concat(StateEstimatorSettings::table(), ekfTable()),
        {}},
       {"run_monitor", "the metric table at the end of a run", infos(RunMonitorSettings::table()), {}},
       {"pso_tuner",

@@ -181,7 +181,26 @@ double YawRateSensor::measure(double omega_true) {
 
 // --- PositionFixSensor -----------------------------------------------------------------------------
 
-PositionFixSensor::PositionFixSensor(const SensorParams& params) : params_(params) {
+void FixSchedule::reset(double t0) {
+  t0_ = t0;
+  next_ = 0;
+}
+
+bool FixSchedule::inDropout(double stamp) const {
+  return params_.dropout_duration > 0.0 && stamp >= params_.dropout_start - kTimeTolerance &&
+         stamp < params_.dropout_start + params_.dropout_duration - kTimeTolerance;
+}
+
+bool FixSchedule::sample(double t) {
+  const double due_at = t0_ + static_cast<double>(next_) / params_.rate;
+  if (t < due_at - kTimeTolerance) return false;
+  // Catch up past slots a coarse caller skipped (t is the first call at or after each one's time): one
+  // measurement per call, the rest of the skipped slots are gone.
+  next_ = static_cast<std::int64_t>(std::floor((t - t0_) * params_.rate + kTimeTolerance)) + 1;
+  return true;
+}
+
+PositionFixSensor::PositionFixSensor(const SensorParams& params) : params_(params), schedule_(params.fix) {
   requireValid(params);
   reset(0.0);
 }
@@ -190,23 +209,12 @@ void PositionFixSensor::reset(double t0) {
   if (!std::isfinite(t0)) throw std::invalid_argument("position fix reset: non-finite time");
   rng_ = sensorGenerator(params_.seed, kFixSeedOffset);
   normal_.reset();
-  t0_ = t0;
-  next_ = 0;
+  schedule_.reset(t0);
   pending_.clear();
 }
 
-bool PositionFixSensor::inDropout(double stamp) const {
-  const FixParams& f = params_.fix;
-  return f.dropout_duration > 0.0 && stamp >= f.dropout_start - kTimeTolerance &&
-         stamp < f.dropout_start + f.dropout_duration - kTimeTolerance;
-}
-
 bool PositionFixSensor::sample(double t, const Pose2D& truth) {
-  const double due_at = t0_ + static_cast<double>(next_) / params_.fix.rate;
-  if (t < due_at - kTimeTolerance) return false;
-  // Catch up past samples a coarse caller skipped (t is the first call at or after each one's time):
-  // one measurement per call, the rest of the skipped slots are gone.
-  next_ = static_cast<std::int64_t>(std::floor((t - t0_) * params_.fix.rate + kTimeTolerance)) + 1;
+  if (!schedule_.sample(t)) return false;
   FixMeasurement m;
   m.stamp = t;
   m.sigma = params_.fix.sigma;

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "sowing_robot/core/node_settings.h"
 #include "sowing_robot/core/types.h"
 #include "sowing_robot/core/validation.h"
 #include "sowing_robot/ros/component_params.h"
@@ -20,19 +21,39 @@ double knownVariance(double v) { return std::isfinite(v) && v > 0.0 ? v : 0.0; }
 struct StateEstimator::Loaded {
   core::EkfParams params;
   double half_track = 0.0;  // [m] the URDF's nominal L: turns the wheels' increments into a heading change
+  std::unique_ptr<core::FixParams> fix_schedule;  // lockstep with fix_source: when the plant measures fixes
 };
 
 StateEstimator::Loaded StateEstimator::loadParams(ros::NodeHandle nh, ros::NodeHandle pnh) {
   ParamReader p(pnh);
   p.allow("robot_description");
-  loadRunSettings(nh, p);
+  const core::RunSettings run = loadRunSettings(nh, p);
   Loaded out;
   core::RobotParams robot;
   const std::string robot_error = loadRobotParams(pnh, robot);
+  core::StateEstimatorSettings settings;
+  loadTable(p, core::StateEstimatorSettings::table(), settings);
   loadTable(p, core::ekfTable(), out.params);
-  requireValid(p, core::firstError({robot_error, robot_error.empty() ? robot.validate() : "", out.params.validate()}));
+  std::string schedule_error;
+  if (!settings.fix_source.empty() && run.lockstep) {
+    // Another node's keys, read but not owned: plant_sim checks them (and refuses unknown ones) itself.
+    ParamReader source(ros::NodeHandle(nh, settings.fix_source));
+    core::SensorParams sensors;
+    loadTable(source, core::sensorsTable(), sensors);
+    schedule_error = core::firstError({source.error(), sensors.validate()});
+    if (!schedule_error.empty()) schedule_error = "fix_source " + settings.fix_source + ": " + schedule_error;
+    out.fix_schedule = std::make_unique<core::FixParams>(sensors.fix);
+  }
+  requireValid(p, core::firstError({robot_error, robot_error.empty() ? robot.validate() : "", settings.validate(),
+                                    out.params.validate(), schedule_error}));
   out.half_track = robot.L;
+  logSettings("state_estimator", core::StateEstimatorSettings::table(), settings);
   logSettings("state_estimator", core::ekfTable(), out.params);
+  if (out.fix_schedule)
+    ROS_INFO("state_estimator: lockstep: each step waits for the fixes due by it (%s's fix at %.3f Hz)",
+             settings.fix_source.c_str(), out.fix_schedule->rate);
+  else if (!settings.fix_source.empty())
+    ROS_INFO("state_estimator: fix_source %s ignored: not in lockstep", settings.fix_source.c_str());
   return out;
 }
 
@@ -43,6 +64,7 @@ StateEstimator::StateEstimator(ros::NodeHandle nh, ros::NodeHandle pnh, const Lo
     : ekf_(loaded.params),
       fixes_(loaded.params.fix_delay),
       increment_covariance_(core::encoderIncrementCovariance(loaded.params.increment_sigma, loaded.half_track)) {
+  if (loaded.fix_schedule) await_ = std::make_unique<core::FixAwait>(*loaded.fix_schedule, loaded.params.fix_delay);
   filtered_pub_ = nh.advertise<nav_msgs::Odometry>("odometry/filtered", kLockstepQueue);
   const auto hints = ros::TransportHints().tcpNoDelay();
   odom_sub_ = nh.subscribe("odom", kLockstepQueue, &StateEstimator::odomCallback, this, hints);
@@ -55,10 +77,10 @@ StateEstimator::~StateEstimator() {
   const core::FixCounts& c = ekf_.counts();
   ROS_INFO(
       "state_estimator: fixes applied %ld, refused %ld (older than the history %ld, newer than the estimate "
-      "%ld, invalid %ld, gated %ld), re-anchored %ld, applied late %ld, lost from a full queue %ld; inputs rejected "
-      "%ld",
+      "%ld, invalid %ld, gated %ld), re-anchored %ld, applied late %ld, lost from a full queue %ld, awaited but never "
+      "received %ld; inputs rejected %ld",
       c.applied, c.refused(), c.too_old, c.future, c.invalid, c.gated, c.reanchored, late_fixes_, fixes_.dropped(),
-      rejected_inputs_);
+      lost_fixes_, rejected_inputs_);
 }
 
 void StateEstimator::odomCallback(const nav_msgs::Odometry::ConstPtr& msg) {
@@ -66,11 +88,26 @@ void StateEstimator::odomCallback(const nav_msgs::Odometry::ConstPtr& msg) {
     ROS_WARN_THROTTLE(1.0, "state_estimator: rejected non-finite odom (%ld so far)", ++rejected_inputs_);
     return;
   }
-  if (inputs_.isRepeat(msg->header.stamp)) {  // the plant asked again: answer with the same numbers
-    publishShared(filtered_pub_, filtered_);
+  if (inputs_.isRepeat(msg->header.stamp)) {
+    if (held_.empty()) {  // the plant asked again: answer with the same numbers
+      publishShared(filtered_pub_, filtered_);
+      return;
+    }
+    // The plant gave up waiting for the answer (plant_sim/lockstep_retry): the fix held for is not coming.
+    // Go on without it rather than stall the run.
+    const double t = held_.front().odom.header.stamp.toSec();
+    double stamp = 0.0;
+    await_->waiting(t, stamp);
+    const int lost = await_->giveUp(t);
+    lost_fixes_ += lost;
+    ROS_ERROR(
+        "state_estimator: the fix stamped %.3f s never came (%d awaited for the step at t=%.3f s): going on without "
+        "it (is fix connected, and are fix_source's sensors/fix keys the plant's?)",
+        stamp, lost, t);
+    runHeld();
     return;
   }
-  if (inputs_.setFirst(*msg)) step();
+  if (inputs_.setFirst(*msg)) paired();
 }
 
 void StateEstimator::imuCallback(const sensor_msgs::Imu::ConstPtr& msg) {
@@ -78,7 +115,7 @@ void StateEstimator::imuCallback(const sensor_msgs::Imu::ConstPtr& msg) {
     ROS_WARN_THROTTLE(1.0, "state_estimator: rejected non-finite imu (%ld so far)", ++rejected_inputs_);
     return;
   }
-  if (inputs_.setSecond(*msg)) step();
+  if (inputs_.setSecond(*msg)) paired();
 }
 
 void StateEstimator::fixCallback(const geometry_msgs::PoseWithCovarianceStamped::ConstPtr& msg) {
@@ -97,11 +134,36 @@ void StateEstimator::fixCallback(const geometry_msgs::PoseWithCovarianceStamped:
                       fix.stamp, ekf_.time(), late_fixes_);
   }
   fixes_.push(fix);
+  if (!await_) return;
+  await_->received(fix.stamp);
+  runHeld();
 }
 
-void StateEstimator::step() {
+void StateEstimator::paired() {
   const nav_msgs::Odometry& odom = inputs_.first();
-  const sensor_msgs::Imu& imu = inputs_.second();
+  if (!await_) {
+    step(odom, inputs_.second());
+    return;
+  }
+  await_->step(odom.header.stamp.toSec(), !ekf_.initialised() && held_.empty());
+  double stamp = 0.0;
+  if (held_.empty() && !await_->waiting(odom.header.stamp.toSec(), stamp)) {
+    step(odom, inputs_.second());
+    return;
+  }
+  // Copies: the pair refers into inputs_, which the next message may prune.
+  held_.push_back({odom, inputs_.second()});
+}
+
+void StateEstimator::runHeld() {
+  double stamp = 0.0;
+  while (!held_.empty() && !await_->waiting(held_.front().odom.header.stamp.toSec(), stamp)) {
+    step(held_.front().odom, held_.front().imu);
+    held_.pop_front();
+  }
+}
+
+void StateEstimator::step(const nav_msgs::Odometry& odom, const sensor_msgs::Imu& imu) {
   const double t = odom.header.stamp.toSec();
   const double rate = imu.angular_velocity.z;
   if (!ekf_.initialised()) {
@@ -137,10 +199,11 @@ void StateEstimator::step() {
     reported_ = c;
   }
   last_odom_ = odom;
-  publish(odom, rate);
+  publish(odom, imu);
 }
 
-void StateEstimator::publish(const nav_msgs::Odometry& odom, double rate) {
+void StateEstimator::publish(const nav_msgs::Odometry& odom, const sensor_msgs::Imu& imu) {
+  const double rate = imu.angular_velocity.z;
   const core::Ekf::Vector& m = ekf_.mean();
   const core::Ekf::Matrix& p = ekf_.covariance();
   filtered_.header = odom.header;
@@ -161,7 +224,7 @@ void StateEstimator::publish(const nav_msgs::Odometry& odom, double rate) {
   filtered_.twist = odom.twist;
   filtered_.twist.twist.angular.z = rate - m(core::Ekf::BIAS);
   filtered_.twist.covariance[35] =
-      p(core::Ekf::BIAS, core::Ekf::BIAS) + knownVariance(inputs_.second().angular_velocity_covariance[8]);
+      p(core::Ekf::BIAS, core::Ekf::BIAS) + knownVariance(imu.angular_velocity_covariance[8]);
   publishShared(filtered_pub_, filtered_);
 }
 

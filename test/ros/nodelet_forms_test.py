@@ -110,13 +110,10 @@ class NodeletForms(unittest.TestCase):
     def test_traction(self):
         self.check_traction_acted(self.check_forms_agree((11681, 11682)))
 
-    # Found by this test (full suite, 03:25 UTC): the two forms differed in one of the estimator's fix-gate
-    # decisions (12 fixes outside the gate as nodelets, 11 as processes, 82 applied in both), so the
-    # metrics differed at the 1e-9 level. The fix topic is not part of the lockstep: when a late fix
-    # arrives relative to the odom steps depends on the threads, and the gate depends on the estimate at
-    # arrival. Passed in 3 of 4 runs. Skipped until state_estimator applies fixes at a deterministic step
-    # (state_estimator / ekf are not this branch's files), so that it does not block landings.
-    @unittest.skip("known: state_estimator's fix gating depends on when the fix arrives (nondeterministic across forms)")
+    # Found by this test: the forms once differed in one fix-gate decision (12 fixes gated as nodelets, 11 as
+    # processes): the fix came on a connection of its own, and whether it came before the estimate passed
+    # its stamp + fix/delay depended on the threads. state_estimator now keeps the plant's fix schedule
+    # (fix_source, core/fix_await.h) and holds a step until the fixes due by it have come.
     def test_traction_fused(self):
         self.check_traction_acted(self.check_forms_agree((11683, 11684), "feedback:=fused"))
 

@@ -101,6 +101,14 @@ struct SeedDrillSettings {
   static const ParamTable<SeedDrillSettings>& table();
 };
 
+/// state_estimator's own keys (the filter's are core/ekf.h's ekfTable()).
+struct StateEstimatorSettings {
+  StateEstimatorSettings();
+  std::string fix_source;
+  std::string validate() const { return table().checkRanges(*this); }
+  static const ParamTable<StateEstimatorSettings>& table();
+};
+
 /// run_monitor: where the metrics go and whether the run ends with them.
 struct RunMonitorSettings {
   RunMonitorSettings();

@@ -148,6 +148,27 @@ struct FixMeasurement {
   double sigma = 0.0;  ///< [m] std of x and of y
 };
 
+/// When the position fix is measured: at t0 and every 1/rate after, each slot taken at the first call at or
+/// after its time; none delivered inside the dropout. PositionFixSensor keeps one; state_estimator keeps its
+/// own copy in lockstep, to know which fixes are on their way (it waits for them, so a run does not depend
+/// on which connection delivers first).
+class FixSchedule {
+ public:
+  explicit FixSchedule(const FixParams& params) : params_(params) {}
+  /// First slot at t0.
+  void reset(double t0);
+  /// Call every step, t increasing: true when a measurement is taken at t (also inside a dropout). A caller
+  /// that skipped slots gets one measurement, the rest are gone.
+  bool sample(double t);
+  /// A stamp inside the dropout window (measured but never delivered).
+  bool inDropout(double stamp) const;
+
+ private:
+  FixParams params_;
+  double t0_ = 0.0;
+  std::int64_t next_ = 0;  // index of the next slot: due at t0 + next_ / rate
+};
+
 class PositionFixSensor {
  public:
   /// Throws std::invalid_argument for invalid params.
@@ -160,15 +181,14 @@ class PositionFixSensor {
   /// The measurements delivered by time t (stamp + latency <= t), oldest first; each is returned once.
   std::vector<FixMeasurement> due(double t);
   /// A stamp inside the dropout window.
-  bool inDropout(double stamp) const;
+  bool inDropout(double stamp) const { return schedule_.inDropout(stamp); }
   std::size_t pending() const { return pending_.size(); }
 
  private:
   SensorParams params_;
+  FixSchedule schedule_;
   std::mt19937_64 rng_;
   std::normal_distribution<double> normal_{0.0, 1.0};
-  double t0_ = 0.0;
-  std::int64_t next_ = 0;  // index of the next sample: due at t0 + next_ / rate
   std::deque<FixMeasurement> pending_;
 };
 
