@@ -1,0 +1,204 @@
+// sowing_robot.core.run_estimated: core::runEstimatedLoop (core/estimated_run.h) from Python: the closed loop
+// with the traction plant, the seeded sensors and the controllers fed the truth, the encoder odometry or the
+// EKF's estimate, scored on the truth. Its blocks take the nodes' keys (plant_sim's traction/ and sensors/,
+// state_estimator's estimator/), checked by the same tables, so a key or a range reads as the node's.
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "core_bindings.h"
+#include "sowing_robot/core/estimated_run.h"
+
+namespace py_core {
+namespace {
+
+/// A dict of a table's keys below `prefix` (nested dicts join with '/': {"fix": {"sigma": 0.05}} is
+/// prefix + "fix/sigma"), each checked against the table's type and range.
+template <typename S>
+void applyTableDict(const ParamTable<S>& table, S& s, const std::string& prefix, const py::handle& d,
+                    const std::string& what) {
+  if (!py::isinstance<py::dict>(d)) throw py::type_error(what + " must be a dict {key: value}");
+  for (const auto& kv : d.cast<py::dict>()) {
+    const std::string key = prefix + kv.first.cast<std::string>();
+    if (py::isinstance<py::dict>(kv.second)) {
+      applyTableDict(table, s, key + "/", kv.second, what);
+      continue;
+    }
+    const ParamEntry<S>* e = table.find(key);
+    if (!e) throw py::value_error(what + ": " + key + " is no parameter of this block");
+    ParamValue v = toParamValue(kv.second, key);
+    // An integer where the table wants a double (2 for 2.0) is that double.
+    if (std::holds_alternative<int>(v) && std::holds_alternative<double>(e->info.default_value))
+      v = static_cast<double>(std::get<int>(v));
+    const std::string error = e->info.check(v, "");
+    if (!error.empty()) throw py::value_error(what + ": " + error);
+    e->set(s, v);
+  }
+}
+
+/// {"polygon": [[x, y], ...], "mu_peak": .., "mu_slide": .., "rolling_resistance": ..}; a coefficient left out
+/// is the traction block's (as plant_sim reads field/patches).
+SoilPatch patchOf(const py::handle& item, const TractionParams& ground, std::size_t i) {
+  const std::string name = "patches[" + std::to_string(i) + "]";
+  if (!py::isinstance<py::dict>(item)) throw py::type_error(name + " must be a dict with a polygon");
+  const py::dict d = item.cast<py::dict>();
+  SoilPatch p;
+  p.mu_peak = ground.mu_peak;
+  p.mu_slide = ground.mu_slide;
+  p.rolling_resistance = ground.rolling_resistance;
+  for (const auto& kv : d) {
+    const std::string key = kv.first.cast<std::string>();
+    if (key == "polygon") {
+      for (const auto& v : kv.second) {
+        const auto xy = v.cast<std::vector<double>>();
+        if (xy.size() != 2) throw py::value_error(name + "/polygon: one [x, y] per vertex");
+        p.polygon.emplace_back(xy[0], xy[1]);
+      }
+    } else if (key == "mu_peak") {
+      p.mu_peak = kv.second.cast<double>();
+    } else if (key == "mu_slide") {
+      p.mu_slide = kv.second.cast<double>();
+    } else if (key == "rolling_resistance") {
+      p.rolling_resistance = kv.second.cast<double>();
+    } else {
+      throw py::value_error(name + ": unknown key '" + key + "' (polygon, mu_peak, mu_slide, rolling_resistance)");
+    }
+  }
+  const std::string e = p.validate(name);
+  if (!e.empty()) throw py::value_error(e);
+  return p;
+}
+
+/// The loop's trace (Trace's columns) and what the controllers were fed, the slip and the tool.
+struct EstimatedTrace {
+  Trace loop;
+  std::vector<std::string> names = {"fed_x",     "fed_y",      "fed_theta", "fed_v",
+                                    "fed_omega", "slip_right", "slip_left", "tool_down"};
+  std::vector<std::vector<double>> columns = std::vector<std::vector<double>>(names.size());
+
+  void reserve(std::size_t n) {
+    loop.reserve(n);
+    for (auto& c : columns) c.reserve(n);
+  }
+  void add(const EstimatedSample& s) {
+    loop.add(*s.loop);
+    const double row[] = {s.fed.x,     s.fed.y,      s.fed.theta, s.fed_v,
+                          s.fed_omega, s.slip_right, s.slip_left, s.tool_down ? 1.0 : 0.0};
+    for (std::size_t i = 0; i < columns.size(); ++i) columns[i].push_back(row[i]);
+  }
+  py::dict toDict() const {
+    py::dict d = loop.toDict();
+    for (std::size_t i = 0; i < names.size(); ++i) d[names[i].c_str()] = toArray(columns[i]);
+    return d;
+  }
+};
+
+py::dict fixCounts(const FixCounts& c, long lost_from_queue) {
+  py::dict d;
+  d["applied"] = c.applied;
+  d["reanchored"] = c.reanchored;
+  d["gated"] = c.gated;
+  d["too_old"] = c.too_old;
+  d["future"] = c.future;
+  d["invalid"] = c.invalid;
+  d["lost_from_queue"] = lost_from_queue;
+  return d;
+}
+
+py::dict runEstimatedPy(const std::string& controller, const py::object& params, const py::object& gains,
+                        const std::string& feedback, const py::object& traction, const py::object& patches,
+                        const py::object& sensors, const py::object& estimator, double duration,
+                        std::int64_t control_period_ns, bool disturbance, double mass_scale, double inertia_scale,
+                        double noise_std, std::uint64_t seed, const std::array<double, 3>& start,
+                        double disturbance_phase, const std::optional<std::array<double, 3>>& line, bool keep_samples,
+                        bool trace) {
+  const Scenario sc = buildScenario(
+      controller, params, gains,
+      {duration, control_period_ns, disturbance, mass_scale, inertia_scale, noise_std, seed, start, disturbance_phase});
+  EstimatedRunConfig cfg;
+  std::string e = parseFeedback(feedback, cfg.feedback);
+  if (!e.empty()) throw py::value_error(e);
+  if (!traction.is_none()) {
+    TractionParams t;
+    if (!py::isinstance<py::bool_>(traction))
+      applyTableDict(tractionTable(), t, "traction/", traction, "traction");
+    else if (!traction.cast<bool>())
+      throw py::value_error("traction: None (or leave it out) for the no-slip plant, True or a dict for traction");
+    cfg.traction = t;
+  }
+  if (!patches.is_none()) {
+    if (!cfg.traction) throw py::value_error("patches need traction (True or a dict)");
+    std::size_t i = 0;
+    for (const auto& item : patches) cfg.patches.push_back(patchOf(item, *cfg.traction, i++));
+  }
+  if (!sensors.is_none()) applyTableDict(sensorsTable(), cfg.sensors, "sensors/", sensors, "sensors");
+  if (!estimator.is_none()) applyTableDict(ekfTable(), cfg.estimator, "estimator/", estimator, "estimator");
+  e = cfg.validate();
+  if (!e.empty()) throw py::value_error(e);
+
+  LineReference reference = lineOf(line);
+  EstimatedTrace columns;
+  EstimatedRunResult r;
+  {
+    py::gil_scoped_release no_gil;  // pure C++ from here; the trace is collected in C++ vectors
+    try {
+      if (trace) {
+        columns.reserve(static_cast<std::size_t>(sc.steps() + 1));
+        r = runEstimatedLoop(sc, cfg, reference, keep_samples,
+                             [&columns](const EstimatedSample& s) { columns.add(s); });
+      } else {
+        r = runEstimatedLoop(sc, cfg, reference, keep_samples);
+      }
+    } catch (const std::invalid_argument& ex) {
+      py::gil_scoped_acquire gil;
+      throw py::value_error(ex.what());
+    }
+  }
+  py::dict d = resultDict(sc, r.run);
+  d["feedback"] = feedbackName(cfg.feedback);
+  d["traction"] = cfg.traction.has_value();
+  d["max_abs_slip"] = r.max_abs_slip;
+  d["tool_down_time"] = r.tool_down_time;
+  d["fed_error_rms"] = r.fed_error_rms;
+  d["fed_error_max"] = r.fed_error_max;
+  d["fed_heading_error_max"] = r.fed_heading_error_max;
+  d["odometry_error_final"] = r.odometry_error_final;
+  d["odometry_error_max"] = r.odometry_error_max;
+  d["fixes"] = fixCounts(r.fixes, r.fixes_lost_from_queue);
+  if (trace) d["trace"] = columns.toDict();
+  return d;
+}
+
+}  // namespace
+
+void bindEstimated(py::module& m) {
+  const Scenario defaults;
+  m.def("run_estimated", &runEstimatedPy, py::kw_only(), py::arg("controller") = std::string("kanayama+atsmc"),
+        py::arg("params") = py::none(), py::arg("gains") = py::none(), py::arg("feedback") = std::string("fused"),
+        py::arg("traction") = py::none(), py::arg("patches") = py::none(), py::arg("sensors") = py::none(),
+        py::arg("estimator") = py::none(), py::arg("duration") = defaults.duration,
+        py::arg("control_period_ns") = defaults.control_period_ns,
+        py::arg("disturbance") = defaults.disturbance.sinusoidal,
+        py::arg("mass_scale") = defaults.disturbance.mass_scale,
+        py::arg("inertia_scale") = defaults.disturbance.inertia_scale,
+        py::arg("noise_std") = defaults.disturbance.noise_std, py::arg("seed") = defaults.disturbance.seed,
+        py::arg("start") = std::array<double, 3>{defaults.start.x, defaults.start.y, defaults.start.theta},
+        py::arg("disturbance_phase") = defaults.disturbance_phase, py::arg("line") = py::none(),
+        py::arg("keep_samples") = true, py::arg("trace") = false,
+        R"doc(core::runEstimatedLoop: run() with an estimate in the loop, scored on the truth (as run_monitor).
+
+feedback: what the controllers are fed: "ground_truth" (then equal to run(), bit for bit), "odometry" (the
+wheel encoders' dead reckoning) or "fused" (the EKF of state_estimator: encoders, yaw rate, late fix).
+traction: None = the no-slip plant; True = the traction plant with config/traction.yaml's defaults; a dict of
+plant_sim's traction/ keys ({"mu_peak": 0.35, "draft_force": 10.0}). patches: soil patches (traction only):
+[{"polygon": [[x, y], ...], "mu_peak": 0.2, "mu_slide": 0.15, "rolling_resistance": 0.08}], a coefficient
+left out taking the traction block's. sensors: plant_sim's sensors/ keys ({"seed": 3, "fix": {"sigma":
+0.05}}); estimator: state_estimator's estimator/ keys ({"fix": {"gate": 0}}). Other arguments as run()'s.
+Returns run()'s dict plus "feedback", "traction", "max_abs_slip", "tool_down_time", "fed_error_rms",
+"fed_error_max", "fed_heading_error_max" (the fed pose against the truth), "odometry_error_final",
+"odometry_error_max", "fixes" ({"applied", "reanchored", "gated", "too_old", "future", "invalid",
+"lost_from_queue"}); with trace=True run()'s columns plus fed_x, fed_y, fed_theta, fed_v, fed_omega,
+slip_right, slip_left, tool_down. Raises ValueError for a bad name, key or value (naming the key).)doc");
+}
+
+}  // namespace py_core
