@@ -11,11 +11,9 @@ Fails without the wait: step 150 is answered before the fix is sent, without it.
 import time
 import unittest
 
+import estimator_feed
 import rospy
 import rostest
-from geometry_msgs.msg import PoseWithCovarianceStamped
-from nav_msgs.msg import Odometry
-from sensor_msgs.msg import Imu
 
 WALL_LIMIT = 60.0
 DT = 0.001
@@ -39,33 +37,12 @@ class StateEstimatorLockstep(unittest.TestCase):
             time.sleep(0.01)
 
     def test_waits_for_the_fix_due(self):
-        out = []
-        sub = rospy.Subscriber("odometry/filtered", Odometry, out.append, queue_size=10000)
-        odom_pub = rospy.Publisher("odom", Odometry, queue_size=10000)
-        imu_pub = rospy.Publisher("imu", Imu, queue_size=10000)
-        fix_pub = rospy.Publisher("fix", PoseWithCovarianceStamped, queue_size=10)
-        pubs = (odom_pub, imu_pub, fix_pub)
-        self.wait_for(lambda: all(p.get_num_connections() > 0 for p in pubs) and sub.get_num_connections() > 0,
-                      "connections")
-
-        def odom(k):
-            o = Odometry()
-            o.header.stamp = stamp(k)
-            o.header.frame_id = "odom"
-            o.child_frame_id = "base_link"
-            o.pose.pose.position.x = V * k * DT
-            o.pose.pose.orientation.w = 1.0
-            o.twist.twist.linear.x = V
-            return o
+        w = estimator_feed.Wiring(WALL_LIMIT)
+        out = w.out
 
         def publish_step(k):
-            i = Imu()
-            i.header.stamp = stamp(k)
-            i.angular_velocity_covariance[8] = 0.005 ** 2
-            i.orientation_covariance[0] = -1.0
-            i.linear_acceleration_covariance[0] = -1.0
-            odom_pub.publish(odom(k))
-            imu_pub.publish(i)
+            w.odom.publish(estimator_feed.odom(stamp(k), V * k * DT, V))
+            w.imu.publish(estimator_feed.imu(stamp(k)))
 
         def count(n):
             self.wait_for(lambda: len(out) >= n, lambda: "%d filtered messages (have %d)" % (n, len(out)))
@@ -75,14 +52,7 @@ class StateEstimatorLockstep(unittest.TestCase):
         count(150)
         time.sleep(0.5)  # (only to see an answer that should not come; not a synchronisation)
         self.assertEqual(len(out), 150, "step 150 answered before the fix due by it came")
-        f = PoseWithCovarianceStamped()
-        f.header.stamp = stamp(0)
-        f.header.frame_id = "odom"
-        f.pose.pose.position.y = 0.05
-        f.pose.covariance[0] = f.pose.covariance[7] = 0.02 ** 2
-        for j in (14, 21, 28, 35):
-            f.pose.covariance[j] = 1e6
-        fix_pub.publish(f)
+        w.fix.publish(estimator_feed.fix(stamp(0), 0.0, 0.05))
         count(161)
         self.assertEqual(out[149].pose.pose.position.y, 0.0)
         self.assertGreater(out[150].pose.pose.position.y, 0.01, "the fix is not in the step it is due at")
@@ -92,10 +62,10 @@ class StateEstimatorLockstep(unittest.TestCase):
         count(250)
         time.sleep(0.5)
         self.assertEqual(len(out), 250, "step 250 answered before the fix of 0.1 s came")
-        odom_pub.publish(odom(250))  # the plant asks again: the fix is given up
+        w.odom.publish(estimator_feed.odom(stamp(250), V * 250 * DT, V))  # the plant asks again: the fix is given up
         count(251)
         time.sleep(0.2)  # (only to see a duplicate, were there one)
-        sub.unregister()
+        w.sub.unregister()
         self.assertEqual([m.header.stamp for m in out], [stamp(k) for k in range(251)])
 
 

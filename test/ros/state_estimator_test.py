@@ -12,11 +12,9 @@ import math
 import time
 import unittest
 
+import estimator_feed
 import rospy
 import rostest
-from geometry_msgs.msg import PoseWithCovarianceStamped
-from nav_msgs.msg import Odometry
-from sensor_msgs.msg import Imu
 
 WALL_LIMIT = 60.0
 STEPS = 400
@@ -45,44 +43,19 @@ class StateEstimatorTest(unittest.TestCase):
     def test_pairing_covariance_and_late_fix(self):
         delay = rospy.get_param("/state_estimator/estimator/fix/delay")
         self.assertAlmostEqual(delay, 0.15)
-        out = []
-        sub = rospy.Subscriber("odometry/filtered", Odometry, out.append, queue_size=10000)
-        odom_pub = rospy.Publisher("odom", Odometry, queue_size=10000)
-        imu_pub = rospy.Publisher("imu", Imu, queue_size=10000)
-        fix_pub = rospy.Publisher("fix", PoseWithCovarianceStamped, queue_size=10)
-        pubs = (odom_pub, imu_pub, fix_pub)
-        self.wait_for(lambda: all(p.get_num_connections() > 0 for p in pubs) and sub.get_num_connections() > 0,
-                      "connections")
-        def publish_step(k):
-            o = Odometry()
-            o.header.stamp = stamp(k)
-            o.header.frame_id = "odom"
-            o.child_frame_id = "base_link"
-            o.pose.pose.position.x = V * k * DT
-            o.pose.pose.orientation.w = 1.0
-            o.twist.twist.linear.x = V
-            i = Imu()
-            i.header.stamp = stamp(k)
-            i.angular_velocity.z = 0.0
-            i.angular_velocity_covariance[8] = 0.005 ** 2
-            i.orientation_covariance[0] = -1.0
-            i.linear_acceleration_covariance[0] = -1.0
-            first, second = ((odom_pub, o), (imu_pub, i)) if k % 2 == 0 else ((imu_pub, i), (odom_pub, o))
-            first[0].publish(first[1])
-            second[0].publish(second[1])
+        w = estimator_feed.Wiring(WALL_LIMIT)
+        out, sub, fix_pub = w.out, w.sub, w.fix
+
+        def publish_step(k):  # odom and imu in alternating order
+            o = (w.odom, estimator_feed.odom(stamp(k), V * k * DT, V))
+            i = (w.imu, estimator_feed.imu(stamp(k)))
+            for pub, msg in (o, i) if k % 2 == 0 else (i, o):
+                pub.publish(msg)
 
         for k in range(STEPS):
             publish_step(k)
             if k == 150:
-                f = PoseWithCovarianceStamped()
-                f.header.stamp = stamp(100)
-                f.header.frame_id = "odom"
-                f.pose.pose.position.x = V * 100 * DT
-                f.pose.pose.position.y = 0.05
-                f.pose.covariance[0] = f.pose.covariance[7] = 0.02 ** 2
-                for j in (14, 21, 28, 35):
-                    f.pose.covariance[j] = 1e6
-                fix_pub.publish(f)
+                fix_pub.publish(estimator_feed.fix(stamp(100), V * 100 * DT, 0.05))
         # The fix travels on its own connection and may reach the estimator after every one of the
         # STEPS odom messages has (the publisher does not wait): then it is applied at the next step.
         # So keep stepping, in batches, until an estimate holds it (bounded), instead of hoping it won.
