@@ -12,34 +12,17 @@ Verified to fail without the fix: with scripts/run's old `roslaunch` call the co
 lines roslaunch's; without sim.launch's `required` on every headless node the plain-roslaunch refusal
 runs into the 60 s bound (the plant waits 120 s for torques)."""
 import os
-import signal
-import subprocess
 import tempfile
-import time
 import unittest
 
-import roslib.packages
+import node_process
 import rostest
 
 BOUND = 60.0  # [s wall] for a run that must end "at once": start-up of every node plus shutdown
 
 
-def run(port, cmd, timeout=240):
-    env = dict(os.environ, ROS_MASTER_URI="http://localhost:%d" % port)
-    start = time.time()
-    proc = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True,
-                            start_new_session=True)  # a hung launch is killed whole
-    try:
-        out, _ = proc.communicate(timeout=timeout)
-    except subprocess.TimeoutExpired:
-        os.killpg(proc.pid, signal.SIGKILL)
-        out, _ = proc.communicate()
-        out += "\n(killed after %d s)" % timeout
-    return proc.returncode, out, time.time() - start
-
-
 def sim(port, *args, timeout=240):
-    return run(port, [roslib.packages.find_node("sowing_robot", "sim")[0], "headless:=true"] + list(args), timeout)
+    return node_process.sim(port, args, timeout)
 
 
 def last_line(out):
@@ -95,8 +78,8 @@ class HeadlessEnd(unittest.TestCase):
         self.check_give_up(11677, "nodelets:=true")
 
     def test_plain_roslaunch_refusal_ends_at_once(self):
-        code, out, seconds = run(11676, ["roslaunch", "-p", "11676", "sowing_robot", "sim.launch", "headless:=true",
-                                         "controller:=foo"], timeout=BOUND)
+        cmd = ["roslaunch", "-p", "11676", "sowing_robot", "sim.launch", "headless:=true", "controller:=foo"]
+        code, out, seconds = node_process.run_on_master(11676, cmd, timeout=BOUND)
         self.assertLess(seconds, BOUND, out[-3000:])
         self.assertIn("/torque_controller: refusing to start: /torque_controller/mode = 'foo'", out)
         self.assertIn("REQUIRED process [torque_controller", out)  # as well as plain roslaunch can say it

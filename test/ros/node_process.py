@@ -1,8 +1,10 @@
 """Shared by the rostests that run a sowing_robot node as a child process of the test: to check its exit
 code and output (a node that must refuse to start, or stop a run), or to restart a node the test killed.
 Imported from the test scripts beside it (a module, not a test: not executable)."""
+import os
 import signal
 import subprocess
+import time
 
 import roslib.packages
 import rospy
@@ -60,3 +62,24 @@ def stop(proc, timeout=15):
             proc.kill()
             proc.wait()
     return proc.returncode
+
+
+def run_on_master(port, cmd, timeout=240):
+    """(exit code, output, wall seconds) of `cmd` (a launch) on a master of its own at `port`; a launch that
+    has not ended after `timeout` s is killed whole and "(killed after N s)" appended to its output."""
+    env = dict(os.environ, ROS_MASTER_URI="http://localhost:%d" % port)
+    begin = time.time()
+    proc = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True,
+                            start_new_session=True)  # a hung launch is killed whole
+    try:
+        out, _ = proc.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        out, _ = proc.communicate()
+        out += "\n(killed after %d s)" % timeout
+    return proc.returncode, out, time.time() - begin
+
+
+def sim(port, args, timeout=240):
+    """run_on_master of `rosrun sowing_robot sim headless:=true ARGS` (what scripts/run calls)."""
+    return run_on_master(port, [executable("sim"), "headless:=true"] + list(args), timeout)

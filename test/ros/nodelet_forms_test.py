@@ -16,13 +16,10 @@ reach its end (a hang) runs into the bound. The fused comparison does not depend
 is (fused_line.test's bounds), only on the two forms computing the same one."""
 import os
 import re
-import signal
-import subprocess
 import tempfile
-import time
 import unittest
 
-import roslib.packages
+import node_process
 import rospkg
 import rostest
 
@@ -40,19 +37,9 @@ ANSI = re.compile(r"\x1b\[[0-9;]*m")
 
 
 def sim(port, args, timeout=BOUND):
-    """(exit code, output, wall seconds) of `rosrun sowing_robot sim headless:=true ARGS` on its own master."""
-    env = dict(os.environ, ROS_MASTER_URI="http://localhost:%d" % port)
-    cmd = [roslib.packages.find_node("sowing_robot", "sim")[0], "headless:=true"] + list(args)
-    start = time.time()
-    proc = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True,
-                            start_new_session=True)  # a hung run is killed whole
-    try:
-        out, _ = proc.communicate(timeout=timeout)
-    except subprocess.TimeoutExpired:
-        os.killpg(proc.pid, signal.SIGKILL)
-        out, _ = proc.communicate()
-        out += "\n(killed after %d s)" % timeout
-    return proc.returncode, ANSI.sub("", out), time.time() - start
+    """(exit code, output without colour codes, wall seconds) of `rosrun sowing_robot sim headless:=true ARGS`."""
+    code, out, seconds = node_process.sim(port, args, timeout)
+    return code, ANSI.sub("", out), seconds
 
 
 def end_lines(out):
