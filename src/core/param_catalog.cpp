@@ -107,13 +107,15 @@ const std::vector<CatalogSection>& parameterCatalog() {
        {"field/patches"}},
       {"kinematic_controller",
        "the outer loop, chosen by `outer`: Kanayama (eqs 4.1-4.2; kx, ky, ktheta live-tunable), pure pursuit or "
-       "nav2's Regulated Pure Pursuit (nav2's parameter names; start-up only). Unmarked parameters are Kanayama's, "
+       "nav2's Regulated Pure Pursuit (nav2's parameter names; their numbers live-tunable, cfg/PurePursuit.cfg). "
+       "Unmarked parameters are Kanayama's, "
        "[marked] ones the baselines'; the parameters of the controllers not selected are checked but inert",
        infos(KinematicControllerSettings::table()),
        {}},
       {"torque_controller",
        "the inner loop, chosen by `inner`: the integral terminal sliding-mode controller (eqs 4.7-4.22; `mode` "
-       "atsmc or tsmc; gains live-tunable) or the wheel-velocity PID (start-up only). Unmarked parameters are the "
+       "atsmc or tsmc; gains live-tunable) or the wheel-velocity PID (gains live-tunable, cfg/WheelPid.cfg). "
+       "Unmarked parameters are the "
        "sliding-mode controller's, [pid] ones the PID's; max_torque (the motor's limit) is both's; the parameters "
        "of the controller not selected are checked but inert",
        infos(TorqueControllerSettings::table()),

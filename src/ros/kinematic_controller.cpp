@@ -15,26 +15,30 @@ KinematicController::KinematicController(ros::NodeHandle nh, ros::NodeHandle pnh
   loadTable(p, core::KinematicControllerSettings::table(), settings);
   requireValid(p, settings.validate());
   input_timeout_ = settings.input_timeout;
+  // Live gains of the controller in use (reconfigure_bridge.h; one server on the private namespace).
   if (settings.outer == core::OuterKind::kanayama) {
     auto kanayama = std::make_unique<core::OuterAdapter<core::Kanayama>>(core::Kanayama(settings.gains));
     kanayama_ = &kanayama->controller();
     outer_ = std::move(kanayama);
+    kanayama_reconfigure_ =
+        startReconfigure<KinematicControllerConfig>(pnh, core::kanayamaTable(), settings.gains, [this](auto& c) {
+          applyReconfigure("kinematic_controller", core::kanayamaTable(), kanayama_->gains(), c,
+                           [this](const core::KanayamaGains& g) { kanayama_->setGains(g); });
+        });
   } else {  // validated above, so the constructor does not throw
-    outer_ = std::make_unique<core::OuterAdapter<core::PurePursuit>>(
+    auto pp = std::make_unique<core::OuterAdapter<core::PurePursuit>>(
         core::PurePursuit(settings.pure_pursuit, settings.outer == core::OuterKind::rpp));
+    pure_pursuit_ = &pp->controller();
+    outer_ = std::move(pp);
+    pure_pursuit_reconfigure_ =
+        startReconfigure<PurePursuitConfig>(pnh, core::purePursuitTable(), settings.pure_pursuit, [this](auto& c) {
+          applyReconfigure("kinematic_controller", core::purePursuitTable(), pure_pursuit_->params(), c,
+                           [this](const core::PurePursuitParams& p) { pure_pursuit_->setParams(p); });
+        });
   }
   logSettings("kinematic_controller", core::KinematicControllerSettings::table(), settings);
   ROS_INFO("kinematic_controller: outer controller %s", core::outerName(settings.outer));
   lockstep_ = run.lockstep;  // lockstep: wait for the paired reference, never time out
-  if (kanayama_) {
-    reconfigure_ = std::make_unique<dynamic_reconfigure::Server<KinematicControllerConfig>>(pnh);
-    // The server starts from the .cfg defaults where a key is not set: hand it the gains in force first,
-    // so its first callback changes nothing.
-    KinematicControllerConfig in_force;
-    toConfig(core::kanayamaTable(), settings.gains, in_force);
-    reconfigure_->updateConfig(in_force);
-    reconfigure_->setCallback([this](KinematicControllerConfig& c, uint32_t level) { reconfigure(c, level); });
-  }
   desired_pub_ = nh.advertise<DesiredVelocity>("desired_velocity", kLockstepQueue);
   error_pub_ = nh.advertise<TrackingError>("tracking_error", kLockstepQueue);
   const auto hints = ros::TransportHints().tcpNoDelay();
@@ -42,22 +46,6 @@ KinematicController::KinematicController(ros::NodeHandle nh, ros::NodeHandle pnh
   odom_sub_ = nh.subscribe("feedback", kLockstepQueue, &KinematicController::odomCallback, this, hints);
   ref_sub_ = nh.subscribe("reference", kLockstepQueue, &KinematicController::referenceCallback, this, hints);
   ready_ = ReadyAnnouncer(nh, pnh);  // last: everything is subscribed (ready_roster.h)
-}
-
-void KinematicController::reconfigure(KinematicControllerConfig& config, uint32_t) {
-  const core::KanayamaGains old = kanayama_->gains();
-  core::KanayamaGains g = old;
-  std::string error = fromConfig(core::kanayamaTable(), config, g);
-  if (error.empty() && g.kx == old.kx && g.ky == old.ky && g.ktheta == old.ktheta) return;
-  if (error.empty()) error = g.validate();
-  if (!error.empty()) {
-    ROS_WARN("kinematic_controller: rejected gain change: %s; keeping kx %g, ky %g, ktheta %g", error.c_str(), old.kx,
-             old.ky, old.ktheta);
-    toConfig(core::kanayamaTable(), old, config);  // the server then reports (and stores) the values in force
-    return;
-  }
-  kanayama_->setGains(g);
-  ROS_INFO("kinematic_controller: gains now kx %g, ky %g, ktheta %g", g.kx, g.ky, g.ktheta);
 }
 
 void KinematicController::odomCallback(const nav_msgs::Odometry::ConstPtr& msg) {

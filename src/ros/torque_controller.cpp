@@ -35,12 +35,17 @@ TorqueController::TorqueController(ros::NodeHandle nh, ros::NodeHandle pnh) {
   ROS_INFO("torque_controller: inner controller %s; m0_hat starts at %.4f kg, I0_hat at %.5f kg m^2; %.0f Hz",
            settings.innerName().c_str(), inner_->m0Hat(), inner_->i0Hat(), 1.0 / dt_);
   state_.mode = settings.innerName();
+  // Live gains of the controller in use (one server: both would be on the node's private namespace).
   if (smc_) {
-    reconfigure_ = std::make_unique<dynamic_reconfigure::Server<TorqueControllerConfig>>(pnh);
-    TorqueControllerConfig in_force;  // see KinematicController: the server's first callback changes nothing
-    toConfig(core::slidingModeTable(), params, in_force);
-    reconfigure_->updateConfig(in_force);
-    reconfigure_->setCallback([this](TorqueControllerConfig& c, uint32_t level) { reconfigure(c, level); });
+    smc_reconfigure_ = startReconfigure<TorqueControllerConfig>(pnh, core::slidingModeTable(), params, [this](auto& c) {
+      applyReconfigure("torque_controller", core::slidingModeTable(), smc_->params(), c,
+                       [this](const core::SlidingModeParams& p) { smc_->setParams(p); });
+    });
+  } else {
+    pid_reconfigure_ = startReconfigure<WheelPidConfig>(pnh, core::wheelPidTable(), settings.pid, [this](auto& c) {
+      applyReconfigure("torque_controller", core::wheelPidTable(), pid_->params(), c,
+                       [this](const core::WheelPidParams& p) { pid_->setParams(p); });
+    });
   }
   torque_pub_ = nh.advertise<WheelTorque>("wheel_torque", kLockstepQueue);
   state_pub_ = pnh.advertise<TorqueControllerState>("state", kLockstepQueue);
@@ -49,21 +54,6 @@ TorqueController::TorqueController(ros::NodeHandle nh, ros::NodeHandle pnh) {
   odom_sub_ = nh.subscribe("feedback", kLockstepQueue, &TorqueController::odomCallback, this, hints);
   desired_sub_ = nh.subscribe("desired_velocity", kLockstepQueue, &TorqueController::desiredCallback, this, hints);
   ready_ = ReadyAnnouncer(nh, pnh);  // last: everything is subscribed (ready_roster.h)
-}
-
-void TorqueController::reconfigure(TorqueControllerConfig& config, uint32_t) {
-  // The server's first call repeats the start-up values; applying them again changes nothing.
-  const core::SlidingModeParams old = smc_->params();
-  core::SlidingModeParams p = old;
-  std::string error = fromConfig(core::slidingModeTable(), config, p);
-  if (error.empty()) error = p.validate();
-  if (!error.empty()) {
-    ROS_WARN("torque_controller: rejected gain change: %s; keeping the previous gains", error.c_str());
-    toConfig(core::slidingModeTable(), old, config);  // the server then reports (and stores) the values in force
-    return;
-  }
-  smc_->setParams(p);
-  ROS_INFO("torque_controller: gains now %s", core::slidingModeTable().describe(p).c_str());
 }
 
 void TorqueController::odomCallback(const nav_msgs::Odometry::ConstPtr& msg) {

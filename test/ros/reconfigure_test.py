@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""rostest: dynamic_reconfigure on both controllers. A valid change is applied; a change outside the
+"""rostest: dynamic_reconfigure on both controllers, with the thesis pair and with the baselines (RPP over
+the wheel PID, in namespace baseline). A valid change is applied; a change outside the
 allowed range is refused and the old value stays in force: a negative gain (which the server clamps to
 0, still invalid for the core), NaN (which the server's clamp lets through) and an unknown switching
 function."""
@@ -46,6 +47,24 @@ class Reconfigure(unittest.TestCase):
         self.assertEqual(c.update_configuration({"ky": 0.0})["ky"], 1.5)
         self.assertTrue(self.warned("kinematic_controller", "rejected gain change: ky"))
         self.assertEqual(c.update_configuration({"ktheta": float("nan")})["ktheta"], 2.2)
+
+    def test_baseline_torque_controller(self):
+        c = Client("/baseline/torque_controller", timeout=30)
+        self.assertEqual(c.update_configuration({"kp": 7.5})["kp"], 7.5)
+        self.assertTrue(self.warned("torque_controller", "gains now kp 7.5"))
+        self.assertEqual(c.update_configuration({"max_torque": -1.0})["max_torque"], 100.0)  # clamped to 0: refused
+        self.assertEqual(c.update_configuration({"kd": float("nan")})["kd"], 0.0)
+        self.assertTrue(self.warned("torque_controller", "rejected gain change: kd"))
+        self.assertEqual(c.update_configuration({"feedforward": 0.5})["feedforward"], 0.5)
+
+    def test_baseline_kinematic_controller(self):
+        c = Client("/baseline/kinematic_controller", timeout=30)
+        self.assertEqual(c.update_configuration({"lookahead_dist": 0.5})["lookahead_dist"], 0.5)
+        # outside [min_lookahead_dist, max_lookahead_dist]: refused by PurePursuitParams::validate
+        self.assertEqual(c.update_configuration({"lookahead_dist": 2.0})["lookahead_dist"], 0.5)
+        self.assertTrue(self.warned("kinematic_controller", "rejected gain change"))
+        cfg = c.update_configuration({"regulated_linear_scaling_min_radius": 0.5, "k_along": 1.0})
+        self.assertEqual((cfg["regulated_linear_scaling_min_radius"], cfg["k_along"]), (0.5, 1.0))
 
     def test_reference_generator(self):
         c = Client("/reference_generator/potential", timeout=30)

@@ -9,11 +9,15 @@
 #include <string>
 
 #include "sowing_robot/KinematicControllerConfig.h"
+#include "sowing_robot/PurePursuitConfig.h"
 #include "sowing_robot/ReferenceGeneratorConfig.h"
 #include "sowing_robot/TorqueControllerConfig.h"
+#include "sowing_robot/WheelPidConfig.h"
 #include "sowing_robot/core/kanayama.h"
 #include "sowing_robot/core/potential_field.h"
+#include "sowing_robot/core/pure_pursuit.h"
 #include "sowing_robot/core/sliding_mode.h"
+#include "sowing_robot/core/wheel_pid.h"
 
 using namespace sowing_robot;
 
@@ -60,3 +64,5 @@ TEST(ReconfigureTables, TorqueController) { expectCfgMatchesTable<TorqueControll
 TEST(ReconfigureTables, ReferenceGenerator) {
   expectCfgMatchesTable<ReferenceGeneratorConfig>(core::potentialFieldTable());
 }
+TEST(ReconfigureTables, PurePursuit) { expectCfgMatchesTable<PurePursuitConfig>(core::purePursuitTable()); }
+TEST(ReconfigureTables, WheelPid) { expectCfgMatchesTable<WheelPidConfig>(core::wheelPidTable()); }

@@ -1,7 +1,7 @@
 // kinematic_controller: reference + odom -> desired body velocities and the tracking error for plotting
-// and metrics. The outer controller is chosen by `outer`: Kanayama (eqs 4.1-4.2, gains live-tunable by
-// dynamic_reconfigure), pure pursuit or nav2's Regulated Pure Pursuit (core/pure_pursuit.h; their
-// parameters are start-up only: the reconfigure server runs only with Kanayama).
+// and metrics. The outer controller is chosen by `outer`: Kanayama (eqs 4.1-4.2), pure pursuit or nav2's
+// Regulated Pure Pursuit (core/pure_pursuit.h), each live-tunable by dynamic_reconfigure
+// (cfg/KinematicController.cfg, cfg/PurePursuit.cfg: the server of the controller in use).
 #pragma once
 
 #include <dynamic_reconfigure/server.h>
@@ -12,10 +12,12 @@
 
 #include "sowing_robot/DesiredVelocity.h"
 #include "sowing_robot/KinematicControllerConfig.h"
+#include "sowing_robot/PurePursuitConfig.h"
 #include "sowing_robot/ReferenceState.h"
 #include "sowing_robot/TrackingError.h"
 #include "sowing_robot/core/controllers.h"
 #include "sowing_robot/core/kanayama.h"
+#include "sowing_robot/core/pure_pursuit.h"
 #include "sowing_robot/ros/ready_roster.h"
 #include "sowing_robot/ros/stamp_pair.h"
 
@@ -29,13 +31,12 @@ class KinematicController {
   void odomCallback(const nav_msgs::Odometry::ConstPtr& msg);
   void referenceCallback(const ReferenceState::ConstPtr& msg);
   void compute();
-  /// Live gain change: validated like the start-up values; a rejected change keeps the old gains.
-  void reconfigure(KinematicControllerConfig& config, uint32_t level);
   /// Realtime only: command a stop for this odom stamp when the reference is older than input_timeout.
   void stopIfStale(const nav_msgs::Odometry& odom);
 
   std::unique_ptr<core::OuterController> outer_;
-  core::Kanayama* kanayama_ = nullptr;  // outer_'s Kanayama when outer is kanayama (live gain changes), else null
+  core::Kanayama* kanayama_ = nullptr;         // outer_'s Kanayama when outer is kanayama, else null
+  core::PurePursuit* pure_pursuit_ = nullptr;  // outer_'s (R)PP when outer is pure_pursuit or rpp, else null
   ros::Subscriber odom_sub_, ref_sub_;
   ros::Publisher desired_pub_, error_pub_;
   bool grid_reported_ = false;  // a control_rate mismatch is reported once
@@ -45,7 +46,9 @@ class KinematicController {
   long rejected_ = 0;
   bool lockstep_;                // run/mode: wait for the paired reference, never time out
   double input_timeout_ = 0.05;  // [s] sim (shorter than torque_controller's: see config/controllers.yaml)
-  std::unique_ptr<dynamic_reconfigure::Server<KinematicControllerConfig>> reconfigure_;
+  // Live gains (reconfigure_bridge.h): validated like the start-up values, a rejected change keeps the old.
+  std::unique_ptr<dynamic_reconfigure::Server<KinematicControllerConfig>> kanayama_reconfigure_;
+  std::unique_ptr<dynamic_reconfigure::Server<PurePursuitConfig>> pure_pursuit_reconfigure_;
   ReadyAnnouncer ready_;  // plant_sim waits for it before step 0
 };
 

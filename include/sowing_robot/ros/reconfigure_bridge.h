@@ -4,7 +4,11 @@
 #pragma once
 
 #include <dynamic_reconfigure/Config.h>
+#include <dynamic_reconfigure/server.h>
+#include <ros/console.h>
 
+#include <memory>
+#include <stdexcept>
 #include <string>
 
 #include "sowing_robot/core/param_table.h"
@@ -68,6 +72,54 @@ std::string fromConfig(const core::ParamTable<S>& table, const Config& config, S
   for (const auto& p : msg.strs)
     if (error.empty()) error = apply(p.name, p.value);
   return error;
+}
+
+/// Every entry of `table` equal in `a` and `b` (exactly: a gain changed in its last digit is a change).
+template <typename S>
+bool sameValues(const core::ParamTable<S>& table, const S& a, const S& b) {
+  for (const auto& e : table.entries())
+    if (!(e.get(a) == e.get(b))) return false;
+  return true;
+}
+
+/// The body of a live change: `config` over a copy of `in_force`, validated, then handed to `apply` (which
+/// may throw std::invalid_argument, keeping the old values); nothing when it changes no value. A refused change is
+/// logged as one WARN naming the key and `config` is set back to the values in force (the server then reports and
+/// stores those).
+template <typename Config, typename S, typename Apply>
+void applyReconfigure(const char* node, const core::ParamTable<S>& table, const S& in_force, Config& config,
+                      Apply apply) {
+  S p = in_force;
+  std::string error = fromConfig(table, config, p);
+  if (error.empty() && sameValues(table, p, in_force)) return;  // the server's first call, or no change
+  if (error.empty()) error = p.validate();
+  if (error.empty()) {
+    try {
+      apply(p);
+    } catch (const std::invalid_argument& e) {
+      error = e.what();
+    }
+  }
+  if (!error.empty()) {
+    ROS_WARN("%s: rejected gain change: %s; keeping the previous gains", node, error.c_str());
+    toConfig(table, in_force, config);
+    return;
+  }
+  ROS_INFO("%s: gains now %s", node, table.describe(p).c_str());
+}
+
+/// A dynamic_reconfigure server on `nh` that starts from the values in force (not the .cfg's defaults,
+/// so its first callback changes nothing) and calls `callback(config)` on every change.
+template <typename Config, typename S, typename Callback>
+std::unique_ptr<dynamic_reconfigure::Server<Config>> startReconfigure(const ros::NodeHandle& nh,
+                                                                      const core::ParamTable<S>& table,
+                                                                      const S& in_force, Callback callback) {
+  auto server = std::make_unique<dynamic_reconfigure::Server<Config>>(nh);
+  Config c;
+  toConfig(table, in_force, c);
+  server->updateConfig(c);
+  server->setCallback([callback](Config& config, uint32_t) { callback(config); });
+  return server;
 }
 
 }  // namespace sowing_robot

@@ -1,7 +1,7 @@
 // torque_controller: desired + measured velocities -> wheel torques. The inner controller is chosen by
-// `inner`: the sliding-mode controller (eqs 4.7-4.22; `mode` atsmc or tsmc; gains live-tunable by
-// dynamic_reconfigure) or the wheel-velocity PID (core/wheel_pid.h; start-up parameters only, the
-// reconfigure server runs only with the sliding-mode controller). Publishes its state on ~state: the
+// `inner`: the sliding-mode controller (eqs 4.7-4.22; `mode` atsmc or tsmc) or the wheel-velocity PID
+// (core/wheel_pid.h), each with its gains live-tunable by dynamic_reconfigure (cfg/TorqueController.cfg,
+// cfg/WheelPid.cfg: the server of the controller in use). Publishes its state on ~state: the
 // sliding variables and adaptive estimates, or for the PID the same record with s_v = s_omega = 0 and
 // the nominal m0, I0 (core/controllers.h, InnerOutput).
 #pragma once
@@ -15,6 +15,7 @@
 #include "sowing_robot/DesiredVelocity.h"
 #include "sowing_robot/TorqueControllerConfig.h"
 #include "sowing_robot/TorqueControllerState.h"
+#include "sowing_robot/WheelPidConfig.h"
 #include "sowing_robot/WheelTorque.h"
 #include "sowing_robot/core/controllers.h"
 #include "sowing_robot/core/sliding_mode.h"
@@ -31,8 +32,6 @@ class TorqueController {
   void odomCallback(const nav_msgs::Odometry::ConstPtr& msg);
   void desiredCallback(const DesiredVelocity::ConstPtr& msg);
   void compute();
-  /// Live gain change: validated like the start-up values; a rejected change keeps the old gains.
-  void reconfigure(TorqueControllerConfig& config, uint32_t level);
   /// Realtime only: zero torque for this odom stamp when the desired velocity is older than input_timeout.
   bool holdZeroIfStale(const nav_msgs::Odometry& odom);
 
@@ -43,7 +42,9 @@ class TorqueController {
   bool lockstep_;               // run/mode: wait for the paired desired velocity, never time out
   double input_timeout_ = 0.1;  // [s] sim
   bool stale_ = false;          // the last output was the zero hold
-  std::unique_ptr<dynamic_reconfigure::Server<TorqueControllerConfig>> reconfigure_;
+  // Live gains (reconfigure_bridge.h): validated like the start-up values, a rejected change keeps the old.
+  std::unique_ptr<dynamic_reconfigure::Server<TorqueControllerConfig>> smc_reconfigure_;
+  std::unique_ptr<dynamic_reconfigure::Server<WheelPidConfig>> pid_reconfigure_;
   ros::Subscriber odom_sub_, desired_sub_;
   ros::Publisher torque_pub_, state_pub_;
   StampPair<nav_msgs::Odometry, DesiredVelocity> inputs_;
