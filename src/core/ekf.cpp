@@ -48,6 +48,9 @@ const ParamTable<EkfParams>& ekfTable() {
       integer("estimator/fix/reanchor_after", &P::reanchor_after, 5, Limits::closed(0.0, 1000000.0), "",
               "gated fixes in a row after which the next gated fix is taken as the position (x, y and their "
               "covariance from it; heading and bias kept): the way back after wheel slip; 0: never"),
+      number("estimator/slip/inflation", &P::slip_inflation, 100.0, Limits::closed(1.0, 1e6), "",
+             "after a fix outside the gate (wheel slip), the distance noise's variance times this until an applied "
+             "fix agrees with the prediction within the fix's own noise; 1: off"),
       number("estimator/fix/delay", &P::fix_delay, 0.15, Limits::closed(0.0, 100.0), "s",
              "a fix is applied once the estimate is this much newer than its stamp, so runs are repeatable; >= "
              "the fix's latency plus two control periods, and within history/length"),
@@ -104,6 +107,7 @@ void Ekf::reset(double t, const Vector& mean, const Matrix& covariance) {
   pinBias(e.mean, e.cov);
   history_.clear();
   history_.push_back(std::move(e));
+  slipping_ = false;
 }
 
 Ekf::Vector Ekf::motion(const Vector6& a) {
@@ -190,7 +194,10 @@ bool Ekf::predict(double t, const EkfStepInput& in) {
   if (!allFinite(in.distance, in.dtheta, in.rate, in.rate_variance) || !finiteMatrix(in.covariance)) return false;
   if (in.covariance(0, 0) < 0.0 || in.covariance(1, 1) < 0.0 || in.rate_variance < 0.0) return false;
   Entry e{t, mean(), covariance(), in, {}};
-  propagate(params_, t - time(), in, e.mean, e.cov);
+  if (slipping_)  // kept in the entry's input: a re-propagation meets the same inflation
+    e.input.covariance(0, 0) +=
+        (params_.slip_inflation - 1.0) * params_.distance_noise * params_.distance_noise * std::fabs(in.distance);
+  propagate(params_, t - time(), e.input, e.mean, e.cov);
   pinBias(e.mean, e.cov);
   if (!e.mean.allFinite() || !e.cov.allFinite()) return false;
   history_.push_back(std::move(e));
@@ -214,11 +221,20 @@ FixOutcome Ekf::fuse(const EkfFix& fix) {
   Entry& at = history_[k];
   bool anchor = false;
   if (params_.gate > 0.0 && update(fix, at.mean, at.cov, false) > params_.gate) {
+    if (params_.slip_inflation > 1.0 && !slipping_) {
+      slipping_ = true;
+      ++counts_.slip_onsets;
+    }
     if (params_.reanchor_after <= 0 || gated_in_a_row_ < params_.reanchor_after) {
       ++gated_in_a_row_;
       return refuse(counts_.gated, FixOutcome::REFUSED_GATE);
     }
     anchor = true;
+  } else if (slipping_) {
+    // The wheels grip again when the fix agrees with the prediction within its own noise: the inflated
+    // covariance would let every applied fix look like agreement.
+    const Eigen::Vector2d nu = fix.xy - at.mean.head<2>();
+    if (nu.dot(fix.covariance.ldlt().solve(nu)) < 1.0) slipping_ = false;
   }
   gated_in_a_row_ = 0;
   if (anchor)

@@ -651,11 +651,14 @@ namespace {
 struct SlipRun {
   double late_error = 0.0;
   FixCounts counts;
+  Ekf::Vector mean;
+  Ekf::Matrix cov;
 };
 
-SlipRun runThroughSlip(int reanchor_after) {
+SlipRun runThroughSlip(int reanchor_after, double slip_inflation = 1.0, double slip = 1.5) {
   EkfParams p;
   p.reanchor_after = reanchor_after;
+  p.slip_inflation = slip_inflation;
   Ekf ekf(p);
   const double dt = 1e-3, v = 1.0;
   ekf.reset(0.0, Pose2D{0.0, 0.0, 0.0});
@@ -664,7 +667,7 @@ SlipRun runThroughSlip(int reanchor_after) {
   for (int i = 1; i <= 10000; ++i) {
     const double t = i * dt, x = v * t;
     EkfStepInput in;
-    in.distance = 1.5 * v * dt;  // the encoders' distance under slip
+    in.distance = slip * v * dt;  // the encoders' distance under slip
     in.covariance = encoderIncrementCovariance(p.increment_sigma, 0.24);
     in.has_rate = true;
     in.rate = 0.0;
@@ -684,12 +687,15 @@ SlipRun runThroughSlip(int reanchor_after) {
     if (t >= 5.0) out.late_error = std::max(out.late_error, std::hypot(ekf.mean()(Ekf::X) - x, ekf.mean()(Ekf::Y)));
   }
   out.counts = ekf.counts();
+  out.mean = ekf.mean();
+  out.cov = ekf.covariance();
   return out;
 }
 
 }  // namespace
 
-// Slip makes the estimate outrun its covariance; the gate then refuses every fix of the truth for ever,
+// Slip makes the estimate outrun its covariance (here with the slip inflation off, to see the re-anchoring
+// alone); the gate then refuses every fix of the truth for ever,
 // unless the filter re-anchors after fix/reanchor_after gated fixes in a row.
 TEST(EkfReanchor, AfterGatedFixesInARowTheFixBecomesThePosition) {
   const SlipRun never = runThroughSlip(0), after5 = runThroughSlip(5);
@@ -705,6 +711,34 @@ TEST(EkfReanchor, AfterGatedFixesInARowTheFixBecomesThePosition) {
   // the fixes applied after an anchor only partly correct.
   EXPECT_LT(after5.late_error, 0.5);
   EXPECT_LE(after5.counts.gated, 5 * (after5.counts.reanchored + 1));
+}
+
+// The slip inflation (the default): the first gated fix raises the distance noise, the next fixes pass the
+// gate and hold the estimate to them: the error stays at the drift between two fixes plus the fix's delay
+// (0.5 m/s x 0.2 s), not metres.
+TEST(EkfSlip, AfterAGatedFixTheInflatedDistanceNoiseLetsTheFixesIn) {
+  const double inflation = EkfParams().slip_inflation;
+  ASSERT_GT(inflation, 1.0);
+  const SlipRun on = runThroughSlip(0, inflation), off = runThroughSlip(0, 1.0);
+  std::printf(
+      "through 10 s of 50 %% slip: slip inflation x%g: %ld of %ld fixes gated, %ld onsets, error %.3f m; off: "
+      "%ld gated, error %.2f m\n",
+      inflation, on.counts.gated, on.counts.gated + on.counts.applied, on.counts.slip_onsets, on.late_error,
+      off.counts.gated, off.late_error);
+  EXPECT_GT(off.late_error, 1.0);  // lost
+  EXPECT_LT(on.late_error, 0.15);
+  EXPECT_GE(on.counts.slip_onsets, 1);
+  EXPECT_LE(on.counts.gated, 5);
+  EXPECT_EQ(off.counts.slip_onsets, 0);
+}
+
+// Without a gated fix the inflation never starts: the estimate is the one without it, to the bit.
+TEST(EkfSlip, WithoutAGatedFixNothingChanges) {
+  const SlipRun on = runThroughSlip(5, 100.0, 1.0), off = runThroughSlip(5, 1.0, 1.0);
+  EXPECT_EQ(on.counts.gated, 0);
+  EXPECT_EQ(on.counts.slip_onsets, 0);
+  EXPECT_TRUE(on.mean == off.mean);
+  EXPECT_TRUE(on.cov == off.cov);
 }
 
 // A fix stamped before a re-anchoring one but arriving after it makes the filter propagate its history

@@ -34,6 +34,13 @@
 // distance, not the gyro's heading). Why: when the wheels slip (wet soil) the encoders count distance
 // the robot does not travel; the estimate leaves the truth faster than its covariance says, every
 // later fix lies outside the gate, and without this the filter never comes back. Counted (reanchored).
+//
+// Slip (slip/inflation = k > 1): a gated fix is taken as the sign that the wheels slip; from then on every
+// step's distance variance from the table (distance_noise^2 |u_m|) is k times larger, so the next fixes
+// pass the gate and pull the estimate back instead of being refused, until an applied fix agrees with
+// the prediction within the fix's own noise (squared distance against the fix's covariance below 1). The
+// inflation is stored with the step's inputs, so a late fix re-propagates through the same steps.
+// Without any gated fix nothing changes. Counted (slip_onsets).
 #pragma once
 
 #include <Eigen/Core>
@@ -63,6 +70,7 @@ struct EkfParams {
   int history_length;          ///< steps kept for late fixes
   double gate;                 ///< squared Mahalanobis distance above which a fix is refused; 0: no gate
   int reanchor_after;          ///< gated fixes in a row after which the next gated one re-anchors x, y; 0: never
+  double slip_inflation;       ///< after a gated fix, the distance noise variance times this until fixes agree
   double fix_delay;            ///< [s] the ROS node applies a fix once its state is this much newer (determinism)
 
   /// checkRanges(): the first bad value as one line naming its key ("" when all are good).
@@ -122,7 +130,8 @@ const char* fixOutcomeName(FixOutcome o);
 /// Counts of what happened to the fixes offered to fuse().
 struct FixCounts {
   long applied = 0, invalid = 0, too_old = 0, future = 0, gated = 0;
-  long reanchored = 0;  ///< gated fixes taken as the position (fix/reanchor_after); also counted in applied
+  long reanchored = 0;   ///< gated fixes taken as the position (fix/reanchor_after); also counted in applied
+  long slip_onsets = 0;  ///< times a gated fix started the slip inflation (slip/inflation)
   long refused() const { return invalid + too_old + future + gated; }
 };
 
@@ -157,6 +166,8 @@ class Ekf {
   double oldestTime() const { return history_.front().t; }
   std::size_t historySize() const { return history_.size(); }
   const FixCounts& counts() const { return counts_; }
+  /// The slip inflation is on (a gated fix, no agreeing fix since).
+  bool slipping() const { return slipping_; }
   const EkfParams& params() const { return params_; }
 
   // The pieces of one step, public for the tests (Jacobians against finite differences).
@@ -190,6 +201,7 @@ class Ekf {
   std::deque<Entry> history_;
   FixCounts counts_;
   int gated_in_a_row_ = 0;  // for fix/reanchor_after
+  bool slipping_ = false;   // slip/inflation in force
 };
 
 /// Holds fixes until the filter's time has passed stamp + delay, so that which fixes an estimate
