@@ -101,8 +101,12 @@ struct RunTally {
       }
       --until_series_;
     }
-    prev2_ = prev_;
-    prev_ = s.control->torques;
+    // Field by field: a struct copy is two 16-byte moves, and the inner controller has just written its
+    // output 8 bytes at a time (a load that cannot be forwarded from those stores).
+    prev2_.right = prev_.right;
+    prev2_.left = prev_.left;
+    prev_.right = s.control->torques.right;
+    prev_.left = s.control->torques.left;
     ++count_;
     last_cross_track = std::fabs(e);
     if (s.t >= settle_time) worst_cross_track = std::max(worst_cross_track, last_cross_track);
