@@ -43,7 +43,11 @@ RunRow measure(const Scenario& sc, ReferenceSource& reference, const MonteCarloS
   RunRow row;
   row.draw = draw;
   RowMeter meter(row, sc, spec, extras);
-  const RunResult r = runClosedLoop(sc, reference, true, [&](const LoopSample& s) { meter.add(s); });
+  // Without a body or a last reference to follow, the row's per-period figures are a RunTally the loop
+  // adds up itself (no callback per period); the same numbers either way.
+  const RunResult r = meter.needsEveryPeriod()
+                          ? runClosedLoop(sc, reference, true, [&](const LoopSample& s) { meter.add(s); })
+                          : runClosedLoop(sc, reference, true, meter.tally());
   meter.finish(r);
   return row;
 }

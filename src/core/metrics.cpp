@@ -32,37 +32,6 @@ void MetricsAccumulator::reset() {
   for (auto& d : time_domain_) d.reset();
 }
 
-bool MetricsAccumulator::add(double t, double ex, double ey, double etheta) {
-  if (!allFinite(t, ex, ey, etheta)) {
-    ++rejected_;
-    return false;
-  }
-  const std::array<double, AXIS_COUNT> e{ex, ey, etheta};
-  // Trapezoids: each integral adds 0.5 h (f(t_last) + f(t)), f = e^2, t e^2, |e|, t |e|. f(t) is kept for
-  // the next sample's f(t_last): the same products of the same operands as computing it again then.
-  std::array<Terms, AXIS_COUNT> now;
-  for (int a = 0; a < AXIS_COUNT; ++a) {
-    const double e1 = e[a], abs1 = std::fabs(e1);
-    now[a] = {e1 * e1, t * e1 * e1, abs1, t * abs1};
-  }
-  if (count_ > 0) {
-    const double h = t - last_t_;
-    for (int a = 0; a < AXIS_COUNT; ++a) {
-      const Terms &p = last_terms_[a], &c = now[a];
-      acc_[a].ise += 0.5 * h * (p.sq + c.sq);
-      acc_[a].itse += 0.5 * h * (p.t_sq + c.t_sq);
-      acc_[a].iae += 0.5 * h * (p.abs + c.abs);
-      acc_[a].itae += 0.5 * h * (p.t_abs + c.t_abs);
-    }
-  }
-  last_t_ = t;
-  last_terms_ = now;
-  ++count_;
-  if (keep_)
-    for (int a = 0; a < AXIS_COUNT; ++a) time_domain_[a].add(t, e[a]);
-  return true;
-}
-
 std::array<AxisMetrics, AXIS_COUNT> MetricsAccumulator::result() const {
   auto r = acc_;
   if (keep_ && count_ > 0) {

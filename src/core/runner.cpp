@@ -29,12 +29,22 @@ std::int64_t Scenario::steps() const {
 
 namespace {
 
+// std::isfinite(s.sum()) with the additions of Eigen's SSE2 reduction of the 7-vector, in its order
+// (lanes {4, 2, 0} and {5, 3, 1}, then the two lanes, then 6: a sum that overflows does so at the same
+// step), from 8-byte loads: Eigen's 16-byte loads of a state that the plant's step has just written 8
+// bytes at a time cannot be forwarded from those stores and waited for them in every period (perf annotate).
+inline bool finiteSum(const State& s) {
+  const double even = (s[4] + s[2]) + s[0], odd = (s[5] + s[3]) + s[1];
+  return std::isfinite((even + odd) + s[6]);
+}
+
 // The loop body, over concrete controller types (no virtual call when they are final or plain
 // classes): Outer::compute(ref, pose, v, omega) -> VelocityCommand; Inner::update(cmd, v, omega, dt) ->
-// InnerOutput, m0Hat(), i0Hat().
-template <typename Outer, typename Inner>
+// InnerOutput, m0Hat(), i0Hat(). Trace: the public API's std::function (may be empty), or a RunTally
+// (its add() inlined here, and what it does not read of the LoopSample never built).
+template <typename Outer, typename Inner, typename Trace>
 RunResult loop(const Scenario& sc, ReferenceSource& reference, Outer& outer, Inner& inner, bool keep_samples,
-               const std::function<void(const LoopSample&)>& trace, const RunStop& stop) {
+               Trace& trace, const RunStop& stop) {
   Plant plant(sc.robot, sc.disturbance);
   State x0 = State::Zero();
   x0[X] = sc.start.x;
@@ -52,7 +62,7 @@ RunResult loop(const Scenario& sc, ReferenceSource& reference, Outer& outer, Inn
   for (std::int64_t k = 0; k <= n; ++k) {
     const double t = secondsFromNanos(k * sc.control_period_ns);
     const State& s = plant.state();
-    if (!std::isfinite(s.sum())) {
+    if (!finiteSum(s)) {
       result.diverged = true;
       break;
     }
@@ -79,7 +89,10 @@ RunResult loop(const Scenario& sc, ReferenceSource& reference, Outer& outer, Inn
     }();
     const InnerOutput u = inner.update(cmd, s[V], s[OMEGA], dt);
     if (u.saturated) ++result.saturated_steps;
-    if (trace) trace({t, &s, &ref, &cmd, &u, inner.m0Hat(), inner.i0Hat(), ex, ey, eth});
+    if constexpr (std::is_same_v<Trace, RunTally>)
+      trace.add({t, &s, &ref, &cmd, &u, inner.m0Hat(), inner.i0Hat(), ex, ey, eth});
+    else if (trace)
+      trace({t, &s, &ref, &cmd, &u, inner.m0Hat(), inner.i0Hat(), ex, ey, eth});
     result.periods = k;
     if (stop && k % kStopCheckEvery == kStopCheckEvery - 1 && k < n && stop(metrics)) {
       result.stopped = true;
@@ -101,9 +114,9 @@ RunResult loop(const Scenario& sc, ReferenceSource& reference, Outer& outer, Inn
   return result;
 }
 
-template <typename Outer>
-RunResult withInner(const Scenario& sc, ReferenceSource& reference, Outer& outer, bool keep_samples,
-                    const std::function<void(const LoopSample&)>& trace, const RunStop& stop) {
+template <typename Outer, typename Trace>
+RunResult withInner(const Scenario& sc, ReferenceSource& reference, Outer& outer, bool keep_samples, Trace& trace,
+                    const RunStop& stop) {
   if (sc.inner == InnerKind::pid) {
     InnerAdapter<WheelPid> pid{WheelPid(sc.pid, sc.robot)};
     return loop(sc, reference, outer, pid, keep_samples, trace, stop);
@@ -112,16 +125,26 @@ RunResult withInner(const Scenario& sc, ReferenceSource& reference, Outer& outer
   return loop(sc, reference, outer, smc, keep_samples, trace, stop);
 }
 
-}  // namespace
-
-RunResult runClosedLoop(const Scenario& sc, ReferenceSource& reference, bool keep_samples,
-                        const std::function<void(const LoopSample&)>& trace, const RunStop& stop) {
+template <typename Trace>
+RunResult withOuter(const Scenario& sc, ReferenceSource& reference, bool keep_samples, Trace& trace,
+                    const RunStop& stop) {
   if (sc.outer == OuterKind::kanayama) {
     Kanayama kanayama(sc.kanayama);
     return withInner(sc, reference, kanayama, keep_samples, trace, stop);
   }
   PurePursuit pursuit(sc.pure_pursuit, sc.outer == OuterKind::rpp);
   return withInner(sc, reference, pursuit, keep_samples, trace, stop);
+}
+
+}  // namespace
+
+RunResult runClosedLoop(const Scenario& sc, ReferenceSource& reference, bool keep_samples,
+                        const std::function<void(const LoopSample&)>& trace, const RunStop& stop) {
+  return withOuter(sc, reference, keep_samples, trace, stop);
+}
+
+RunResult runClosedLoop(const Scenario& sc, ReferenceSource& reference, bool keep_samples, RunTally& tally) {
+  return withOuter(sc, reference, keep_samples, tally, RunStop{});
 }
 
 RunResult runClosedLoop(const Scenario& sc, ReferenceSource& reference, OuterController& outer, InnerController& inner,

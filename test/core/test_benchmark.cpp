@@ -75,6 +75,40 @@ TEST(Benchmark, ARunDependsOnItsSeedOnlyAndCanBeRepeatedAlone) {
   EXPECT_EQ(drawRun(spec, sc, 3).phase, rows[3].draw.phase);
 }
 
+// A line row's per-period figures are a RunTally the loop adds up itself (no callback): the same bits as
+// a trace callback calling add() every period, for both inner-controller kinds (PID: another loop).
+TEST(Benchmark, TheTallyInTheLoopEqualsTheTallyFedByACallback) {
+  for (const char* pair : {"kanayama+atsmc", "rpp+pid"}) {
+    const Scenario base = shortLine(pair);
+    const MonteCarloSpec spec = shortSpec();
+    const Scenario sc = applyDraw(base, spec, drawRun(spec, base, 2));
+    std::vector<double> series_in, series_cb;
+    RunTally in, cb;
+    for (RunTally* t : {&in, &cb}) {
+      t->dt = secondsFromNanos(sc.control_period_ns);
+      t->settle_time = 1.0;
+      t->series_every = 7;
+    }
+    in.series = &series_in;
+    cb.series = &series_cb;
+    LineReference line;
+    const RunResult a = runClosedLoop(sc, line, true, in);
+    const RunResult b = runClosedLoop(sc, line, true, [&cb](const LoopSample& s) { cb.add(s); });
+    EXPECT_GT(in.effort, 0.0) << pair;
+    EXPECT_GT(in.worst_cross_track, 0.0) << pair;
+    EXPECT_EQ(in.effort, cb.effort) << pair;
+    EXPECT_EQ(in.chattering, cb.chattering) << pair;
+    EXPECT_EQ(in.worst_cross_track, cb.worst_cross_track) << pair;
+    EXPECT_EQ(in.last_cross_track, cb.last_cross_track) << pair;
+    EXPECT_EQ(series_in.size(), static_cast<std::size_t>(sc.steps() / 7 + 1)) << pair;
+    EXPECT_EQ(series_in, series_cb) << pair;
+    EXPECT_EQ(a.periods, b.periods) << pair;
+    EXPECT_EQ(a.saturated_steps, b.saturated_steps) << pair;
+    EXPECT_EQ(a.metrics[AXIS_Y].itae, b.metrics[AXIS_Y].itae) << pair;
+    EXPECT_EQ(a.metrics[AXIS_THETA].settling_time, b.metrics[AXIS_THETA].settling_time) << pair;
+  }
+}
+
 TEST(Benchmark, AFailedRunIsCountedWithItsReason) {
   Scenario sc = shortLine("kanayama+atsmc");
   LineReference line;

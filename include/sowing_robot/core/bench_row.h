@@ -23,18 +23,6 @@ std::string csvNumber(double v);
 /// %.4g (report.md).
 std::string shortNumber(double v);
 
-/// Lateral error in the reference's frame (cross-track for a line or a row).
-inline double crossTrack(const LoopSample& s) {
-  const double th = s.reference->pose.theta;
-  // sin(+-0) = +-0 and cos(+-0) = 1 exactly: a line or a row along x needs no sincos every period.
-  double sn = th, c = 1.0;
-  if (th != 0.0) {
-    sn = std::sin(th);
-    c = std::cos(th);
-  }
-  return -sn * s.ex + c * s.ey;
-}
-
 /// Periods between two samples of a scenario's cross-track series (its envelope_period, at least 1).
 inline std::int64_t seriesEvery(const BenchScenario& bench) {
   return static_cast<std::int64_t>(
@@ -49,44 +37,43 @@ struct RunExtras {
 };
 
 /// A row's figures, fed every period's sample (add(), inline: it runs in the loop's callback), then
-/// written into the row with the failure reason (finish()).
+/// written into the row with the failure reason (finish()). The effort, chattering and cross-track are a
+/// RunTally (runner.h): a run with neither contacts nor a last reference to follow needs nothing else per
+/// period and can give the loop tally() instead of a callback (benchmark.cpp's measure()).
 class RowMeter {
  public:
   RowMeter(RunRow& row, const Scenario& sc, const MonteCarloSpec& spec, const RunExtras& extras)
       : row_(row), spec_(spec), extras_(extras), dt_(secondsFromNanos(sc.control_period_ns)) {
+    tally_.dt = dt_;
+    tally_.settle_time = spec.settle_time;
+    tally_.series_every = extras.series_every;
+    tally_.series = &row.cross_track_series;
     if (extras.series_every > 0)
       row.cross_track_series.reserve(static_cast<std::size_t>(sc.steps() / extras.series_every + 1));
   }
 
+  /// Whether add() does more per period than tally().add() (the body against obstacles, the last
+  /// reference): then the loop must call add().
+  bool needsEveryPeriod() const { return extras_.contacts != nullptr || extras_.last_reference != nullptr; }
+  /// The per-period figures, for runClosedLoop(scenario, reference, keep_samples, tally) when
+  /// !needsEveryPeriod(); finish() reads them either way.
+  RunTally& tally() { return tally_; }
+
   void add(const LoopSample& s) {
-    // A period's torque is applied over the next dt: count it when the next sample arrives, so the
-    // last one (never applied) is left out of the effort and of the total variation.
-    if (count_ >= 1) row_.effort += dt_ * (prev_.right * prev_.right + prev_.left * prev_.left);
-    if (count_ >= 2) row_.chattering += std::fabs(prev_.right - prev2_.right) + std::fabs(prev_.left - prev2_.left);
-    const double e = crossTrack(s);
-    if (extras_.series_every > 0) {  // at count = 0, series_every, 2 series_every, ... (no % per period)
-      if (until_series_ == 0) {
-        row_.cross_track_series.push_back(e);
-        until_series_ = extras_.series_every;
-      }
-      --until_series_;
-    }
+    tally_.add(s);
     if (extras_.contacts) extras_.contacts->update(s.t, {(*s.state)[X], (*s.state)[Y], (*s.state)[THETA]});
     if (extras_.last_reference) *extras_.last_reference = s.reference->pose;
-    prev2_ = prev_;
-    prev_ = s.control->torques;
-    ++count_;
-    last_ = std::fabs(e);
-    if (s.t >= spec_.settle_time) worst_ = std::max(worst_, last_);
   }
 
   /// The run's metrics, time at the limit, cross-track, body and end distance into the row, and its
   /// failure: diverged, else contact, else cross-track (the finish check comes after: markNotFinished).
   void finish(const RunResult& r) {
     row_.metrics = r.metrics;
+    row_.effort = tally_.effort;
+    row_.chattering = tally_.chattering;
     row_.time_at_limit = dt_ * static_cast<double>(r.saturated_steps);
-    row_.worst_cross_track = worst_;
-    row_.final_cross_track = last_;
+    row_.worst_cross_track = tally_.worst_cross_track;
+    row_.final_cross_track = tally_.last_cross_track;
     row_.diverged = r.diverged;
     row_.min_clearance = std::numeric_limits<double>::quiet_NaN();
     if (extras_.last_reference)
@@ -103,7 +90,7 @@ class RowMeter {
       row_.failure = "diverged";
     } else if (row_.contacts > 0) {
       row_.failure = "contact";
-    } else if (!(worst_ < spec_.cross_track_threshold)) {
+    } else if (!(tally_.worst_cross_track < spec_.cross_track_threshold)) {
       row_.failure = "cross-track";
     }
     row_.success = row_.failure.empty();
@@ -114,9 +101,7 @@ class RowMeter {
   const MonteCarloSpec& spec_;
   const RunExtras& extras_;
   const double dt_;
-  std::int64_t count_ = 0, until_series_ = 0;
-  WheelTorques prev_, prev2_;
-  double worst_ = 0.0, last_ = 0.0;
+  RunTally tally_;
 };
 
 /// A field run's finish check: not finished when the plan stops short of a row end, the path had not

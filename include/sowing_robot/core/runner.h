@@ -5,11 +5,14 @@
 // Scenario::outer / inner (controllers.h).
 #pragma once
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "sowing_robot/core/controllers.h"
 #include "sowing_robot/core/kanayama.h"
@@ -56,6 +59,64 @@ struct LoopSample {
   double ex, ey, etheta;       ///< world-frame errors
 };
 
+/// Lateral error in the reference's frame (cross-track for a line or a row).
+inline double crossTrack(const LoopSample& s) {
+  const double th = s.reference->pose.theta;
+  // sin(+-0) = +-0 and cos(+-0) = 1 exactly: a line or a row along x needs no sincos every period.
+  double sn = th, c = 1.0;
+  if (th != 0.0) {
+    sn = std::sin(th);
+    c = std::cos(th);
+  }
+  return -sn * s.ex + c * s.ey;
+}
+
+/// The per-period figures of a benchmark row (core/bench_row.h's RowMeter) beyond the metrics, added up
+/// sample by sample: the wheel-torque effort and its total variation, the cross-track error (its worst
+/// after settle_time, its last, a series every series_every periods). runClosedLoop takes one directly
+/// (below), so a run that needs nothing else per period has them without a trace callback: no
+/// std::function call and no LoopSample built every period (docs/performance.md).
+struct RunTally {
+  // Set before the run:
+  double dt = 0.0;                ///< control period [s]
+  double settle_time = 0.0;       ///< worst_cross_track counts from here [s]
+  std::int64_t series_every = 0;  ///< cross-track into *series every this many periods (0: none)
+  std::vector<double>* series = nullptr;
+  // The figures:
+  double effort = 0.0;             ///< integral of tau_r^2 + tau_l^2 [N^2·m^2·s]
+  double chattering = 0.0;         ///< sum |delta tau_r| + |delta tau_l| [N·m]
+  double worst_cross_track = 0.0;  ///< max |cross-track| from settle_time on [m]
+  double last_cross_track = 0.0;   ///< |cross-track| of the last sample [m]
+
+  void add(const LoopSample& s) {
+    // A period's torque is applied over the next dt: count it when the next sample arrives, so the
+    // last one (never applied) is left out of the effort and of the total variation.
+    if (count_ >= 1) effort += dt * (prev_.right * prev_.right + prev_.left * prev_.left);
+    if (count_ >= 2) chattering += std::fabs(prev_.right - prev2_.right) + std::fabs(prev_.left - prev2_.left);
+    const double e = crossTrack(s);
+    if (series_every > 0) {  // at count = 0, series_every, 2 series_every, ... (no % per period)
+      if (until_series_ == 0) {
+        series->push_back(e);
+        until_series_ = series_every;
+      }
+      --until_series_;
+    }
+    // Field by field: a struct copy is two 16-byte moves, and the inner controller has just written its
+    // output 8 bytes at a time (a load that cannot be forwarded from those stores).
+    prev2_.right = prev_.right;
+    prev2_.left = prev_.left;
+    prev_.right = s.control->torques.right;
+    prev_.left = s.control->torques.left;
+    ++count_;
+    last_cross_track = std::fabs(e);
+    if (s.t >= settle_time) worst_cross_track = std::max(worst_cross_track, last_cross_track);
+  }
+
+ private:
+  std::int64_t count_ = 0, until_series_ = 0;
+  WheelTorques prev_, prev2_;
+};
+
 struct RunResult {
   std::array<AxisMetrics, AXIS_COUNT> metrics{};
   State final_state = State::Zero();
@@ -75,6 +136,10 @@ constexpr std::int64_t kStopCheckEvery = 256;
 /// on the time-domain figures (rise/settling/overshoot).
 RunResult runClosedLoop(const Scenario& scenario, ReferenceSource& reference, bool keep_samples = true,
                         const std::function<void(const LoopSample&)>& trace = {}, const RunStop& stop = {});
+
+/// The same run with a RunTally fed every period (inlined into the loop; the same numbers as a trace
+/// callback calling tally.add()).
+RunResult runClosedLoop(const Scenario& scenario, ReferenceSource& reference, bool keep_samples, RunTally& tally);
 
 /// The same loop with caller-built controllers behind the run-time interfaces (virtual calls; the
 /// Scenario's outer/inner choice and gains are then ignored, its plant, timing and start are used).

@@ -3,7 +3,8 @@
 // the bit and in the same order, but cheaper in the closed loop, where it was ~20 % of a noisy run:
 //  - drawn in blocks of kBlock: the polar method's rejection test (taken ~21 % of the time, at random)
 //    mispredicts inside a short loop of its own instead of in the middle of a control period, where each
-//    miss threw away the period's work in flight; the values are the same, only drawn earlier;
+//    miss threw away the period's work in flight; the values are the same, only drawn earlier; and
+//    within a block the rejection is an index that advances or not, not a branch (refill());
 //  - inline, and the 64-bit unsigned to double conversion without the branch GCC emits for it
 //    (u >= 2^63 in half the draws, at random).
 // test_plant's TorqueNoise.SameNumbersAsTheStandardLibrary compares it with std::normal_distribution.
@@ -25,7 +26,6 @@ class TorqueNoise {
   /// Back to the start of the sequence of `seed` (std::mt19937_64::seed and normal_distribution::reset).
   void seed(std::uint64_t seed) {
     engine_.seed(seed);
-    saved_available_ = false;
     next_ = kBlock;
   }
 
@@ -36,8 +36,31 @@ class TorqueNoise {
   }
 
  private:
+  static constexpr int kPairs = kBlock / 2;  // a block is whole polar pairs (kBlock even): no value saved across
+
+  // kPairs polar pairs in two passes (the same draws, the same operations, the same order of values as
+  // normal_distribution: y * mult, then the saved x * mult):
+  //  1. the candidates (x, y) in draw order, each written at the next free slot and kept (the slot
+  //     advanced) when inside the unit circle: the rejection is an add, not a branch that mispredicts
+  //     about one time in five;
+  //  2. log, division and sqrt of the kept ones: independent of each other, so they overlap.
   void refill() {
-    for (double& v : block_) v = polar();
+    int n = 0;
+    while (n < kPairs) {
+      const double x = 2.0 * canonical() - 1.0;
+      const double y = 2.0 * canonical() - 1.0;
+      const double r2 = x * x + y * y;
+      x_[n] = x;
+      y_[n] = y;
+      r2_[n] = r2;
+      n += static_cast<int>(!((r2 > 1.0) | (r2 == 0.0)));
+    }
+    for (int j = 0; j < kPairs; ++j) {
+      const double mult = std::sqrt(-2 * std::log(r2_[j]) / r2_[j]);
+      // ret * stddev + mean, as the library returns both values (+0.0 turns -0 into 0)
+      block_[2 * j] = (y_[j] * mult) * 1.0 + 0.0;
+      block_[2 * j + 1] = (x_[j] * mult) * 1.0 + 0.0;
+    }
     next_ = 0;
   }
 
@@ -52,30 +75,10 @@ class TorqueNoise {
     return r >= 1.0 ? 0x1.fffffffffffffp-1 : r;  // nextafter(1, 0) when u rounds up to 2^64
   }
 
-  // normal_distribution<double>::operator() with mean 0, stddev 1: one polar pair, the second value
-  // saved for the next call.
-  double polar() {
-    if (saved_available_) {
-      saved_available_ = false;
-      return saved_ * 1.0 + 0.0;  // ret * stddev + mean, as the library returns it (+0.0 turns -0 into 0)
-    }
-    double x, y, r2;
-    do {
-      x = 2.0 * canonical() - 1.0;
-      y = 2.0 * canonical() - 1.0;
-      r2 = x * x + y * y;
-    } while (r2 > 1.0 || r2 == 0.0);
-    const double mult = std::sqrt(-2 * std::log(r2) / r2);
-    saved_ = x * mult;
-    saved_available_ = true;
-    return (y * mult) * 1.0 + 0.0;
-  }
-
   std::mt19937_64 engine_;
-  bool saved_available_ = false;
-  double saved_ = 0.0;
   int next_ = kBlock;  // kBlock: the block is used up (or never drawn)
   double block_[kBlock] = {};
+  double x_[kPairs] = {}, y_[kPairs] = {}, r2_[kPairs] = {};  // refill()'s kept candidates
 };
 
 }  // namespace core
