@@ -97,6 +97,7 @@ py::dict fixCounts(const FixCounts& c, long lost_from_queue) {
   py::dict d;
   d["applied"] = c.applied;
   d["reanchored"] = c.reanchored;
+  d["slip_onsets"] = c.slip_onsets;
   d["gated"] = c.gated;
   d["too_old"] = c.too_old;
   d["future"] = c.future;
@@ -196,8 +197,8 @@ left out taking the traction block's. sensors: plant_sim's sensors/ keys ({"seed
 0.05}}); estimator: state_estimator's estimator/ keys ({"fix": {"gate": 0}}). Other arguments as run()'s.
 Returns run()'s dict plus "feedback", "traction", "max_abs_slip", "tool_down_time", "fed_error_rms",
 "fed_error_max", "fed_heading_error_max" (the fed pose against the truth), "odometry_error_final",
-"odometry_error_max", "fixes" ({"applied", "reanchored", "gated", "too_old", "future", "invalid",
-"lost_from_queue"}); with trace=True run()'s columns plus fed_x, fed_y, fed_theta, fed_v, fed_omega,
+"odometry_error_max", "fixes" ({"applied", "reanchored", "slip_onsets", "gated", "too_old", "future",
+"invalid", "lost_from_queue"}); with trace=True run()'s columns plus fed_x, fed_y, fed_theta, fed_v, fed_omega,
 slip_right, slip_left, tool_down. Raises ValueError for a bad name, key or value (naming the key).)doc");
 }
 

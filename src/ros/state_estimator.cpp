@@ -77,9 +77,9 @@ StateEstimator::~StateEstimator() {
   const core::FixCounts& c = ekf_.counts();
   ROS_INFO(
       "state_estimator: fixes applied %ld, refused %ld (older than the history %ld, newer than the estimate "
-      "%ld, invalid %ld, gated %ld), re-anchored %ld, applied late %ld, lost from a full queue %ld, awaited but never "
+      "%ld, invalid %ld, gated %ld), re-anchored %ld, slip onsets %ld, applied late %ld, lost from a full queue %ld, awaited but never "
       "received %ld; inputs rejected %ld",
-      c.applied, c.refused(), c.too_old, c.future, c.invalid, c.gated, c.reanchored, late_fixes_, fixes_.dropped(),
+      c.applied, c.refused(), c.too_old, c.future, c.invalid, c.gated, c.reanchored, c.slip_onsets, late_fixes_, fixes_.dropped(),
       lost_fixes_, rejected_inputs_);
 }
 
@@ -190,12 +190,15 @@ void StateEstimator::step(const nav_msgs::Odometry& odom, const sensor_msgs::Imu
   }
   for (const core::EkfFix& f : fixes_.due(ekf_.time())) ekf_.fuse(f);
   const core::FixCounts& c = ekf_.counts();
-  if (c.refused() != reported_.refused() || c.reanchored != reported_.reanchored) {
+  if (c.refused() != reported_.refused() || c.reanchored != reported_.reanchored ||
+      c.slip_onsets != reported_.slip_onsets) {
     ROS_WARN_THROTTLE(1.0,
                       "state_estimator: fixes refused so far: %ld older than the history, %ld newer than the "
                       "estimate, %ld invalid, %ld outside the gate (%ld applied, %ld of them re-anchoring the "
-                      "position after estimator/fix/reanchor_after gated in a row)",
-                      c.too_old, c.future, c.invalid, c.gated, c.applied, c.reanchored);
+                      "position after estimator/fix/reanchor_after gated in a row); wheel slip taken %ld time(s) "
+                      "(estimator/slip/inflation)%s",
+                      c.too_old, c.future, c.invalid, c.gated, c.applied, c.reanchored, c.slip_onsets,
+                      ekf_.slipping() ? ", slipping now" : "");
     reported_ = c;
   }
   last_odom_ = odom;
