@@ -42,6 +42,16 @@ def fix(stamp, x, y, sigma=0.02):
     return f
 
 
+def wait_for(condition, what, wall_limit):
+    """Poll `condition` until it holds; AssertionError ("no WHAT after N s wall") after `wall_limit` s. `what`
+    may be a callable, for a message that says how far it got."""
+    deadline = time.time() + wall_limit
+    while not condition():
+        if time.time() > deadline:
+            raise AssertionError("no %s after %.0f s wall" % (what() if callable(what) else what, wall_limit))
+        time.sleep(0.01)
+
+
 class Wiring:
     """Publishers of odom, imu and fix, a subscriber collecting odometry/filtered in `out`, connected."""
 
@@ -51,9 +61,5 @@ class Wiring:
         self.odom = rospy.Publisher("odom", Odometry, queue_size=10000)
         self.imu = rospy.Publisher("imu", Imu, queue_size=10000)
         self.fix = rospy.Publisher("fix", PoseWithCovarianceStamped, queue_size=10)
-        deadline = time.time() + wall_limit
-        while not (all(p.get_num_connections() > 0 for p in (self.odom, self.imu, self.fix)) and
-                   self.sub.get_num_connections() > 0):
-            if time.time() > deadline:
-                raise AssertionError("state_estimator's topics not connected after %.0f s wall" % wall_limit)
-            time.sleep(0.01)
+        wait_for(lambda: all(p.get_num_connections() > 0 for p in (self.odom, self.imu, self.fix, self.sub)),
+                 "connections to state_estimator", wall_limit)

@@ -30,11 +30,7 @@ class StateEstimatorLockstep(unittest.TestCase):
         rospy.init_node("state_estimator_lockstep_test")
 
     def wait_for(self, condition, what):
-        deadline = time.time() + WALL_LIMIT
-        while not condition():
-            if time.time() > deadline:
-                self.fail("no %s after %.0f s wall" % (what() if callable(what) else what, WALL_LIMIT))
-            time.sleep(0.01)
+        estimator_feed.wait_for(condition, what, WALL_LIMIT)
 
     def test_waits_for_the_fix_due(self):
         w = estimator_feed.Wiring(WALL_LIMIT)

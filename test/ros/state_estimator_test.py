@@ -34,11 +34,7 @@ class StateEstimatorTest(unittest.TestCase):
         rospy.init_node("state_estimator_test")
 
     def wait_for(self, condition, what):
-        deadline = time.time() + WALL_LIMIT
-        while not condition():
-            if time.time() > deadline:
-                self.fail("no %s after %.0f s wall" % (what() if callable(what) else what, WALL_LIMIT))
-            time.sleep(0.01)
+        estimator_feed.wait_for(condition, what, WALL_LIMIT)
 
     def test_pairing_covariance_and_late_fix(self):
         delay = rospy.get_param("/state_estimator/estimator/fix/delay")
