@@ -232,23 +232,12 @@ std::vector<RunRow> runBenchmark(const BenchScenario& bench, std::int64_t runs, 
   return parallelRows(runs, threads, progress, [&]() {
     return [&bench, &base, &spec, period_steps](std::int64_t i) {
       const RunDraw draw = drawRun(spec, base, i);
-      Scenario sc = applyDraw(base, spec, draw);
-      FieldRunSetup setup;
-      setup.scenario = sc;
-      setup.field = bench.field;
-      setup.field.start_pose = sc.start;
-      setup.obstacles = bench.obstacles;
-      sc.duration += approachExtraTime(setup);
-      FieldReference reference(setup.field, bench.obstacles);
-      ContactMonitor contacts(bench.footprint, bench.obstacles);
-      Pose2D last_ref;
       RunExtras extras;
-      extras.contacts = &contacts;
       extras.series_every = period_steps;
-      extras.last_reference = &last_ref;
-      RunRow row = measure(sc, reference, spec, draw, extras);
-      markNotFinished(row, reference, sc.duration, bench.finish_tolerance);
-      return row;
+      return fieldRow(bench, applyDraw(base, spec, draw), extras,
+                      [&spec, &draw](const Scenario& sc, ReferenceSource& reference, const RunExtras& e) {
+                        return measure(sc, reference, spec, draw, e);
+                      });
     };
   });
 }

@@ -73,24 +73,14 @@ RunRow estimatedBenchRow(const BenchScenario& bench, std::int64_t index) {
     SineReference reference(bench.sine);
     return measureEstimated(sc, cfg, reference, spec, draw, extras);
   }
-  // Field: as runBenchmark's field runs (the approach from the drawn start, its extra time, the body, the
-  // finish check), with the plant's tool rule on the field's rows (as runField with traction).
-  FieldRunSetup setup;
-  setup.scenario = sc;
-  setup.field = bench.field;
-  setup.field.start_pose = sc.start;
-  setup.obstacles = bench.obstacles;
-  sc.duration += approachExtraTime(setup);
+  // Field: as runBenchmark's field runs (fieldRow), with the plant's tool rule on the field's rows (as
+  // runField with traction).
   cfg.tool_rows = rowsOf(bench.field);
   cfg.tool_rows_open_ended = false;
-  FieldReference reference(setup.field, bench.obstacles);
-  ContactMonitor contacts(bench.footprint, bench.obstacles);
-  Pose2D last_ref;
-  extras.contacts = &contacts;
-  extras.last_reference = &last_ref;
-  RunRow row = measureEstimated(sc, cfg, reference, spec, draw, extras);
-  markNotFinished(row, reference, sc.duration, bench.finish_tolerance);
-  return row;
+  return fieldRow(bench, sc, extras,
+                  [&cfg, &spec, &draw](const Scenario& s, ReferenceSource& reference, const RunExtras& e) {
+                    return measureEstimated(s, cfg, reference, spec, draw, e);
+                  });
 }
 
 std::string estimatedCsvHeader() {

@@ -70,12 +70,7 @@ EstimatedRunResult loop(const Scenario& sc, const EstimatedRunConfig& cfg, P& pl
                         bool keep_samples, const std::function<void(const EstimatedSample&)>& trace) {
   std::unique_ptr<OuterController> outer = makeOuterController(sc);
   std::unique_ptr<InnerController> inner = makeInnerController(sc);
-  State x0 = State::Zero();
-  x0[X] = sc.start.x;
-  x0[Y] = sc.start.y;
-  x0[THETA] = sc.start.theta;
-  const bool phased = sc.disturbance_phase != 0.0 && sc.disturbance.frequency > 0.0;
-  plant.reset(x0, phased ? sc.disturbance_phase / sc.disturbance.frequency : 0.0);
+  plant.reset(startState(sc), phaseStartTime(sc));
   reference.reset();
   const std::int64_t n = sc.steps();
   const double dt = secondsFromNanos(sc.control_period_ns);
@@ -119,7 +114,7 @@ EstimatedRunResult loop(const Scenario& sc, const EstimatedRunConfig& cfg, P& pl
   for (std::int64_t k = 0; k <= n; ++k) {
     const double t = secondsFromNanos(k * sc.control_period_ns);
     const State& s = plant.state();
-    if (!std::isfinite(s.sum())) {
+    if (!finiteSum(s)) {
       result.diverged = true;
       break;
     }

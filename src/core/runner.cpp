@@ -29,15 +29,6 @@ std::int64_t Scenario::steps() const {
 
 namespace {
 
-// std::isfinite(s.sum()) with the additions of Eigen's SSE2 reduction of the 7-vector, in its order
-// (lanes {4, 2, 0} and {5, 3, 1}, then the two lanes, then 6: a sum that overflows does so at the same
-// step), from 8-byte loads: Eigen's 16-byte loads of a state that the plant's step has just written 8
-// bytes at a time cannot be forwarded from those stores and waited for them in every period (perf annotate).
-inline bool finiteSum(const State& s) {
-  const double even = (s[4] + s[2]) + s[0], odd = (s[5] + s[3]) + s[1];
-  return std::isfinite((even + odd) + s[6]);
-}
-
 // The loop body, over concrete controller types (no virtual call when they are final or plain
 // classes): Outer::compute(ref, pose, v, omega) -> VelocityCommand; Inner::update(cmd, v, omega, dt) ->
 // InnerOutput, m0Hat(), i0Hat(). Trace: the public API's std::function (may be empty), or a RunTally
@@ -46,12 +37,7 @@ template <typename Outer, typename Inner, typename Trace>
 RunResult loop(const Scenario& sc, ReferenceSource& reference, Outer& outer, Inner& inner, bool keep_samples,
                Trace& trace, const RunStop& stop) {
   Plant plant(sc.robot, sc.disturbance);
-  State x0 = State::Zero();
-  x0[X] = sc.start.x;
-  x0[Y] = sc.start.y;
-  x0[THETA] = sc.start.theta;
-  const bool phased = sc.disturbance_phase != 0.0 && sc.disturbance.frequency > 0.0;
-  plant.reset(x0, phased ? sc.disturbance_phase / sc.disturbance.frequency : 0.0);
+  plant.reset(startState(sc), phaseStartTime(sc));
   reference.reset();
   const std::int64_t n = sc.steps();
   const double dt = secondsFromNanos(sc.control_period_ns);

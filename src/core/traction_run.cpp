@@ -12,11 +12,7 @@ TractionRunResult runTractionClosedLoop(const Scenario& sc, const TractionParams
                                         const std::function<void(TractionPlant&)>& setup) {
   TractionPlant plant(sc.robot, sc.disturbance, traction);
   if (setup) setup(plant);
-  State x0 = State::Zero();
-  x0[X] = sc.start.x;
-  x0[Y] = sc.start.y;
-  x0[THETA] = sc.start.theta;
-  plant.reset(x0, 0.0);
+  plant.reset(startState(sc), 0.0);  // (the disturbance's phase is not applied here)
   Kanayama kanayama(sc.kanayama);
   SlidingModeController smc(sc.sliding, sc.robot);
   reference.reset();
@@ -30,7 +26,7 @@ TractionRunResult runTractionClosedLoop(const Scenario& sc, const TractionParams
   for (std::int64_t k = 0; k <= n; ++k) {
     const double t = secondsFromNanos(k * sc.control_period_ns);
     const State& s = plant.state();
-    if (!std::isfinite(s.sum())) {
+    if (!finiteSum(s)) {
       result.diverged = true;
       break;
     }

@@ -13,6 +13,7 @@
 #include "sowing_robot/core/benchmark.h"
 #include "sowing_robot/core/contact.h"
 #include "sowing_robot/core/field.h"
+#include "sowing_robot/core/field_run.h"
 #include "sowing_robot/core/runner.h"
 
 namespace sowing_robot {
@@ -115,6 +116,28 @@ inline void markNotFinished(RunRow& row, const FieldReference& reference, double
     row.failure = "not finished";
     row.success = false;
   }
+}
+
+/// A field row as run_scenario --field runs it: the path from the drawn start (the approach), the run's
+/// duration grown by the approach's extra time, the body followed against the obstacles, the finish checked.
+/// `measure(scenario, reference, extras)` runs the row (benchmark.cpp's measure, estimated_bench.cpp's
+/// measureEstimated).
+template <typename Measure>
+RunRow fieldRow(const BenchScenario& bench, Scenario sc, RunExtras extras, Measure measure) {
+  FieldRunSetup setup;
+  setup.scenario = sc;
+  setup.field = bench.field;
+  setup.field.start_pose = sc.start;
+  setup.obstacles = bench.obstacles;
+  sc.duration += approachExtraTime(setup);
+  FieldReference reference(setup.field, bench.obstacles);
+  ContactMonitor contacts(bench.footprint, bench.obstacles);
+  Pose2D last_ref;
+  extras.contacts = &contacts;
+  extras.last_reference = &last_ref;
+  RunRow row = measure(sc, reference, extras);
+  markNotFinished(row, reference, sc.duration, bench.finish_tolerance);
+  return row;
 }
 
 }  // namespace core

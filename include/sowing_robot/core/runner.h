@@ -126,6 +126,29 @@ struct RunResult {
   std::int64_t saturated_steps = 0;
 };
 
+/// The plant's state at the start of every closed loop: at rest at scenario.start.
+inline State startState(const Scenario& sc) {
+  State x0 = State::Zero();
+  x0[X] = sc.start.x;
+  x0[Y] = sc.start.y;
+  x0[THETA] = sc.start.theta;
+  return x0;
+}
+/// The plant's clock at the start: the disturbance's phase as a time (0 without one).
+inline double phaseStartTime(const Scenario& sc) {
+  return sc.disturbance_phase != 0.0 && sc.disturbance.frequency > 0.0 ? sc.disturbance_phase / sc.disturbance.frequency
+                                                                       : 0.0;
+}
+/// The loops' divergence test: std::isfinite(s.sum()) with the additions of Eigen's SSE2 reduction of the
+/// 7-vector, in its order (lanes {4, 2, 0} and {5, 3, 1}, then the two lanes, then 6: a sum that overflows
+/// does so at the same step), from 8-byte loads: Eigen's 16-byte loads of a state that the plant's step
+/// has just written 8 bytes at a time cannot be forwarded from those stores and waited for them in every
+/// period (perf annotate).
+inline bool finiteSum(const State& s) {
+  const double even = (s[4] + s[2]) + s[0], odd = (s[5] + s[3]) + s[1];
+  return std::isfinite((even + odd) + s[6]);
+}
+
 /// Asked every kStopCheckEvery periods with the metrics so far; true ends the run there. Every integral
 /// only grows with time, so a caller that only needs to know whether a run beats a bound can stop once
 /// the partial cost has reached it (the PSO tuner does).
