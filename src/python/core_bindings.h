@@ -9,6 +9,8 @@
 #include <array>
 #include <optional>
 #include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include "sowing_robot/core/metrics.h"
@@ -236,6 +238,24 @@ inline py::dict resultDict(const Scenario& sc, const RunResult& r) {
   d["periods"] = r.periods;
   d["saturated_steps"] = r.saturated_steps;
   return d;
+}
+
+/// The plant and timing keywords of run(), tune() and run_estimated() (what PlantArgs and lineOf take), with
+/// the core's defaults: expanded into each m.def with withPlantKeywords().
+inline auto plantKeywords() {
+  const Scenario d;
+  return std::make_tuple(py::arg("duration") = d.duration, py::arg("control_period_ns") = d.control_period_ns,
+                         py::arg("disturbance") = d.disturbance.sinusoidal,
+                         py::arg("mass_scale") = d.disturbance.mass_scale,
+                         py::arg("inertia_scale") = d.disturbance.inertia_scale,
+                         py::arg("noise_std") = d.disturbance.noise_std, py::arg("seed") = d.disturbance.seed,
+                         py::arg("start") = std::array<double, 3>{d.start.x, d.start.y, d.start.theta},
+                         py::arg("disturbance_phase") = d.disturbance_phase, py::arg("line") = py::none());
+}
+/// def(plant keywords...): the caller's m.def with the plant keywords in place.
+template <typename Def>
+void withPlantKeywords(Def def) {
+  std::apply([&def](auto&&... keywords) { def(std::forward<decltype(keywords)>(keywords)...); }, plantKeywords());
 }
 
 /// Registers run_estimated (estimated_binding.cpp).

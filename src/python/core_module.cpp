@@ -222,17 +222,11 @@ Returns {"metrics": {axis: {field: value}}, "final_state": array (x, y, theta, v
 with one row per control period (t, state, reference, command, torques, sliding variables, estimates,
 errors ex, ey, etheta). Raises ValueError for an invalid scenario.)doc");
 
-  m.def("run", &runPy, py::kw_only(), py::arg("controller") = std::string("kanayama+atsmc"),
-        py::arg("params") = py::none(), py::arg("gains") = py::none(), py::arg("duration") = defaults.duration,
-        py::arg("control_period_ns") = defaults.control_period_ns,
-        py::arg("disturbance") = defaults.disturbance.sinusoidal,
-        py::arg("mass_scale") = defaults.disturbance.mass_scale,
-        py::arg("inertia_scale") = defaults.disturbance.inertia_scale,
-        py::arg("noise_std") = defaults.disturbance.noise_std, py::arg("seed") = defaults.disturbance.seed,
-        py::arg("start") = std::array<double, 3>{defaults.start.x, defaults.start.y, defaults.start.theta},
-        py::arg("disturbance_phase") = defaults.disturbance_phase, py::arg("line") = py::none(),
-        py::arg("keep_samples") = true, py::arg("trace") = false,
-        R"doc(core::runClosedLoop of any controller pair on the line (None: the thesis's row).
+  withPlantKeywords([&m](auto&&... plant) {
+    m.def("run", &runPy, py::kw_only(), py::arg("controller") = std::string("kanayama+atsmc"),
+          py::arg("params") = py::none(), py::arg("gains") = py::none(), plant..., py::arg("keep_samples") = true,
+          py::arg("trace") = false,
+          R"doc(core::runClosedLoop of any controller pair on the line (None: the thesis's row).
 
 controller: "outer+inner", outer kanayama|pure_pursuit|rpp, inner atsmc|tsmc|pid.
 params: controller parameters by node, in the nodes' keys, as in a gains YAML: {"kinematic_controller":
@@ -240,27 +234,23 @@ params: controller parameters by node, in the nodes' keys, as in a gains YAML: {
 (yaml.safe_load of config/tuned/<pair>.yaml as it is), or flat {"torque_controller/k1": 400.0}.
 gains: {name: value} of the pair's tunable gains (tunable_gains()). Plant arguments as run_closed_loop's.
 Returns run_closed_loop's dict plus "controller". Raises ValueError for a bad name, key or value.)doc");
+  });
 
-  m.def("tune", &tunePy, py::kw_only(), py::arg("controller") = std::string("kanayama+atsmc"),
-        py::arg("params") = py::none(), py::arg("gains") = py::none(), py::arg("bounds") = py::none(),
-        py::arg("particles") = 20, py::arg("iterations") = 30, py::arg("pso_seed") = 1, py::arg("threads") = 0,
-        py::arg("velocity_clamp") = 0.2, py::arg("w_max") = 0.9, py::arg("w_min") = 0.1, py::arg("c1") = 2.0,
-        py::arg("c2") = 2.0, py::arg("cost") = std::string("itae"), py::arg("torque_weight") = 0.0,
-        py::arg("chattering_weight") = 0.0, py::arg("duration") = defaults.duration,
-        py::arg("control_period_ns") = defaults.control_period_ns,
-        py::arg("disturbance") = defaults.disturbance.sinusoidal,
-        py::arg("mass_scale") = defaults.disturbance.mass_scale,
-        py::arg("inertia_scale") = defaults.disturbance.inertia_scale,
-        py::arg("noise_std") = defaults.disturbance.noise_std, py::arg("seed") = defaults.disturbance.seed,
-        py::arg("start") = std::array<double, 3>{defaults.start.x, defaults.start.y, defaults.start.theta},
-        py::arg("disturbance_phase") = defaults.disturbance_phase, py::arg("line") = py::none(),
-        R"doc(core::tuneGains: the pso_tuner node's PSO on the scenario run() would build.
+  withPlantKeywords([&m](auto&&... plant) {
+    m.def("tune", &tunePy, py::kw_only(), py::arg("controller") = std::string("kanayama+atsmc"),
+          py::arg("params") = py::none(), py::arg("gains") = py::none(), py::arg("bounds") = py::none(),
+          py::arg("particles") = 20, py::arg("iterations") = 30, py::arg("pso_seed") = 1, py::arg("threads") = 0,
+          py::arg("velocity_clamp") = 0.2, py::arg("w_max") = 0.9, py::arg("w_min") = 0.1, py::arg("c1") = 2.0,
+          py::arg("c2") = 2.0, py::arg("cost") = std::string("itae"), py::arg("torque_weight") = 0.0,
+          py::arg("chattering_weight") = 0.0, plant...,
+          R"doc(core::tuneGains: the pso_tuner node's PSO on the scenario run() would build.
 
 bounds: [(name, lower, upper), ...]; None = every tunable gain of the pair in its default bounds
 (tunable_gains()). PSO settings as config/pso.yaml's (velocity_clamp 0.2). Same arguments, same
 result, bit for bit, whatever `threads`. Returns {"best_gains": {name: value}, "best_cost",
 "initial_best_cost", "cost_per_iteration" (array), "tracking", "effort", "chattering", "evaluations",
 "evaluations_cut", "threads", "wall_s", "bounds", "yaml" (the gains YAML body of the tuned pair)}.)doc");
+  });
 
   m.def(
       "tunable_gains",

@@ -173,20 +173,12 @@ py::dict runEstimatedPy(const std::string& controller, const py::object& params,
 }  // namespace
 
 void bindEstimated(py::module& m) {
-  const Scenario defaults;
-  m.def("run_estimated", &runEstimatedPy, py::kw_only(), py::arg("controller") = std::string("kanayama+atsmc"),
-        py::arg("params") = py::none(), py::arg("gains") = py::none(), py::arg("feedback") = std::string("fused"),
-        py::arg("traction") = py::none(), py::arg("patches") = py::none(), py::arg("sensors") = py::none(),
-        py::arg("estimator") = py::none(), py::arg("duration") = defaults.duration,
-        py::arg("control_period_ns") = defaults.control_period_ns,
-        py::arg("disturbance") = defaults.disturbance.sinusoidal,
-        py::arg("mass_scale") = defaults.disturbance.mass_scale,
-        py::arg("inertia_scale") = defaults.disturbance.inertia_scale,
-        py::arg("noise_std") = defaults.disturbance.noise_std, py::arg("seed") = defaults.disturbance.seed,
-        py::arg("start") = std::array<double, 3>{defaults.start.x, defaults.start.y, defaults.start.theta},
-        py::arg("disturbance_phase") = defaults.disturbance_phase, py::arg("line") = py::none(),
-        py::arg("keep_samples") = true, py::arg("trace") = false,
-        R"doc(core::runEstimatedLoop: run() with an estimate in the loop, scored on the truth (as run_monitor).
+  withPlantKeywords([&m](auto&&... plant) {
+    m.def("run_estimated", &runEstimatedPy, py::kw_only(), py::arg("controller") = std::string("kanayama+atsmc"),
+          py::arg("params") = py::none(), py::arg("gains") = py::none(), py::arg("feedback") = std::string("fused"),
+          py::arg("traction") = py::none(), py::arg("patches") = py::none(), py::arg("sensors") = py::none(),
+          py::arg("estimator") = py::none(), plant..., py::arg("keep_samples") = true, py::arg("trace") = false,
+          R"doc(core::runEstimatedLoop: run() with an estimate in the loop, scored on the truth (as run_monitor).
 
 feedback: what the controllers are fed: "ground_truth" (then equal to run(), bit for bit), "odometry" (the
 wheel encoders' dead reckoning) or "fused" (the EKF of state_estimator: encoders, yaw rate, late fix).
@@ -200,6 +192,7 @@ Returns run()'s dict plus "feedback", "traction", "max_abs_slip", "tool_down_tim
 "odometry_error_max", "fixes" ({"applied", "reanchored", "slip_onsets", "gated", "too_old", "future",
 "invalid", "lost_from_queue"}); with trace=True run()'s columns plus fed_x, fed_y, fed_theta, fed_v, fed_omega,
 slip_right, slip_left, tool_down. Raises ValueError for a bad name, key or value (naming the key).)doc");
+  });
 }
 
 }  // namespace py_core
