@@ -9,16 +9,10 @@
 
 namespace sowing_robot {
 
-namespace {
-std::int64_t lastStep(double duration, std::int64_t period_ns) {
-  return duration > 0.0 ? std::llround(duration * 1e9 / period_ns) : -1;
-}
-}  // namespace
-
 LockstepDriver::LockstepDriver(ros::NodeHandle nh, SimulatedPlant& plant, const Config& config)
     : plant_(plant),
       cfg_(config),
-      protocol_(plant.periodNs(), lastStep(config.duration, plant.periodNs()), config.timing),
+      protocol_(plant.periodNs(), core::lockstepLastStep(config.duration, plant.periodNs()), config.timing),
       roster_(nh, config.wait_for) {
   torque_sub_ = subscribeTorque(nh, &queue_, [this](const WheelTorque::ConstPtr& m) { torqueCallback(m); });
 }

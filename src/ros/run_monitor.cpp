@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <cstdio>
 
+#include "sowing_robot/core/lockstep.h"
 #include "sowing_robot/core/runner.h"
 #include "sowing_robot/core/validation.h"
 #include "sowing_robot/ros/component_params.h"
@@ -20,7 +21,7 @@ RunMonitor::RunMonitor(ros::NodeHandle nh, ros::NodeHandle pnh) : pnh_(pnh) {
   loadTable(p, core::RunMonitorSettings::table(), settings);
   requireValid(p, core::firstError({settings.validate(), core::checkPositive("run/duration", run.duration, "s")}));
   duration_ = run.duration;
-  if (run.lockstep) expected_samples_ = std::llround(duration_ * 1e9 / static_cast<double>(run.periodNs())) + 1;
+  if (run.lockstep) expected_samples_ = core::lockstepLastStep(duration_, run.periodNs()) + 1;  // as plant_sim stops
   output_ = settings.output;
   label_ = settings.label;
   exit_at_end_ = settings.exit_at_end;

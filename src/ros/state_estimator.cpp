@@ -78,8 +78,7 @@ StateEstimator::~StateEstimator() {
   ROS_INFO(
       "state_estimator: fixes applied %ld, refused %ld (older than the history %ld, newer than the estimate "
       "%ld, invalid %ld, gated %ld), re-anchored %ld, slip onsets %ld, applied late %ld, lost from a full queue %ld, "
-      "awaited but never "
-      "received %ld; inputs rejected %ld",
+      "awaited but never received %ld; inputs rejected %ld",
       c.applied, c.refused(), c.too_old, c.future, c.invalid, c.gated, c.reanchored, c.slip_onsets, late_fixes_,
       fixes_.dropped(), lost_fixes_, rejected_inputs_);
 }

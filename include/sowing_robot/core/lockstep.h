@@ -8,6 +8,7 @@
 // supervising thread), as PlantSim's lockstep driver does with one mutex.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 
 #include "sowing_robot/core/types.h"
@@ -22,6 +23,12 @@ struct LockstepTiming {
   double give_up = 120.0;      ///< end the run once an answer has been missing this long; 0 = never
   double startup_delay = 0.5;  ///< after the loop has connected, before step 0 (>= 0)
 };
+
+/// Index of a lockstep run's final state: `duration` [s] on the grid of `period_ns` (states 0..last, both
+/// ends stepped), -1 for duration 0 (run forever). plant_sim stops there; run_monitor expects last + 1 samples.
+inline std::int64_t lockstepLastStep(double duration, std::int64_t period_ns) {
+  return duration > 0.0 ? std::llround(duration * 1e9 / static_cast<double>(period_ns)) : -1;
+}
 
 class LockstepProtocol {
  public:
