@@ -99,6 +99,7 @@ SlidingModeController::SlidingModeController(const SlidingModeParams& params, co
   const std::string error = firstError({params.validate(), nominal.validate()});
   if (!error.empty()) throw std::invalid_argument(error);
   estimateRates(params_, R_, L_, rate_m_, rate_i_);
+  exponent_ = static_cast<double>(params_.p) / params_.q;
   reset();
 }
 
@@ -118,6 +119,7 @@ void SlidingModeController::setParams(const SlidingModeParams& params) {
   if (!error.empty()) throw std::invalid_argument(error);
   params_ = params;
   estimateRates(params_, R_, L_, rate_m_, rate_i_);
+  exponent_ = static_cast<double>(params_.p) / params_.q;
   if (params_.adaptive) {
     m0_hat_ = std::clamp(m0_hat_, params_.m0_min, params_.m0_max);
     i0_hat_ = std::clamp(i0_hat_, params_.i0_min, params_.i0_max);
@@ -147,7 +149,7 @@ inline void SlidingModeController::surface(Channel& c, double e, double xd_dot, 
     power_p_minus_q = realPower(c.integral, params_.p - params_.q, params_.q);
   }
   s = e + beta * power_p;
-  phi = xd_dot + beta * (static_cast<double>(params_.p) / params_.q) * e * power_p_minus_q;
+  phi = xd_dot + beta * exponent_ * e * power_p_minus_q;
 }
 
 // One named result on every path, so that it is built in the caller's slot (NRVO): with two, it was built on

@@ -7,22 +7,6 @@
 namespace sowing_robot {
 namespace core {
 
-double SwitchFunction::operator()(double s) const {
-  switch (type) {
-    case SwitchType::Sign: return s > 0.0 ? 1.0 : (s < 0.0 ? -1.0 : 0.0);
-    case SwitchType::Saturation: {  // eq 4.47
-      const double r = s / width;
-      return r > 1.0 ? 1.0 : (r < -1.0 ? -1.0 : r);
-    }
-    case SwitchType::Relay:  // eq 4.46
-      return s / (std::fabs(s) + width);
-    case SwitchType::Atan:  // eq 4.48, scaled by 2/pi so that eta keeps its meaning as the switching gain
-      return M_2_PI * std::atan(s / width);
-    case SwitchType::Tanh: return std::tanh(s / width);
-  }
-  return 0.0;
-}
-
 const ParamTable<SwitchFunction>& switchingTable() {
   using F = SwitchFunction;
   static const ParamTable<F> table({

@@ -88,6 +88,7 @@ class SlidingModeController {
   double m0_initial_, i0_initial_;
   double m0_hat_, i0_hat_;
   double rate_m_, rate_i_;  ///< the rates of m0_hat and I0_hat themselves (params_ scaled by `adaptation`)
+  double exponent_;         ///< p / q (set with params_: a division the surface needed twice every period)
   Channel linear_, angular_;
   SlidingModeOutput last_output_;  ///< held on a rejected input
 };

@@ -1,9 +1,10 @@
 // The robustness term's switching function: sign and its chattering remedies (eqs 4.46-4.48).
 #pragma once
 
-#include "sowing_robot/core/param_table.h"
-
+#include <cmath>
 #include <string>
+
+#include "sowing_robot/core/param_table.h"
 
 namespace sowing_robot {
 namespace core {
@@ -19,8 +20,23 @@ struct SwitchFunction {
   /// S/(|S|+delta), and 1/Delta of the normalised arctangent (2/pi) atan(S/width).
   double width;
 
-  /// Value in [-1, 1]; odd in s; tends to sign(s) as |s| grows.
-  double operator()(double s) const;
+  /// Value in [-1, 1]; odd in s; tends to sign(s) as |s| grows. Inline: the sliding-mode controller
+  /// calls it twice every period.
+  double operator()(double s) const {
+    switch (type) {
+      case SwitchType::Sign: return s > 0.0 ? 1.0 : (s < 0.0 ? -1.0 : 0.0);
+      case SwitchType::Saturation: {  // eq 4.47
+        const double r = s / width;
+        return r > 1.0 ? 1.0 : (r < -1.0 ? -1.0 : r);
+      }
+      case SwitchType::Relay:  // eq 4.46
+        return s / (std::fabs(s) + width);
+      case SwitchType::Atan:  // eq 4.48, scaled by 2/pi so that eta keeps its meaning as the switching gain
+        return M_2_PI * std::atan(s / width);
+      case SwitchType::Tanh: return std::tanh(s / width);
+    }
+    return 0.0;
+  }
 
   std::string validate() const;
   /// "sign", "sat", "relay", "atan", "tanh" -> type; false on an unknown name.

@@ -1,6 +1,7 @@
 // The plant's Gaussian torque noise: the numbers of std::normal_distribution<double>(0, 1) over
 // std::mt19937_64 as GCC's libstdc++ draws them (Marsaglia's polar method over generate_canonical), to
 // the bit and in the same order, but cheaper in the closed loop, where it was ~20 % of a noisy run:
+//  - the engine is Mt19937_64 (mt19937_64.h), the standard engine's sequence with a branchless twist;
 //  - drawn in blocks of kBlock: the polar method's rejection test (taken ~21 % of the time, at random)
 //    mispredicts inside a short loop of its own instead of in the middle of a control period, where each
 //    miss threw away the period's work in flight; the values are the same, only drawn earlier; and
@@ -12,7 +13,8 @@
 
 #include <cmath>
 #include <cstdint>
-#include <random>
+
+#include "sowing_robot/core/mt19937_64.h"
 
 namespace sowing_robot {
 namespace core {
@@ -75,7 +77,7 @@ class TorqueNoise {
     return r >= 1.0 ? 0x1.fffffffffffffp-1 : r;  // nextafter(1, 0) when u rounds up to 2^64
   }
 
-  std::mt19937_64 engine_;
+  Mt19937_64 engine_;
   int next_ = kBlock;  // kBlock: the block is used up (or never drawn)
   double block_[kBlock] = {};
   double x_[kPairs] = {}, y_[kPairs] = {}, r2_[kPairs] = {};  // refill()'s kept candidates
