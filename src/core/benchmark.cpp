@@ -1,6 +1,7 @@
 #include "sowing_robot/core/benchmark.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstdio>
@@ -52,18 +53,38 @@ RunRow measure(const Scenario& sc, ReferenceSource& reference, const MonteCarloS
   return row;
 }
 
+/// measure() of two runs at once (runClosedLoopPair): the same two rows. Runs whose meters need every
+/// period (a body, a last reference) are measured one after the other.
+void measurePair(const Scenario& sa, ReferenceSource& ra, const RunDraw& da, RunRow& row_a, const Scenario& sb,
+                 ReferenceSource& rb, const RunDraw& db, RunRow& row_b, const MonteCarloSpec& spec,
+                 const RunExtras& extras) {
+  if (extras.contacts != nullptr || extras.last_reference != nullptr) {
+    row_a = measure(sa, ra, spec, da, extras);
+    row_b = measure(sb, rb, spec, db, extras);
+    return;
+  }
+  row_a.draw = da;
+  row_b.draw = db;
+  RowMeter meter_a(row_a, sa, spec, extras), meter_b(row_b, sb, spec, extras);
+  const std::array<RunResult, 2> r = runClosedLoopPair(sa, ra, meter_a.tally(), sb, rb, meter_b.tally(), true);
+  meter_a.finish(r[0]);
+  meter_b.finish(r[1]);
+}
+
 RunRow runOne(const Scenario& base, ReferenceSource& reference, const MonteCarloSpec& spec, std::int64_t index) {
   const RunDraw draw = drawRun(spec, base, index);
   return measure(applyDraw(base, spec, draw), reference, spec, draw);
 }
 
-/// Runs 0..runs-1 on `threads` threads; make() is called once per thread and returns that thread's
-/// run(i) -> RunRow (its own reference and state). Row i lands at index i whatever thread ran it.
+/// Runs 0..runs-1 on `threads` threads, two at a time: make() is called once per thread and returns that
+/// thread's run(i, count, rows), which writes runs i .. i + count - 1 (count 1 or 2) into rows[0 .. count-1]
+/// with its own references and state. Row i lands at index i whatever thread ran it (and whichever run it
+/// was paired with: a pair's rows are those of the two runs alone).
 template <typename MakeWorker>
 std::vector<RunRow> parallelRows(std::int64_t runs, int threads, const std::function<void(std::int64_t)>& progress,
                                  const MakeWorker& make) {
   if (threads <= 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  threads = static_cast<int>(std::min<std::int64_t>(threads, runs));
+  threads = static_cast<int>(std::min<std::int64_t>(threads, (runs + 1) / 2));
   std::vector<RunRow> rows(static_cast<std::size_t>(runs));
   std::atomic<std::int64_t> next{0};
   std::int64_t done = 0;
@@ -73,17 +94,18 @@ std::vector<RunRow> parallelRows(std::int64_t runs, int threads, const std::func
   auto worker = [&]() {
     try {
       auto run = make();
-      for (std::int64_t i = next++; i < runs; i = next++) {
-        rows[static_cast<std::size_t>(i)] = run(i);
+      for (std::int64_t i = next.fetch_add(2); i < runs; i = next.fetch_add(2)) {
+        const int count = static_cast<int>(std::min<std::int64_t>(2, runs - i));
+        run(i, count, &rows[static_cast<std::size_t>(i)]);
         if (progress) {
           std::lock_guard<std::mutex> lock(progress_mutex);
-          progress(++done);
+          for (int j = 0; j < count; ++j) progress(++done);
         }
       }
     } catch (...) {
       std::lock_guard<std::mutex> lock(failure_mutex);
       if (!failure) failure = std::current_exception();
-      next = runs;  // the others stop after their current run
+      next = runs;  // the others stop after their current runs
     }
   };
   if (threads == 1) {
@@ -95,6 +117,14 @@ std::vector<RunRow> parallelRows(std::int64_t runs, int threads, const std::func
   }
   if (failure) std::rethrow_exception(failure);
   return rows;
+}
+
+/// A parallelRows worker from a one-run function run(i) -> RunRow: the runs of a batch one by one.
+template <typename RunOne>
+auto oneByOne(RunOne run) {
+  return [run](std::int64_t i, int count, RunRow* rows) {
+    for (int j = 0; j < count; ++j) rows[j] = run(i + j);
+  };
 }
 
 /// Nearest-rank quantile of sorted values.
@@ -170,7 +200,7 @@ std::vector<RunRow> runMonteCarlo(const Scenario& base, const ReferenceSource& r
   if (!e.empty()) throw std::invalid_argument("a drawn run does not validate: " + e);
   return parallelRows(runs, threads, progress, [&]() {
     std::shared_ptr<ReferenceSource> ref = reference.clone();
-    return [&base, &spec, ref](std::int64_t i) { return runOne(base, *ref, spec, i); };
+    return oneByOne([&base, &spec, ref](std::int64_t i) { return runOne(base, *ref, spec, i); });
   });
 }
 
@@ -209,7 +239,7 @@ std::vector<RunRow> runBenchmark(const BenchScenario& bench, std::int64_t runs, 
   if (!e.empty()) throw std::invalid_argument("a drawn run does not validate: " + e);
   if (bench.realism)  // sensors, traction or an estimate in the loop (issue 16): estimated_bench.h
     return parallelRows(runs, threads, progress,
-                        [&]() { return [&bench](std::int64_t i) { return estimatedBenchRow(bench, i); }; });
+                        [&]() { return oneByOne([&bench](std::int64_t i) { return estimatedBenchRow(bench, i); }); });
   const std::int64_t period_steps = seriesEvery(bench);
   if (bench.track != TrackKind::field) {
     std::unique_ptr<ReferenceSource> proto;
@@ -217,20 +247,27 @@ std::vector<RunRow> runBenchmark(const BenchScenario& bench, std::int64_t runs, 
       proto = std::make_unique<LineReference>(bench.line_v_r, bench.line_y, bench.line_x0);
     else
       proto = std::make_unique<SineReference>(bench.sine);
+    // Two runs at a time in lockstep (measurePair), each with its own reference.
     return parallelRows(runs, threads, progress, [&]() {
-      std::shared_ptr<ReferenceSource> ref = proto->clone();
-      return [&base, &spec, ref, period_steps](std::int64_t i) {
-        const RunDraw draw = drawRun(spec, base, i);
+      std::shared_ptr<ReferenceSource> ref_a = proto->clone(), ref_b = proto->clone();
+      return [&base, &spec, ref_a, ref_b, period_steps](std::int64_t i, int count, RunRow* rows) {
         RunExtras extras;
         extras.series_every = period_steps;
-        return measure(applyDraw(base, spec, draw), *ref, spec, draw, extras);
+        const RunDraw draw_a = drawRun(spec, base, i);
+        if (count == 1) {
+          rows[0] = measure(applyDraw(base, spec, draw_a), *ref_a, spec, draw_a, extras);
+          return;
+        }
+        const RunDraw draw_b = drawRun(spec, base, i + 1);
+        measurePair(applyDraw(base, spec, draw_a), *ref_a, draw_a, rows[0], applyDraw(base, spec, draw_b), *ref_b,
+                    draw_b, rows[1], spec, extras);
       };
     });
   }
   // Field: the path starts at the drawn start (the approach), so each run builds its own reference, and its
   // duration grows by the approach's extra time, as run_scenario --field does.
   return parallelRows(runs, threads, progress, [&]() {
-    return [&bench, &base, &spec, period_steps](std::int64_t i) {
+    return oneByOne([&bench, &base, &spec, period_steps](std::int64_t i) {
       const RunDraw draw = drawRun(spec, base, i);
       RunExtras extras;
       extras.series_every = period_steps;
@@ -238,7 +275,7 @@ std::vector<RunRow> runBenchmark(const BenchScenario& bench, std::int64_t runs, 
                       [&spec, &draw](const Scenario& sc, ReferenceSource& reference, const RunExtras& e) {
                         return measure(sc, reference, spec, draw, e);
                       });
-    };
+    });
   });
 }
 

@@ -5,9 +5,20 @@
 #include <limits>
 #include <stdexcept>
 
+#include "sowing_robot/core/lanes2.h"
 #include "sowing_robot/core/rotation.h"
 #include "sowing_robot/core/types.h"
 #include "sowing_robot/core/validation.h"
+
+// The step's pieces are called from two steps (one plant, two plants); GCC inlines them into the first but
+// left them as calls in the second (perf: ~15 % of a benchmark run in the calls' overhead).
+#if defined(__GNUC__)
+#define SOWING_INLINE inline __attribute__((always_inline))
+#define SOWING_LAMBDA_INLINE __attribute__((always_inline))
+#else
+#define SOWING_INLINE inline
+#define SOWING_LAMBDA_INLINE
+#endif
 
 namespace sowing_robot {
 namespace core {
@@ -98,7 +109,7 @@ inline State Plant::derivativeWithHeading(const State& s, double cos_th, double 
   return ds;
 }
 
-inline void Plant::disturbanceAt(double t, double& right, double& left) {
+SOWING_INLINE void Plant::disturbanceAt(double t, double& right, double& left) {
   // RK4 asks for three times per step (t, t + h/2 twice, t + h) and the next step starts where this one
   // ended: remembering the last time evaluated halves the sin/cos calls, with bit-identical values.
   if (t != cached_disturbance_time_) {
@@ -120,61 +131,168 @@ bool Plant::step(double tau_right, double tau_left, double dt, double theta, dou
   return step(tau_right, tau_left, dt);
 }
 
+namespace {
+
+// The rates of one RK4 stage (eq 3.13, 3.54) on plain numbers: the same operations, in the same order, as
+// derivativeWithHeading() on the Eigen state, without the temporaries. Wheel angles never enter a
+// derivative, so the stage states only carry x, y, theta, v, omega. N: double (one plant) or Lanes2 (two
+// plants at once, stepPair), so both have the very same arithmetic.
+template <typename N>
+struct Rates {
+  N x, y, theta, v, omega, phi_r, phi_l;
+};
+
+template <typename N>
+struct PlantCoefficients {
+  N mcd, m0, i0, R, L;
+};
+
+template <typename N>
+SOWING_INLINE Rates<N> stageRates(const PlantCoefficients<N>& p, N v, N w, N cos_heading, N sin_heading,
+                                  N applied_right, N applied_left) {
+  const N u1 = applied_right + applied_left, u2 = applied_right - applied_left;
+  Rates<N> k;
+  k.x = v * cos_heading;
+  k.y = v * sin_heading;
+  k.theta = w;
+  k.v = (p.mcd * w * w + u1 / p.R) / p.m0;
+  k.omega = (-p.mcd * w * v + p.L * u2 / p.R) / p.i0;
+  k.phi_r = (v + p.L * w) / p.R;
+  k.phi_l = (v - p.L * w) / p.R;
+  return k;
+}
+
+// The disturbance's time at RK4 stage `stage` (0..3) of the step from t: t, t + h/2 twice, t + h.
+inline double stageTime(double t, double h, int stage) { return stage == 0 ? t : (stage == 3 ? t + h : t + 0.5 * h); }
+
+// One RK4 step of (x, y, theta, v, omega, phi_r, phi_l): stage(k, v, omega, heading increment) gives the
+// rates of stage k. The increments, sixth (k1 + 2 k2 + 2 k3 + k4), go into *increment.
+template <typename N, typename Stage>
+SOWING_INLINE void rk4Increment(N v0, N w0, double h, const Stage& stage, Rates<N>& increment) {
+  const N half(0.5 * h), whole(h), two(2.0);
+  const Rates<N> k1 = stage(0, v0, w0, N(0.0));
+  const Rates<N> k2 = stage(1, v0 + half * k1.v, w0 + half * k1.omega, half * k1.theta);
+  const Rates<N> k3 = stage(2, v0 + half * k2.v, w0 + half * k2.omega, half * k2.theta);
+  const Rates<N> k4 = stage(3, v0 + whole * k3.v, w0 + whole * k3.omega, whole * k3.theta);
+  const N sixth(h / 6.0);
+  auto combine = [&](N a, N b, N c, N d) { return sixth * (a + two * b + two * c + d); };
+  increment.x = combine(k1.x, k2.x, k3.x, k4.x);
+  increment.y = combine(k1.y, k2.y, k3.y, k4.y);
+  increment.theta = combine(k1.theta, k2.theta, k3.theta, k4.theta);
+  increment.v = combine(k1.v, k2.v, k3.v, k4.v);
+  increment.omega = combine(k1.omega, k2.omega, k3.omega, k4.omega);
+  increment.phi_r = combine(k1.phi_r, k2.phi_r, k3.phi_r, k4.phi_r);
+  increment.phi_l = combine(k1.phi_l, k2.phi_l, k3.phi_l, k4.phi_l);
+}
+
+}  // namespace
+
+SOWING_INLINE void Plant::drawNoise(double& right, double& left) {
+  right = left = 0.0;
+  if (disturbance_.noise_std > 0.0) {
+    right = disturbance_.noise_std * noise_.next();
+    left = disturbance_.noise_std * noise_.next();
+  }
+}
+
+SOWING_INLINE void Plant::addIncrement(double x, double y, double theta, double v, double omega, double phi_r,
+                                       double phi_l, double dt) {
+  state_[X] += x;
+  state_[Y] += y;
+  state_[THETA] += theta;
+  state_[V] += v;
+  state_[OMEGA] += omega;
+  state_[PHI_R] += phi_r;
+  state_[PHI_L] += phi_l;
+  time_ += dt;
+}
+
 // cos0, sin0: cos and sin of state_[THETA].
 inline bool Plant::stepWithHeading(double tau_right, double tau_left, double dt, double cos0, double sin0) {
   if (!allFinite(tau_right, tau_left, dt) || !(dt > 0.0)) return false;
-  double noise_r = 0.0, noise_l = 0.0;
-  if (disturbance_.noise_std > 0.0) {
-    noise_r = disturbance_.noise_std * noise_.next();
-    noise_l = disturbance_.noise_std * noise_.next();
-  }
+  double noise_r, noise_l;
+  drawNoise(noise_r, noise_l);
   // The sinusoid is evaluated at each RK4 stage time; command and noise are held over the step.
-  // Stages 2 and 3 share t + h/2, and stage 4's t + h is the next step's stage 1.
+  // Stages 2 and 3 share t + h/2, and stage 4's t + h is the next step's stage 1 (disturbanceAt).
   // The heading's cos/sin come from one sincos at the start of the step, turned by each stage's small
   // heading increment (rotateHeading), instead of a sincos per stage.
   const double t = time_, h = dt;
-  // Each stage's derivative (eq 3.13, 3.54) on plain scalars: the same operations, in the same order, as
-  // derivativeWithHeading() on the Eigen state (the RK4 below is Eigen's element-wise evaluation of
-  // s + (h/2) k, written out), without the temporaries. Wheel angles never enter a derivative, so the
-  // stage states only carry x, y, theta, v, omega.
-  const double R = nominal_.R, L = nominal_.L;
   const double applied_r0 = tau_right + noise_r, applied_l0 = tau_left + noise_l;
-  struct Rates {
-    double x, y, theta, v, omega, phi_r, phi_l;
-  };
-  auto f = [&](double v, double w, double ts, double heading_increment) {
+  const PlantCoefficients<double> p{mcd_, m0_, i0_, nominal_.R, nominal_.L};
+  auto stage = [&](int k, double v, double w, double heading_increment) {
     double dr, dl, c, sn;
-    disturbanceAt(ts, dr, dl);
+    disturbanceAt(stageTime(t, h, k), dr, dl);
     rotateHeading(cos0, sin0, heading_increment, c, sn);
-    const double applied_right = applied_r0 + dr, applied_left = applied_l0 + dl;
-    const double u1 = applied_right + applied_left, u2 = applied_right - applied_left;
-    Rates k;
-    k.x = v * c;
-    k.y = v * sn;
-    k.theta = w;
-    k.v = (mcd_ * w * w + u1 / R) / m0_;
-    k.omega = (-mcd_ * w * v + L * u2 / R) / i0_;
-    k.phi_r = (v + L * w) / R;
-    k.phi_l = (v - L * w) / R;
-    return k;
+    return stageRates(p, v, w, c, sn, applied_r0 + dr, applied_l0 + dl);
   };
-  const double v0 = state_[V], w0 = state_[OMEGA];
-  const double half = 0.5 * h;
-  const Rates k1 = f(v0, w0, t, 0.0);
-  const Rates k2 = f(v0 + half * k1.v, w0 + half * k1.omega, t + 0.5 * h, 0.5 * h * k1.theta);
-  const Rates k3 = f(v0 + half * k2.v, w0 + half * k2.omega, t + 0.5 * h, 0.5 * h * k2.theta);
-  const Rates k4 = f(v0 + h * k3.v, w0 + h * k3.omega, t + h, h * k3.theta);
-  const double sixth = h / 6.0;
-  auto combine = [sixth](double a, double b, double c, double d) { return sixth * (a + 2.0 * b + 2.0 * c + d); };
-  state_[X] += combine(k1.x, k2.x, k3.x, k4.x);
-  state_[Y] += combine(k1.y, k2.y, k3.y, k4.y);
-  state_[THETA] += combine(k1.theta, k2.theta, k3.theta, k4.theta);
-  state_[V] += combine(k1.v, k2.v, k3.v, k4.v);
-  state_[OMEGA] += combine(k1.omega, k2.omega, k3.omega, k4.omega);
-  state_[PHI_R] += combine(k1.phi_r, k2.phi_r, k3.phi_r, k4.phi_r);
-  state_[PHI_L] += combine(k1.phi_l, k2.phi_l, k3.phi_l, k4.phi_l);
-  time_ += dt;
+  Rates<double> d;
+  rk4Increment(state_[V], state_[OMEGA], h, stage, d);
+  addIncrement(d.x, d.y, d.theta, d.v, d.omega, d.phi_r, d.phi_l, dt);
   return true;
+}
+
+void Plant::stepPair(Plant& a, const HeadingStep& in_a, Plant& b, const HeadingStep& in_b, double dt) {
+  const auto alone = [dt](Plant& plant, const HeadingStep& in) {
+    plant.step(in.tau_right, in.tau_left, dt, in.theta, in.cos_theta, in.sin_theta);
+  };
+  const auto takes = [dt](const HeadingStep& in) { return allFinite(in.tau_right, in.tau_left, dt) && dt > 0.0; };
+  if constexpr (!kHaveLanes2) {
+    alone(a, in_a);
+    alone(b, in_b);
+  } else {
+    // One lane's numbers are the other plant's only if the wheel geometry is shared; a refused input
+    // takes the one-plant path, which refuses it.
+    if (!(takes(in_a) && takes(in_b) && a.nominal_.R == b.nominal_.R && a.nominal_.L == b.nominal_.L)) {
+      alone(a, in_a);
+      alone(b, in_b);
+      return;
+    }
+    // step()'s choice of cos/sin: the caller's when theta is the state's heading to the bit, else computed.
+    const auto heading = [](const Plant& plant, const HeadingStep& in, double& c, double& s) {
+      if (std::memcmp(&in.theta, &plant.state_[THETA], sizeof in.theta) == 0) {
+        c = in.cos_theta;
+        s = in.sin_theta;
+      } else {
+        c = std::cos(plant.state_[THETA]);
+        s = std::sin(plant.state_[THETA]);
+      }
+    };
+    double cos_a, sin_a, cos_b, sin_b;
+    heading(a, in_a, cos_a, sin_a);
+    heading(b, in_b, cos_b, sin_b);
+    double noise_ra, noise_la, noise_rb, noise_lb;
+    a.drawNoise(noise_ra, noise_la);
+    b.drawNoise(noise_rb, noise_lb);
+    const double ta = a.time_, tb = b.time_, h = dt;
+    const Lanes2 cos0(cos_a, cos_b), sin0(sin_a, sin_b);
+    const Lanes2 applied_r0(in_a.tau_right + noise_ra, in_b.tau_right + noise_rb);
+    const Lanes2 applied_l0(in_a.tau_left + noise_la, in_b.tau_left + noise_lb);
+    const PlantCoefficients<Lanes2> p{Lanes2(a.mcd_, b.mcd_), Lanes2(a.m0_, b.m0_), Lanes2(a.i0_, b.i0_),
+                                      Lanes2(a.nominal_.R), Lanes2(a.nominal_.L)};
+    auto stage = [&](int k, Lanes2 v, Lanes2 w, Lanes2 heading_increment) SOWING_LAMBDA_INLINE {
+      double dra, dla, drb, dlb;
+      a.disturbanceAt(stageTime(ta, h, k), dra, dla);
+      b.disturbanceAt(stageTime(tb, h, k), drb, dlb);
+      Lanes2 c, sn;
+      const double inc_a = heading_increment.first(), inc_b = heading_increment.second();
+      if (std::fabs(inc_a) <= 0.05 && std::fabs(inc_b) <= 0.05) {  // rotateHeading's series, both lanes
+        rotateBySeries(cos0, sin0, heading_increment, c, sn);
+      } else {
+        double ca, sa, cb, sb;
+        rotateHeading(cos_a, sin_a, inc_a, ca, sa);
+        rotateHeading(cos_b, sin_b, inc_b, cb, sb);
+        c = Lanes2(ca, cb);
+        sn = Lanes2(sa, sb);
+      }
+      return stageRates(p, v, w, c, sn, applied_r0 + Lanes2(dra, drb), applied_l0 + Lanes2(dla, dlb));
+    };
+    Rates<Lanes2> d;
+    rk4Increment(Lanes2(a.state_[V], b.state_[V]), Lanes2(a.state_[OMEGA], b.state_[OMEGA]), h, stage, d);
+    a.addIncrement(d.x.first(), d.y.first(), d.theta.first(), d.v.first(), d.omega.first(), d.phi_r.first(),
+                   d.phi_l.first(), dt);
+    b.addIncrement(d.x.second(), d.y.second(), d.theta.second(), d.v.second(), d.omega.second(), d.phi_r.second(),
+                   d.phi_l.second(), dt);
+  }
 }
 
 Eigen::Vector2d Plant::centreOfMass() const {

@@ -29,35 +29,45 @@ std::int64_t Scenario::steps() const {
 
 namespace {
 
-// The loop body, over concrete controller types (no virtual call when they are final or plain
-// classes): Outer::compute(ref, pose, v, omega) -> VelocityCommand; Inner::update(cmd, v, omega, dt) ->
-// InnerOutput, m0Hat(), i0Hat(). Trace: the public API's std::function (may be empty), or a RunTally
-// (its add() inlined here, and what it does not read of the LoopSample never built).
+// One run's state through the loop, over concrete controller types (no virtual call when they are final or
+// plain classes): Outer::compute(ref, pose, v, omega) -> VelocityCommand; Inner::update(cmd, v, omega, dt)
+// -> InnerOutput, m0Hat(), i0Hat(). Trace: the public API's std::function (may be empty), or a RunTally
+// (its add() inlined here, and what it does not read of the LoopSample never built). The one-run loop and
+// the two-run loop (runPair) step it the same way: control(k), then the plant, period after period.
 template <typename Outer, typename Inner, typename Trace>
-RunResult loop(const Scenario& sc, ReferenceSource& reference, Outer& outer, Inner& inner, bool keep_samples,
-               Trace& trace, const RunStop& stop) {
-  Plant plant(sc.robot, sc.disturbance);
-  plant.reset(startState(sc), phaseStartTime(sc));
-  reference.reset();
-  const std::int64_t n = sc.steps();
-  const double dt = secondsFromNanos(sc.control_period_ns);
-  MetricsAccumulator metrics(keep_samples);
-  metrics.reserve(static_cast<std::size_t>(n + 1));
-  RunResult result;
+struct LoopRun {
+  static constexpr bool kanayama = std::is_same_v<Outer, Kanayama>;
 
-  for (std::int64_t k = 0; k <= n; ++k) {
+  LoopRun(const Scenario& scenario, ReferenceSource& ref, Outer& o, Inner& i, bool keep_samples, Trace& tr,
+          const RunStop& st)
+      : sc(scenario),
+        reference(ref),
+        outer(o),
+        inner(i),
+        trace(tr),
+        stop(st),
+        plant(scenario.robot, scenario.disturbance),
+        n(scenario.steps()),
+        dt(secondsFromNanos(scenario.control_period_ns)),
+        metrics(keep_samples) {
+    plant.reset(startState(sc), phaseStartTime(sc));
+    reference.reset();
+    metrics.reserve(static_cast<std::size_t>(n + 1));
+  }
+
+  /// Period k up to its torques (tau_right, tau_left, for stepPlant()). False: the run ends at k (the state
+  /// diverged, or stop() said so) and the plant must not step.
+  bool control(std::int64_t k) {
     const double t = secondsFromNanos(k * sc.control_period_ns);
     const State& s = plant.state();
     if (!finiteSum(s)) {
       result.diverged = true;
-      break;
+      return false;
     }
     // What the controllers receive in nav_msgs/Odometry.
-    const Pose2D pose{s[X], s[Y], yawThroughQuaternion(s[THETA])};
+    pose = Pose2D{s[X], s[Y], yawThroughQuaternion(s[THETA])};
     // With Kanayama: cos/sin of that yaw, which Kanayama needs, and so does the plant's step when the
     // quaternion round trip gave the heading back to the bit (about two steps in three): computed once.
-    constexpr bool kanayama = std::is_same_v<Outer, Kanayama>;
-    double cos_yaw = 0.0, sin_yaw = 0.0;
     if constexpr (kanayama) {
       cos_yaw = std::cos(pose.theta);
       sin_yaw = std::sin(pose.theta);
@@ -73,6 +83,8 @@ RunResult loop(const Scenario& sc, ReferenceSource& reference, Outer& outer, Inn
       else
         return outer.compute(ref, pose, s[V], s[OMEGA]);
     }();
+    // A local, not a member: assigned to one, the result would be copied 16 bytes at a time out of
+    // fields just stored 8 bytes at a time (store-forwarding stalls); the torques are taken field by field.
     const InnerOutput u = inner.update(cmd, s[V], s[OMEGA], dt);
     if (u.saturated) ++result.saturated_steps;
     if constexpr (std::is_same_v<Trace, RunTally>)
@@ -82,22 +94,89 @@ RunResult loop(const Scenario& sc, ReferenceSource& reference, Outer& outer, Inn
     result.periods = k;
     if (stop && k % kStopCheckEvery == kStopCheckEvery - 1 && k < n && stop(metrics)) {
       result.stopped = true;
+      return false;
+    }
+    tau_right = u.torques.right;
+    tau_left = u.torques.left;
+    return true;
+  }
+
+  /// The plant's step with this period's torques.
+  void stepPlant() {
+    if constexpr (kanayama)
+      plant.step(tau_right, tau_left, dt, pose.theta, cos_yaw, sin_yaw);
+    else
+      plant.step(tau_right, tau_left, dt);
+  }
+  /// The same, as Plant::stepPair's input (a heading that matches no state without Kanayama's cos/sin).
+  Plant::HeadingStep headingStep() const {
+    if constexpr (kanayama)
+      return {tau_right, tau_left, pose.theta, cos_yaw, sin_yaw};
+    else
+      return {tau_right, tau_left, std::numeric_limits<double>::quiet_NaN(), 0.0, 0.0};
+  }
+
+  /// Periods from `from` to the end (or to an earlier end of the run).
+  void runFrom(std::int64_t from) {
+    for (std::int64_t k = from; k <= n; ++k) {
+      if (!control(k)) break;
+      if (k < n) stepPlant();
+    }
+  }
+
+  RunResult finish() {
+    result.final_state = plant.state();
+    result.metrics = metrics.result();
+    if (result.diverged) {
+      const double inf = std::numeric_limits<double>::infinity();
+      for (auto& m : result.metrics) m.ise = m.itse = m.iae = m.itae = inf;
+    }
+    return result;
+  }
+
+  const Scenario& sc;
+  ReferenceSource& reference;
+  Outer& outer;
+  Inner& inner;
+  Trace& trace;
+  const RunStop& stop;
+  Plant plant;
+  const std::int64_t n;
+  const double dt;
+  MetricsAccumulator metrics;
+  RunResult result;
+  Pose2D pose;
+  double cos_yaw = 0.0, sin_yaw = 0.0;
+  double tau_right = 0.0, tau_left = 0.0;
+};
+
+template <typename Outer, typename Inner, typename Trace>
+RunResult loop(const Scenario& sc, ReferenceSource& reference, Outer& outer, Inner& inner, bool keep_samples,
+               Trace& trace, const RunStop& stop) {
+  LoopRun<Outer, Inner, Trace> run(sc, reference, outer, inner, keep_samples, trace, stop);
+  run.runFrom(0);
+  return run.finish();
+}
+
+// Two runs of the same length and period in lockstep: each period's control for one, then the other, then
+// both plants in one Plant::stepPair. When one run ends early (diverged), the other goes on alone. Each
+// result is the one-run loop's to the bit: the same calls in the same order for each run.
+template <typename Outer, typename Inner>
+std::array<RunResult, 2> loopPair(LoopRun<Outer, Inner, RunTally>& a, LoopRun<Outer, Inner, RunTally>& b) {
+  const std::int64_t n = a.n;
+  for (std::int64_t k = 0; k <= n; ++k) {
+    const bool go_a = a.control(k), go_b = b.control(k);
+    if (!(go_a && go_b)) {
+      for (auto* run : {&a, &b}) {
+        if (!(run == &a ? go_a : go_b)) continue;
+        if (k < n) run->stepPlant();
+        run->runFrom(k + 1);
+      }
       break;
     }
-    if (k < n) {
-      if constexpr (kanayama)
-        plant.step(u.torques.right, u.torques.left, dt, pose.theta, cos_yaw, sin_yaw);
-      else
-        plant.step(u.torques.right, u.torques.left, dt);
-    }
+    if (k < n) Plant::stepPair(a.plant, a.headingStep(), b.plant, b.headingStep(), a.dt);
   }
-  result.final_state = plant.state();
-  result.metrics = metrics.result();
-  if (result.diverged) {
-    const double inf = std::numeric_limits<double>::infinity();
-    for (auto& m : result.metrics) m.ise = m.itse = m.iae = m.itae = inf;
-  }
-  return result;
+  return {a.finish(), b.finish()};
 }
 
 template <typename Outer, typename Trace>
@@ -122,6 +201,28 @@ RunResult withOuter(const Scenario& sc, ReferenceSource& reference, bool keep_sa
   return withInner(sc, reference, pursuit, keep_samples, trace, stop);
 }
 
+template <typename Outer, typename Inner>
+std::array<RunResult, 2> pairOf(const Scenario& sa, ReferenceSource& ra, RunTally& ta, Outer& oa, Inner& ia,
+                                const Scenario& sb, ReferenceSource& rb, RunTally& tb, Outer& ob, Inner& ib,
+                                bool keep_samples) {
+  const RunStop none;
+  LoopRun<Outer, Inner, RunTally> a(sa, ra, oa, ia, keep_samples, ta, none);
+  LoopRun<Outer, Inner, RunTally> b(sb, rb, ob, ib, keep_samples, tb, none);
+  return loopPair(a, b);
+}
+
+template <typename Outer>
+std::array<RunResult, 2> pairWithInner(const Scenario& sa, ReferenceSource& ra, RunTally& ta, Outer& oa,
+                                       const Scenario& sb, ReferenceSource& rb, RunTally& tb, Outer& ob,
+                                       bool keep_samples) {
+  if (sa.inner == InnerKind::pid) {
+    InnerAdapter<WheelPid> pa{WheelPid(sa.pid, sa.robot)}, pb{WheelPid(sb.pid, sb.robot)};
+    return pairOf(sa, ra, ta, oa, pa, sb, rb, tb, ob, pb, keep_samples);
+  }
+  SlidingModeController ca(sa.sliding, sa.robot), cb(sb.sliding, sb.robot);
+  return pairOf(sa, ra, ta, oa, ca, sb, rb, tb, ob, cb, keep_samples);
+}
+
 }  // namespace
 
 RunResult runClosedLoop(const Scenario& sc, ReferenceSource& reference, bool keep_samples,
@@ -131,6 +232,21 @@ RunResult runClosedLoop(const Scenario& sc, ReferenceSource& reference, bool kee
 
 RunResult runClosedLoop(const Scenario& sc, ReferenceSource& reference, bool keep_samples, RunTally& tally) {
   return withOuter(sc, reference, keep_samples, tally, RunStop{});
+}
+
+std::array<RunResult, 2> runClosedLoopPair(const Scenario& a, ReferenceSource& reference_a, RunTally& tally_a,
+                                           const Scenario& b, ReferenceSource& reference_b, RunTally& tally_b,
+                                           bool keep_samples) {
+  // In lockstep only runs of one shape: the same controller types, period and number of periods.
+  if (!(a.outer == b.outer && a.inner == b.inner && a.control_period_ns == b.control_period_ns &&
+        a.steps() == b.steps()))
+    return {runClosedLoop(a, reference_a, keep_samples, tally_a), runClosedLoop(b, reference_b, keep_samples, tally_b)};
+  if (a.outer == OuterKind::kanayama) {
+    Kanayama ka(a.kanayama), kb(b.kanayama);
+    return pairWithInner(a, reference_a, tally_a, ka, b, reference_b, tally_b, kb, keep_samples);
+  }
+  PurePursuit pa(a.pure_pursuit, a.outer == OuterKind::rpp), pb(b.pure_pursuit, b.outer == OuterKind::rpp);
+  return pairWithInner(a, reference_a, tally_a, pa, b, reference_b, tally_b, pb, keep_samples);
 }
 
 RunResult runClosedLoop(const Scenario& sc, ReferenceSource& reference, OuterController& outer, InnerController& inner,

@@ -1,7 +1,10 @@
 // The in-process closed loop on the thesis scenario (xd = t, yd = 3, start (-1, 0, 0), 25 s).
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
+#include <cstring>
+#include <vector>
 
 #include "sowing_robot/core/runner.h"
 
@@ -69,6 +72,95 @@ TEST(Runner, DivergenceIsReportedNotHidden) {
   const RunResult r = runClosedLoop(sc, ref, false);
   EXPECT_TRUE(r.diverged);
   EXPECT_TRUE(std::isinf(r.metrics[AXIS_Y].itae));
+}
+
+namespace {
+bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+// Everything a RunResult and a RunTally hold, bit for bit.
+void expectSameRun(const RunResult& pair, const RunTally& pair_tally, const RunResult& alone,
+                   const RunTally& alone_tally, const char* what) {
+  for (int i = 0; i < STATE_SIZE; ++i) EXPECT_TRUE(sameBits(pair.final_state[i], alone.final_state[i])) << what << i;
+  for (int a = 0; a < AXIS_COUNT; ++a) {
+    const AxisMetrics &p = pair.metrics[a], &q = alone.metrics[a];
+    for (auto [x, y] : {std::pair{p.ise, q.ise},
+                        {p.itse, q.itse},
+                        {p.iae, q.iae},
+                        {p.itae, q.itae},
+                        {p.rise_time, q.rise_time},
+                        {p.settling_time, q.settling_time},
+                        {p.overshoot, q.overshoot}})
+      EXPECT_TRUE(sameBits(x, y) || (std::isnan(x) && std::isnan(y))) << what << " axis " << a << ": " << x << " " << y;
+  }
+  EXPECT_EQ(pair.diverged, alone.diverged) << what;
+  EXPECT_EQ(pair.periods, alone.periods) << what;
+  EXPECT_EQ(pair.saturated_steps, alone.saturated_steps) << what;
+  for (auto [x, y] : {std::pair{pair_tally.effort, alone_tally.effort},
+                      {pair_tally.chattering, alone_tally.chattering},
+                      {pair_tally.worst_cross_track, alone_tally.worst_cross_track},
+                      {pair_tally.last_cross_track, alone_tally.last_cross_track}})
+    EXPECT_TRUE(sameBits(x, y) || (std::isinf(x) && std::isinf(y))) << what;
+  EXPECT_EQ(*pair_tally.series, *alone_tally.series) << what;
+}
+
+Scenario noisyLine(double mass_scale, std::uint64_t seed, double phase) {
+  Scenario sc;
+  sc.duration = 6.0;
+  sc.disturbance.sinusoidal = true;
+  sc.disturbance.amplitude = 1.5;
+  sc.disturbance.noise_std = 0.3;
+  sc.disturbance.seed = seed;
+  sc.disturbance.mass_scale = mass_scale;
+  sc.disturbance.inertia_scale = 2.0 - mass_scale;
+  sc.disturbance_phase = phase;
+  sc.start = {-1.0, 0.2 * mass_scale, 0.3 - 0.2 * mass_scale};
+  return sc;
+}
+
+// runClosedLoopPair against the two runs alone: for each pair of controllers, for two runs of another
+// length (one after the other), and for a run that diverges beside one that does not (the other goes on
+// alone from there).
+void expectPairIsTheRunsAlone(Scenario a, Scenario b, const char* what) {
+  std::vector<double> series[4];
+  RunTally tallies[4];
+  for (int i = 0; i < 4; ++i) {
+    tallies[i].dt = 0.001;
+    tallies[i].settle_time = 2.0;
+    tallies[i].series_every = 250;
+    tallies[i].series = &series[i];
+  }
+  LineReference ra, rb, r;
+  const std::array<RunResult, 2> pair = runClosedLoopPair(a, ra, tallies[0], b, rb, tallies[1], true);
+  const RunResult alone_a = runClosedLoop(a, r, true, tallies[2]);
+  const RunResult alone_b = runClosedLoop(b, r, true, tallies[3]);
+  expectSameRun(pair[0], tallies[0], alone_a, tallies[2], what);
+  expectSameRun(pair[1], tallies[1], alone_b, tallies[3], what);
+}
+}  // namespace
+
+TEST(Runner, TwoRunsInLockstepAreTheRunsAlone) {
+  const std::pair<OuterKind, InnerKind> pairs[] = {{OuterKind::kanayama, InnerKind::sliding_mode},
+                                                   {OuterKind::rpp, InnerKind::pid},
+                                                   {OuterKind::pure_pursuit, InnerKind::sliding_mode}};
+  for (auto [outer, inner] : pairs) {
+    Scenario a = noisyLine(1.3, 5, 0.4), b = noisyLine(0.8, 9, 2.0);
+    a.outer = b.outer = outer;
+    a.inner = b.inner = inner;
+    expectPairIsTheRunsAlone(a, b, a.controllerName().c_str());
+  }
+  Scenario tsmc = noisyLine(1.3, 5, 0.4);
+  tsmc.sliding.adaptive = false;
+  expectPairIsTheRunsAlone(noisyLine(0.8, 9, 2.0), tsmc, "atsmc beside tsmc");
+  Scenario shorter = noisyLine(0.8, 9, 2.0);
+  shorter.duration = 4.0;
+  expectPairIsTheRunsAlone(noisyLine(1.3, 5, 0.4), shorter, "another length");
+  Scenario diverging = noisyLine(1.3, 5, 0.4);
+  diverging.sliding.k2 = 1e6;  // as DivergenceIsReportedNotHidden
+  diverging.sliding.max_torque = 1e9;
+  LineReference line;
+  ASSERT_TRUE(runClosedLoop(diverging, line, false).diverged);
+  expectPairIsTheRunsAlone(diverging, noisyLine(0.8, 9, 2.0), "first diverges");
+  expectPairIsTheRunsAlone(noisyLine(0.8, 9, 2.0), diverging, "second diverges");
 }
 
 TEST(Runner, ScenarioValidation) {

@@ -46,7 +46,12 @@ class TorqueNoise {
   //     advanced) when inside the unit circle: the rejection is an add, not a branch that mispredicts
   //     about one time in five;
   //  2. log, division and sqrt of the kept ones: independent of each other, so they overlap.
-  void refill() {
+  // Out of line (once per kBlock / 2 steps), so that the step that draws stays small enough to inline.
+#if defined(__GNUC__)
+  __attribute__((noinline))
+#endif
+  void
+  refill() {
     int n = 0;
     while (n < kPairs) {
       const double x = 2.0 * canonical() - 1.0;
