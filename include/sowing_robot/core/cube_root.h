@@ -1,16 +1,21 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// (This file only: it reproduces the GNU C Library's cbrt, see below; the rest of the package is BSD.)
+//
 // The real cube root of the terminal sliding surface, inline and to the bit the value of std::cbrt on
 // Debian 12 (glibc 2.36), so that no published number moves: two calls per control period were ~12 %
 // of a benchmark run, most of it not the arithmetic but glibc's calls to frexp and ldexp and their
 // handling of cases the surface never produces (perf report, docs/performance.md).
 //
-// It is glibc's algorithm (sysdeps/ieee754/dbl-64/s_cbrt.c, Ulrich Drepper 1997, LGPL-2.1-or-later):
+// It is glibc's algorithm (sysdeps/ieee754/dbl-64/s_cbrt.c, contributed by Ulrich Drepper, 1997;
+// Copyright (C) the Free Software Foundation; LGPL-2.1-or-later, hence this file's licence):
 // a degree-6 polynomial start u on the mantissa xm in [0.5, 1), one Halley step
 // u (u^3 + 2 xm) / (2 u^3 + xm), times 2^((e mod 3) / 3), scaled by 2^(e / 3). The coefficients are those
 // of that file, written as hexadecimal floats read from libm.so.6. Only frexp and ldexp are replaced, by
-// exponent-field arithmetic that is exact here: a normal |x| (others go to std::cbrt) has 2^-1021 <= xm 2^e
-// < 2^1024, and ym in [0.5, 2) scaled by 2^(e / 3) with |e / 3| <= 341 stays a normal number.
-// test_cube_root compares it with std::cbrt bit for bit over every exponent and the surface's range;
-// on a C library with another cbrt that test fails, and the loop should then call std::cbrt.
+// exponent-field arithmetic that is exact here: a normal |x| = xm 2^e (others go to std::cbrt) has e in
+// [-1021, 1024], so |e / 3| <= 341, and ym in [0.5, 2) scaled by 2^(e / 3) stays a normal number.
+// test_sliding_mode's CubeRoot.SameBitsAsTheCLibrary compares it with std::cbrt bit for bit over every
+// exponent and the surface's range; on a C library with another cbrt that test fails, and the surface
+// should then call std::cbrt.
 #pragma once
 
 #include <cmath>
