@@ -200,11 +200,9 @@ EstimatedRunResult loop(const Scenario& sc, const EstimatedRunConfig& cfg, P& pl
       }
     }
   }
-  result.final_state = plant.state();
-  result.metrics = metrics.result();
+  closeRun(result, plant.state(), metrics);
   if (result.diverged) {
     const double inf = std::numeric_limits<double>::infinity();
-    for (auto& m : result.metrics) m.ise = m.itse = m.iae = m.itae = inf;
     out.fed_error_rms = out.fed_error_max = inf;
   } else {
     out.fed_error_rms = fed_count > 0 ? std::sqrt(fed_sq / static_cast<double>(fed_count)) : 0.0;

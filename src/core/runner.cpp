@@ -125,12 +125,7 @@ struct LoopRun {
   }
 
   RunResult finish() {
-    result.final_state = plant.state();
-    result.metrics = metrics.result();
-    if (result.diverged) {
-      const double inf = std::numeric_limits<double>::infinity();
-      for (auto& m : result.metrics) m.ise = m.itse = m.iae = m.itae = inf;
-    }
+    closeRun(result, plant.state(), metrics);
     return result;
   }
 

@@ -49,12 +49,7 @@ TractionRunResult runTractionClosedLoop(const Scenario& sc, const TractionParams
           std::max({out.max_abs_slip, std::fabs(plant.slipRatio(RIGHT)), std::fabs(plant.slipRatio(LEFT))});
     }
   }
-  result.final_state = plant.state();
-  result.metrics = metrics.result();
-  if (result.diverged) {
-    const double inf = std::numeric_limits<double>::infinity();
-    for (auto& m : result.metrics) m.ise = m.itse = m.iae = m.itae = inf;
-  }
+  closeRun(result, plant.state(), metrics);
   return out;
 }
 

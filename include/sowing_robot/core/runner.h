@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -147,6 +148,17 @@ inline double phaseStartTime(const Scenario& sc) {
 inline bool finiteSum(const State& s) {
   const double even = (s[4] + s[2]) + s[0], odd = (s[5] + s[3]) + s[1];
   return std::isfinite((even + odd) + s[6]);
+}
+
+/// The end of every closed loop: the final state and the metrics into the result; a diverged run's
+/// integrals are +inf (the divergence is reported, never hidden).
+inline void closeRun(RunResult& result, const State& final_state, const MetricsAccumulator& metrics) {
+  result.final_state = final_state;
+  result.metrics = metrics.result();
+  if (result.diverged) {
+    const double inf = std::numeric_limits<double>::infinity();
+    for (auto& m : result.metrics) m.ise = m.itse = m.iae = m.itae = inf;
+  }
 }
 
 /// Asked every kStopCheckEvery periods with the metrics so far; true ends the run there. Every integral
