@@ -5,6 +5,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <limits>
 #include <memory>
 #include <mutex>
@@ -76,27 +77,39 @@ RunRow runOne(const Scenario& base, ReferenceSource& reference, const MonteCarlo
   return measure(applyDraw(base, spec, draw), reference, spec, draw);
 }
 
+/// CPU time of the calling thread [s] (0 where the clock is missing: the load figures are then 0, and
+/// nothing else depends on them).
+double threadCpuSeconds() {
+  timespec ts{};
+  if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts) != 0) return 0.0;
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
 /// Runs 0..runs-1 on `threads` threads, two at a time: make() is called once per thread and returns that
 /// thread's run(i, count, rows), which writes runs i .. i + count - 1 (count 1 or 2) into rows[0 .. count-1]
 /// with its own references and state. Row i lands at index i whatever thread ran it (and whichever run it
-/// was paired with: a pair's rows are those of the two runs alone).
+/// was paired with: a pair's rows are those of the two runs alone). loads (optional): each thread's runs
+/// and CPU time, thread t's in (*loads)[t].
 template <typename MakeWorker>
 std::vector<RunRow> parallelRows(std::int64_t runs, int threads, const std::function<void(std::int64_t)>& progress,
-                                 const MakeWorker& make) {
+                                 const MakeWorker& make, std::vector<WorkerLoad>* loads = nullptr) {
   if (threads <= 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   threads = static_cast<int>(std::min<std::int64_t>(threads, (runs + 1) / 2));
+  std::vector<WorkerLoad> load(static_cast<std::size_t>(threads));
   std::vector<RunRow> rows(static_cast<std::size_t>(runs));
   std::atomic<std::int64_t> next{0};
   std::int64_t done = 0;
   std::mutex progress_mutex;
   std::exception_ptr failure;
   std::mutex failure_mutex;
-  auto worker = [&]() {
+  auto worker = [&](WorkerLoad& mine) {
+    const double cpu0 = threadCpuSeconds();
     try {
       auto run = make();
       for (std::int64_t i = next.fetch_add(2); i < runs; i = next.fetch_add(2)) {
         const int count = static_cast<int>(std::min<std::int64_t>(2, runs - i));
         run(i, count, &rows[static_cast<std::size_t>(i)]);
+        mine.runs += count;
         if (progress) {
           std::lock_guard<std::mutex> lock(progress_mutex);
           for (int j = 0; j < count; ++j) progress(++done);
@@ -107,15 +120,17 @@ std::vector<RunRow> parallelRows(std::int64_t runs, int threads, const std::func
       if (!failure) failure = std::current_exception();
       next = runs;  // the others stop after their current runs
     }
+    mine.cpu_seconds = threadCpuSeconds() - cpu0;
   };
   if (threads == 1) {
-    worker();
+    worker(load[0]);
   } else {
     std::vector<std::thread> pool;
-    for (int t = 0; t < threads; ++t) pool.emplace_back(worker);
+    for (int t = 0; t < threads; ++t) pool.emplace_back(worker, std::ref(load[static_cast<std::size_t>(t)]));
     for (auto& t : pool) t.join();
   }
   if (failure) std::rethrow_exception(failure);
+  if (loads != nullptr) *loads = load;
   return rows;
 }
 
@@ -229,7 +244,7 @@ std::string BenchScenario::validate() const {
 }
 
 std::vector<RunRow> runBenchmark(const BenchScenario& bench, std::int64_t runs, int threads,
-                                 const std::function<void(std::int64_t)>& progress) {
+                                 const std::function<void(std::int64_t)>& progress, std::vector<WorkerLoad>* loads) {
   if (runs < 1) throw std::invalid_argument("the number of runs (seeds) must be >= 1, not " + std::to_string(runs));
   std::string e = bench.validate();
   if (!e.empty()) throw std::invalid_argument(e);
@@ -238,8 +253,9 @@ std::vector<RunRow> runBenchmark(const BenchScenario& bench, std::int64_t runs, 
   for (std::int64_t i = 0; i < runs && e.empty(); ++i) e = applyDraw(base, spec, drawRun(spec, base, i)).validate();
   if (!e.empty()) throw std::invalid_argument("a drawn run does not validate: " + e);
   if (bench.realism)  // sensors, traction or an estimate in the loop (issue 16): estimated_bench.h
-    return parallelRows(runs, threads, progress,
-                        [&]() { return oneByOne([&bench](std::int64_t i) { return estimatedBenchRow(bench, i); }); });
+    return parallelRows(
+        runs, threads, progress,
+        [&]() { return oneByOne([&bench](std::int64_t i) { return estimatedBenchRow(bench, i); }); }, loads);
   const std::int64_t period_steps = seriesEvery(bench);
   if (bench.track != TrackKind::field) {
     std::unique_ptr<ReferenceSource> proto;
@@ -248,35 +264,41 @@ std::vector<RunRow> runBenchmark(const BenchScenario& bench, std::int64_t runs, 
     else
       proto = std::make_unique<SineReference>(bench.sine);
     // Two runs at a time in lockstep (measurePair), each with its own reference.
-    return parallelRows(runs, threads, progress, [&]() {
-      std::shared_ptr<ReferenceSource> ref_a = proto->clone(), ref_b = proto->clone();
-      return [&base, &spec, ref_a, ref_b, period_steps](std::int64_t i, int count, RunRow* rows) {
-        RunExtras extras;
-        extras.series_every = period_steps;
-        const RunDraw draw_a = drawRun(spec, base, i);
-        if (count == 1) {
-          rows[0] = measure(applyDraw(base, spec, draw_a), *ref_a, spec, draw_a, extras);
-          return;
-        }
-        const RunDraw draw_b = drawRun(spec, base, i + 1);
-        measurePair(applyDraw(base, spec, draw_a), *ref_a, draw_a, rows[0], applyDraw(base, spec, draw_b), *ref_b,
-                    draw_b, rows[1], spec, extras);
-      };
-    });
+    return parallelRows(
+        runs, threads, progress,
+        [&]() {
+          std::shared_ptr<ReferenceSource> ref_a = proto->clone(), ref_b = proto->clone();
+          return [&base, &spec, ref_a, ref_b, period_steps](std::int64_t i, int count, RunRow* rows) {
+            RunExtras extras;
+            extras.series_every = period_steps;
+            const RunDraw draw_a = drawRun(spec, base, i);
+            if (count == 1) {
+              rows[0] = measure(applyDraw(base, spec, draw_a), *ref_a, spec, draw_a, extras);
+              return;
+            }
+            const RunDraw draw_b = drawRun(spec, base, i + 1);
+            measurePair(applyDraw(base, spec, draw_a), *ref_a, draw_a, rows[0], applyDraw(base, spec, draw_b), *ref_b,
+                        draw_b, rows[1], spec, extras);
+          };
+        },
+        loads);
   }
   // Field: the path starts at the drawn start (the approach), so each run builds its own reference, and its
   // duration grows by the approach's extra time, as run_scenario --field does.
-  return parallelRows(runs, threads, progress, [&]() {
-    return oneByOne([&bench, &base, &spec, period_steps](std::int64_t i) {
-      const RunDraw draw = drawRun(spec, base, i);
-      RunExtras extras;
-      extras.series_every = period_steps;
-      return fieldRow(bench, applyDraw(base, spec, draw), extras,
-                      [&spec, &draw](const Scenario& sc, ReferenceSource& reference, const RunExtras& e) {
-                        return measure(sc, reference, spec, draw, e);
-                      });
-    });
-  });
+  return parallelRows(
+      runs, threads, progress,
+      [&]() {
+        return oneByOne([&bench, &base, &spec, period_steps](std::int64_t i) {
+          const RunDraw draw = drawRun(spec, base, i);
+          RunExtras extras;
+          extras.series_every = period_steps;
+          return fieldRow(bench, applyDraw(base, spec, draw), extras,
+                          [&spec, &draw](const Scenario& sc, ReferenceSource& reference, const RunExtras& e) {
+                            return measure(sc, reference, spec, draw, e);
+                          });
+        });
+      },
+      loads);
 }
 
 Envelope crossTrackEnvelope(const std::vector<RunRow>& rows, double period) {

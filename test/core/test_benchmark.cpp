@@ -2,6 +2,7 @@
 // failures counted with their reason, statistics.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -220,6 +221,31 @@ TEST(Benchmark, AFieldBenchmarkGivesTheSameRowsOnOneAndTwoThreads) {
                                                                    1e-9)) +
                                1;
   EXPECT_NEAR(static_cast<double>(one[0].cross_track_series.size()), static_cast<double>(expected), 1.0);
+}
+
+TEST(Benchmark, WorkerLoadsCountEveryRunOnceAndLeaveTheRowsAlone) {
+  BenchScenario b;
+  b.name = "short_line";
+  b.base = shortLine("kanayama+atsmc");
+  b.spec = shortSpec();
+  ASSERT_EQ(b.validate(), "");
+  const std::vector<RunRow> plain = runBenchmark(b, 7, 2);
+  // 7 runs in batches of 2: at most 4 batches, so 5 threads are cut to 4 workers.
+  for (const int threads : {1, 2, 5}) {
+    SCOPED_TRACE(threads);
+    std::vector<WorkerLoad> loads{{99, -1.0}};  // overwritten, not appended to
+    const std::vector<RunRow> rows = runBenchmark(b, 7, threads, {}, &loads);
+    expectSameRows(plain, rows);
+    ASSERT_EQ(loads.size(), static_cast<std::size_t>(std::min(threads, 4)));
+    std::int64_t runs = 0;
+    for (const WorkerLoad& w : loads) {
+      runs += w.runs;
+      EXPECT_GE(w.cpu_seconds, 0.0);
+      EXPECT_TRUE(std::isfinite(w.cpu_seconds));
+    }
+    EXPECT_EQ(runs, 7);
+    if (threads == 1) EXPECT_GT(loads[0].cpu_seconds, 0.0);  // 7 runs of 4 s at 1 kHz take CPU time
+  }
 }
 
 TEST(Benchmark, EnvelopeQuantilesAreNearestRankPerSampleTime) {

@@ -91,6 +91,15 @@ struct RunRow {
   long fixes_applied = 0, fixes_refused = 0;                             ///< feedback fused
 };
 
+/// What one worker thread of a benchmark did: how many runs, and the CPU time its thread used
+/// (CLOCK_THREAD_CPUTIME_ID). Two workers' ms per run differ when the cores do (a VM's vCPUs may): the
+/// benchmark prints them so that a speed-up from 1 to K threads below K can be told apart from idle
+/// workers (CPU below K x wall) and from cores of unequal speed (ms per run unequal).
+struct WorkerLoad {
+  std::int64_t runs = 0;
+  double cpu_seconds = 0.0;
+};
+
 /// Runs base (its controller pair, plant, timing) on `reference` for seeds 0..runs-1 with `threads`
 /// threads (0: hardware concurrency). progress (optional) is called with the number of finished runs,
 /// from whichever thread finished one (serialised). Throws std::invalid_argument for a bad spec or
@@ -143,8 +152,10 @@ const std::vector<std::string>& availableModels();
 /// and the finish check of field tracks, and the cross-track series for envelopes. Success: not
 /// diverged, no contact, finished, and |cross-track| < threshold from settle_time on. Throws
 /// std::invalid_argument for a bad scenario or runs < 1.
+/// loads (optional): one WorkerLoad per worker thread, in the order the threads were started.
 std::vector<RunRow> runBenchmark(const BenchScenario& bench, std::int64_t runs, int threads = 0,
-                                 const std::function<void(std::int64_t)>& progress = {});
+                                 const std::function<void(std::int64_t)>& progress = {},
+                                 std::vector<WorkerLoad>* loads = nullptr);
 
 /// Quantiles over the runs of the cross-track series at each sample time (runs whose series is shorter
 /// are left out there; a diverged run's non-finite samples count as +inf).
