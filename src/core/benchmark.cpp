@@ -72,9 +72,21 @@ void measurePair(const Scenario& sa, ReferenceSource& ra, const RunDraw& da, Run
   meter_b.finish(r[1]);
 }
 
-RunRow runOne(const Scenario& base, ReferenceSource& reference, const MonteCarloSpec& spec, std::int64_t index) {
-  const RunDraw draw = drawRun(spec, base, index);
-  return measure(applyDraw(base, spec, draw), reference, spec, draw);
+/// A parallelRows worker for seeded runs of `base`: runs i and i + 1 of a batch in lockstep (measurePair),
+/// each on its own clone of `reference`; a batch of one run alone (measure). Either way a row is its run's.
+auto pairedRuns(const Scenario& base, const MonteCarloSpec& spec, const ReferenceSource& reference,
+                const RunExtras& extras) {
+  std::shared_ptr<ReferenceSource> ref_a = reference.clone(), ref_b = reference.clone();
+  return [&base, &spec, ref_a, ref_b, extras](std::int64_t i, int count, RunRow* rows) {
+    const RunDraw draw_a = drawRun(spec, base, i);
+    if (count == 1) {
+      rows[0] = measure(applyDraw(base, spec, draw_a), *ref_a, spec, draw_a, extras);
+      return;
+    }
+    const RunDraw draw_b = drawRun(spec, base, i + 1);
+    measurePair(applyDraw(base, spec, draw_a), *ref_a, draw_a, rows[0], applyDraw(base, spec, draw_b), *ref_b, draw_b,
+                rows[1], spec, extras);
+  };
 }
 
 /// CPU time of the calling thread [s] (0 where the clock is missing: the load figures are then 0, and
@@ -213,10 +225,7 @@ std::vector<RunRow> runMonteCarlo(const Scenario& base, const ReferenceSource& r
   // Every drawn scenario must validate too (e.g. a mismatch outside the plant's range).
   for (std::int64_t i = 0; i < runs && e.empty(); ++i) e = applyDraw(base, spec, drawRun(spec, base, i)).validate();
   if (!e.empty()) throw std::invalid_argument("a drawn run does not validate: " + e);
-  return parallelRows(runs, threads, progress, [&]() {
-    std::shared_ptr<ReferenceSource> ref = reference.clone();
-    return oneByOne([&base, &spec, ref](std::int64_t i) { return runOne(base, *ref, spec, i); });
-  });
+  return parallelRows(runs, threads, progress, [&]() { return pairedRuns(base, spec, reference, RunExtras{}); });
 }
 
 std::string BenchScenario::validate() const {
@@ -264,24 +273,10 @@ std::vector<RunRow> runBenchmark(const BenchScenario& bench, std::int64_t runs, 
     else
       proto = std::make_unique<SineReference>(bench.sine);
     // Two runs at a time in lockstep (measurePair), each with its own reference.
+    RunExtras extras;
+    extras.series_every = period_steps;
     return parallelRows(
-        runs, threads, progress,
-        [&]() {
-          std::shared_ptr<ReferenceSource> ref_a = proto->clone(), ref_b = proto->clone();
-          return [&base, &spec, ref_a, ref_b, period_steps](std::int64_t i, int count, RunRow* rows) {
-            RunExtras extras;
-            extras.series_every = period_steps;
-            const RunDraw draw_a = drawRun(spec, base, i);
-            if (count == 1) {
-              rows[0] = measure(applyDraw(base, spec, draw_a), *ref_a, spec, draw_a, extras);
-              return;
-            }
-            const RunDraw draw_b = drawRun(spec, base, i + 1);
-            measurePair(applyDraw(base, spec, draw_a), *ref_a, draw_a, rows[0], applyDraw(base, spec, draw_b), *ref_b,
-                        draw_b, rows[1], spec, extras);
-          };
-        },
-        loads);
+        runs, threads, progress, [&]() { return pairedRuns(base, spec, *proto, extras); }, loads);
   }
   // Field: the path starts at the drawn start (the approach), so each run builds its own reference, and its
   // duration grows by the approach's extra time, as run_scenario --field does.
