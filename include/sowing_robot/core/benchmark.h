@@ -92,9 +92,9 @@ struct RunRow {
 };
 
 /// What one worker thread of a benchmark did: how many runs, and the CPU time its thread used
-/// (CLOCK_THREAD_CPUTIME_ID). Two workers' ms per run differ when the cores do (a VM's vCPUs may): the
-/// benchmark prints them so that a speed-up from 1 to K threads below K can be told apart from idle
-/// workers (CPU below K x wall) and from cores of unequal speed (ms per run unequal).
+/// (CLOCK_THREAD_CPUTIME_ID). The benchmark prints them to tell why a speed-up from 1 to K threads falls
+/// short of K: workers waiting (CPU below K x wall: the code) or cores of unequal speed (ms per run
+/// unequal across workers: the machine; a VM's vCPUs may differ).
 struct WorkerLoad {
   std::int64_t runs = 0;
   double cpu_seconds = 0.0;
