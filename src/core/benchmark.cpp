@@ -89,6 +89,15 @@ auto pairedRuns(const Scenario& base, const MonteCarloSpec& spec, const Referenc
   };
 }
 
+/// Throws std::invalid_argument naming the first of runs 0..runs-1 whose drawn scenario does not validate
+/// (e.g. a mismatch outside the plant's range): checked before any run starts, so no partial result.
+void refuseBadDraws(const Scenario& base, const MonteCarloSpec& spec, std::int64_t runs) {
+  for (std::int64_t i = 0; i < runs; ++i) {
+    const std::string e = applyDraw(base, spec, drawRun(spec, base, i)).validate();
+    if (!e.empty()) throw std::invalid_argument("a drawn run does not validate: " + e);
+  }
+}
+
 /// CPU time of the calling thread [s] (0 where the clock is missing: the load figures are then 0, and
 /// nothing else depends on them).
 double threadCpuSeconds() {
@@ -220,11 +229,9 @@ Scenario applyDraw(const Scenario& base, const MonteCarloSpec& spec, const RunDr
 std::vector<RunRow> runMonteCarlo(const Scenario& base, const ReferenceSource& reference, const MonteCarloSpec& spec,
                                   std::int64_t runs, int threads, const std::function<void(std::int64_t)>& progress) {
   if (runs < 1) throw std::invalid_argument("the number of runs (seeds) must be >= 1, not " + std::to_string(runs));
-  std::string e = firstError({spec.validate(), base.validate()});
+  const std::string e = firstError({spec.validate(), base.validate()});
   if (!e.empty()) throw std::invalid_argument(e);
-  // Every drawn scenario must validate too (e.g. a mismatch outside the plant's range).
-  for (std::int64_t i = 0; i < runs && e.empty(); ++i) e = applyDraw(base, spec, drawRun(spec, base, i)).validate();
-  if (!e.empty()) throw std::invalid_argument("a drawn run does not validate: " + e);
+  refuseBadDraws(base, spec, runs);
   return parallelRows(runs, threads, progress, [&]() { return pairedRuns(base, spec, reference, RunExtras{}); });
 }
 
@@ -255,12 +262,11 @@ std::string BenchScenario::validate() const {
 std::vector<RunRow> runBenchmark(const BenchScenario& bench, std::int64_t runs, int threads,
                                  const std::function<void(std::int64_t)>& progress, std::vector<WorkerLoad>* loads) {
   if (runs < 1) throw std::invalid_argument("the number of runs (seeds) must be >= 1, not " + std::to_string(runs));
-  std::string e = bench.validate();
+  const std::string e = bench.validate();
   if (!e.empty()) throw std::invalid_argument(e);
   const MonteCarloSpec& spec = bench.spec;
   const Scenario& base = bench.base;
-  for (std::int64_t i = 0; i < runs && e.empty(); ++i) e = applyDraw(base, spec, drawRun(spec, base, i)).validate();
-  if (!e.empty()) throw std::invalid_argument("a drawn run does not validate: " + e);
+  refuseBadDraws(base, spec, runs);
   if (bench.realism)  // sensors, traction or an estimate in the loop (issue 16): estimated_bench.h
     return parallelRows(
         runs, threads, progress,
