@@ -271,10 +271,12 @@ int main(int argc, char** argv) {
   std::string error;
   if (!writeAll(output, {{"runs.csv", &csv}, {"envelopes.csv", &envelopes}, {"report.md", &report}}, error))
     return fail(error);
+  // The worker threads that ran (--threads 0 is all cores; never more workers than batches of runs).
+  const std::size_t workers = loads.size();
   std::printf(
-      "benchmark: %lld runs in %.2f s wall (%.2f ms per run, %s threads); %s/runs.csv, envelopes.csv, report.md\n",
-      total, wall, 1e3 * wall / static_cast<double>(total), threads == 0 ? "all" : std::to_string(threads).c_str(),
-      output.c_str());
+      "benchmark: %lld runs in %.2f s wall (%.2f ms per run, %zu thread%s%s); %s/runs.csv, envelopes.csv, report.md\n",
+      total, wall, 1e3 * wall / static_cast<double>(total), workers, workers == 1 ? "" : "s",
+      threads == 0 ? ", all cores" : "", output.c_str());
   std::printf("%s\n", loadLine(loads, wall).c_str());
   return 0;
 }

@@ -155,6 +155,41 @@ TEST(Benchmark, BadRequestsAreRefusedNamingWhy) {
   }
 }
 
+// A draw range the spec accepts (> 0) but the plant does not (mass_scale within [0.1, 10]): refused
+// before any run starts, naming the first run whose draw is out and the plant's reason, by both runners.
+TEST(Benchmark, ADrawThePlantRefusesStopsTheRunsBeforeAnyStarts) {
+  MonteCarloSpec spec = shortSpec();
+  spec.mass_scale = {5.0, 20.0};  // two thirds of the draws above 10
+  ASSERT_EQ(spec.validate(), "");
+  BenchScenario b;
+  b.name = "heavy";
+  b.base = shortLine("kanayama+atsmc");
+  b.spec = spec;
+  ASSERT_EQ(b.validate(), "");
+  // Run 0 alone may draw in range; among 20 runs some draw above 10 for any seed.
+  std::int64_t calls = 0;
+  const auto count = [&](std::int64_t) { ++calls; };
+  LineReference line;
+  for (int runner = 0; runner < 2; ++runner) {
+    SCOPED_TRACE(runner == 0 ? "runMonteCarlo" : "runBenchmark");
+    try {
+      if (runner == 0)
+        runMonteCarlo(b.base, line, spec, 20, 2, count);
+      else
+        runBenchmark(b, 20, 2, count);
+      FAIL() << "no refusal";
+    } catch (const std::invalid_argument& e) {
+      const std::string what = e.what();
+      EXPECT_EQ(what.rfind("a drawn run does not validate: ", 0), 0u) << what;
+      EXPECT_NE(what.find("mass_scale"), std::string::npos) << what;
+    }
+  }
+  EXPECT_EQ(calls, 0) << "runs started before the refusal";
+  // The same spec with the range inside the plant's runs.
+  spec.mass_scale = {5.0, 10.0};
+  EXPECT_EQ(runMonteCarlo(b.base, line, spec, 2, 1).size(), 2u);
+}
+
 TEST(Benchmark, StatisticsCountDivergedRunsAndSkipMissingFigures) {
   const double inf = std::numeric_limits<double>::infinity(), nan = std::numeric_limits<double>::quiet_NaN();
   Statistic s = statistic({1.0, 2.0, 3.0, 4.0});

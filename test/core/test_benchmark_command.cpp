@@ -91,6 +91,12 @@ TEST(BenchmarkCommand, BadRequestsGiveOneLineAndNoReport) {
   typo.replace(typo.find("  noise_std:"), 12, "  noise_sdt:");
   std::ofstream(dir.path + "/quick_line.yaml") << typo;
   expectOneLineRefusal(dir, "--scenarios " + line + " --controllers kanayama+atsmc --seeds 2", "noise_sdt");
+  // A draw range the file's checks accept but the plant refuses for some seeds (mass_scale above 10).
+  std::string heavy = readFile(quickLine(dir));
+  heavy.replace(heavy.find("mass_scale: [0.8, 1.5]"), 22, "mass_scale: [5.0, 20.0]");
+  std::ofstream(dir.path + "/quick_line.yaml") << heavy;
+  expectOneLineRefusal(dir, "--scenarios " + line + " --controllers kanayama+atsmc --seeds 20",
+                       "a drawn run does not validate");
 }
 
 TEST(BenchmarkCommand, TheFilesDoNotDependOnTheThreadCount) {
