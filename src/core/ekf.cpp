@@ -1,4 +1,5 @@
 #include "sowing_robot/core/ekf.h"
+#include "sowing_robot/core/trig.h"
 
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
@@ -113,12 +114,12 @@ void Ekf::reset(double t, const Vector& mean, const Matrix& covariance) {
 Ekf::Vector Ekf::motion(const Vector6& a) {
   const double mid = a(THETA) + 0.5 * a(4), u = a(5);
   Vector s;
-  s << a(X) + u * std::cos(mid), a(Y) + u * std::sin(mid), wrapAngle(a(THETA) + a(4)), a(BIAS);
+  s << a(X) + u * cosOf(mid), a(Y) + u * sinOf(mid), wrapAngle(a(THETA) + a(4)), a(BIAS);
   return s;
 }
 
 Eigen::Matrix<double, 4, 6> Ekf::motionJacobian(const Vector6& a) {
-  const double mid = a(THETA) + 0.5 * a(4), u = a(5), c = std::cos(mid), s = std::sin(mid);
+  const double mid = a(THETA) + 0.5 * a(4), u = a(5), c = cosOf(mid), s = sinOf(mid);
   Eigen::Matrix<double, 4, 6> f = Eigen::Matrix<double, 4, 6>::Zero();
   f(X, X) = 1.0;
   f(X, THETA) = -u * s;

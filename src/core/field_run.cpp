@@ -7,6 +7,7 @@
 
 #include "sowing_robot/core/tool_engagement.h"
 #include "sowing_robot/core/traction_run.h"
+#include "sowing_robot/core/trig.h"
 
 namespace sowing_robot {
 namespace core {
@@ -48,7 +49,7 @@ FieldRunReport runField(const FieldRunSetup& setup) {
     const State& x = *s.state;
     const Pose2D pose{x[X], x[Y], x[THETA]};
     contacts.update(s.t, pose);
-    const double c = std::cos(x[THETA]), sn = std::sin(x[THETA]);
+    const double c = cosOf(x[THETA]), sn = sinOf(x[THETA]);
     const Eigen::Vector2d tool(x[X] + c * setup.tool.x() - sn * setup.tool.y(),
                                x[Y] + sn * setup.tool.x() + c * setup.tool.y());
     Eigen::Vector2d seed;

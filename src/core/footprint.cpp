@@ -1,4 +1,5 @@
 #include "sowing_robot/core/footprint.h"
+#include "sowing_robot/core/trig.h"
 
 #include <algorithm>
 #include <cmath>
@@ -86,14 +87,14 @@ double Footprint::signedDistance(const Eigen::Vector2d& q) const {
 
 double Footprint::distanceToCircle(const Pose2D& pose, const Eigen::Vector2d& centre, double radius) const {
   // The centre in base_link: rotate the offset by -theta.
-  const double c = std::cos(pose.theta), s = std::sin(pose.theta);
+  const double c = cosOf(pose.theta), s = sinOf(pose.theta);
   const Eigen::Vector2d w = centre - Eigen::Vector2d(pose.x, pose.y);
   const Eigen::Vector2d q(c * w.x() + s * w.y(), -s * w.x() + c * w.y());
   return signedDistance(q) - radius;
 }
 
 std::vector<Eigen::Vector2d> Footprint::placed(const Pose2D& pose) const {
-  const double c = std::cos(pose.theta), s = std::sin(pose.theta);
+  const double c = cosOf(pose.theta), s = sinOf(pose.theta);
   std::vector<Eigen::Vector2d> out;
   out.reserve(vertices_.size());
   for (const auto& v : vertices_) out.emplace_back(pose.x + c * v.x() - s * v.y(), pose.y + s * v.x() + c * v.y());

@@ -4,6 +4,7 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "sowing_robot/core/trig.h"
 #include "sowing_robot/core/validation.h"
 
 namespace sowing_robot {
@@ -44,11 +45,11 @@ bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 }  // namespace
 
 PostureError Kanayama::postureError(const Pose2D& r, const Pose2D& a) {
-  return postureErrorWith(r, a, std::cos(a.theta), std::sin(a.theta));
+  return postureErrorWith(r, a, cosOf(a.theta), sinOf(a.theta));
 }
 
 VelocityCommand Kanayama::compute(const Reference& ref, const Pose2D& actual, double v, double omega) const {
-  return compute(ref, actual, std::cos(actual.theta), std::sin(actual.theta), v, omega);
+  return compute(ref, actual, cosOf(actual.theta), sinOf(actual.theta), v, omega);
 }
 
 VelocityCommand Kanayama::compute(const Reference& ref, const Pose2D& actual, double cos_theta, double sin_theta,
@@ -58,16 +59,14 @@ VelocityCommand Kanayama::compute(const Reference& ref, const Pose2D& actual, do
     return VelocityCommand{};
   const PostureError e = postureErrorWith(ref.pose, actual, cos_theta, sin_theta);
   // Along a reference heading of 0 (the thesis line, rows along x) theta_e is exactly -theta, and cos is
-  // even and sin odd to the bit (glibc computes both on |x| and restores the sign; test_kanayama's
-  // CosSinOfANegatedAngleAreTheMirroredOnes holds the library to it): the robot's heading's cos/sin
-  // serve, without a second sincos.
+  // even and sin odd to the bit (core/trig.h; test_trig's CosIsEvenAndSinOddToTheBit holds it to that):
+  // the robot's heading's cos/sin serve, without a second sincos.
   double c, s;
   if (sameBits(e.thetae, -actual.theta)) {
     c = cos_theta;
     s = -sin_theta;
   } else {
-    c = std::cos(e.thetae);
-    s = std::sin(e.thetae);
+    sinCos(e.thetae, s, c);
   }
   VelocityCommand out;
   out.v = ref.v * c + gains_.kx * e.xe;
@@ -83,7 +82,7 @@ VelocityCommand Kanayama::compute(const Reference& ref, const Pose2D& actual, do
 }
 
 double Kanayama::lyapunov(const PostureError& e) const {
-  return 0.5 * (e.xe * e.xe + e.ye * e.ye) + (1.0 - std::cos(e.thetae)) / gains_.ky;
+  return 0.5 * (e.xe * e.xe + e.ye * e.ye) + (1.0 - cosOf(e.thetae)) / gains_.ky;
 }
 
 }  // namespace core

@@ -7,6 +7,7 @@
 
 #include "sowing_robot/core/lanes2.h"
 #include "sowing_robot/core/rotation.h"
+#include "sowing_robot/core/trig.h"
 #include "sowing_robot/core/types.h"
 #include "sowing_robot/core/validation.h"
 
@@ -76,8 +77,10 @@ inline void sinusoid(const PlantDisturbance& d, double t, double& right, double&
     return;
   }
   const double angle = d.frequency * t, amplitude = d.amplitude;
-  right = amplitude * std::sin(angle);
-  left = amplitude * std::cos(angle);
+  double s, c;
+  sinCos(angle, s, c);
+  right = amplitude * s;
+  left = amplitude * c;
 }
 
 }  // namespace
@@ -87,7 +90,9 @@ void Plant::sinusoidalDisturbance(double t, double& right, double& left) const {
 }
 
 State Plant::derivative(const State& s, double applied_right, double applied_left) const {
-  return derivativeWithHeading(s, std::cos(s[THETA]), std::sin(s[THETA]), applied_right, applied_left);
+  double c, sn;
+  sinCos(s[THETA], sn, c);
+  return derivativeWithHeading(s, c, sn, applied_right, applied_left);
 }
 
 // derivative() with cos/sin of the heading supplied (step() writes the same arithmetic out on scalars).
@@ -121,7 +126,9 @@ SOWING_INLINE void Plant::disturbanceAt(double t, double& right, double& left) {
 }
 
 bool Plant::step(double tau_right, double tau_left, double dt) {
-  return stepWithHeading(tau_right, tau_left, dt, std::cos(state_[THETA]), std::sin(state_[THETA]));
+  double c, s;
+  sinCos(state_[THETA], s, c);
+  return stepWithHeading(tau_right, tau_left, dt, c, s);
 }
 
 bool Plant::step(double tau_right, double tau_left, double dt, double theta, double cos_theta, double sin_theta) {
@@ -253,8 +260,7 @@ void Plant::stepPair(Plant& a, const HeadingStep& in_a, Plant& b, const HeadingS
         c = in.cos_theta;
         s = in.sin_theta;
       } else {
-        c = std::cos(plant.state_[THETA]);
-        s = std::sin(plant.state_[THETA]);
+        sinCos(plant.state_[THETA], s, c);
       }
     };
     double cos_a, sin_a, cos_b, sin_b;
@@ -296,7 +302,7 @@ void Plant::stepPair(Plant& a, const HeadingStep& in_a, Plant& b, const HeadingS
 }
 
 Eigen::Vector2d Plant::centreOfMass() const {
-  return {state_[X] + nominal_.d * std::cos(state_[THETA]), state_[Y] + nominal_.d * std::sin(state_[THETA])};
+  return {state_[X] + nominal_.d * cosOf(state_[THETA]), state_[Y] + nominal_.d * sinOf(state_[THETA])};
 }
 
 }  // namespace core

@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "sowing_robot/core/trig.h"
 #include "sowing_robot/core/validation.h"
 
 namespace sowing_robot {
@@ -66,7 +67,7 @@ PotentialFieldParams::PotentialFieldParams() { potentialFieldTable().applyDefaul
 
 std::string PotentialFieldParams::validate() const { return potentialFieldTable().checkRanges(*this); }
 
-LineTarget::LineTarget(const RowLine& row) : row_(row), u_(std::cos(row.heading), std::sin(row.heading)) {}
+LineTarget::LineTarget(const RowLine& row) : row_(row), u_(cosOf(row.heading), sinOf(row.heading)) {}
 
 TargetState LineTarget::at(double t) const {
   TargetState s;
@@ -182,7 +183,7 @@ double PotentialField::sideFor(std::size_t i, const Eigen::Vector2d& p, const Ta
     ++count;
   }
   centroid /= count;
-  const Eigen::Vector2d left(-std::sin(target.heading), std::cos(target.heading));
+  const Eigen::Vector2d left(-sinOf(target.heading), cosOf(target.heading));
   const double offset = (p - centroid).dot(left);
   if (offset > params_.side_band) return 1.0;
   if (offset < -params_.side_band) return -1.0;
@@ -258,7 +259,7 @@ double PotentialField::minObstacleClearance(const Eigen::Vector2d& p) const {
 Eigen::Vector2d PotentialField::mu(const Eigen::Vector2d& p, const TargetState& target, Eigen::Matrix2d* jac) const {
   Eigen::Vector2d f = Eigen::Vector2d::Zero();
   if (params_.gain <= 0.0) return f;
-  const Eigen::Vector2d left(-std::sin(target.heading), std::cos(target.heading));
+  const Eigen::Vector2d left(-sinOf(target.heading), cosOf(target.heading));
   const double k = params_.gain, kt = params_.tangential_ratio;
   for (std::size_t i = 0; i < obstacles_.size(); ++i) {
     const Obstacle& o = obstacles_[i];
@@ -354,7 +355,7 @@ Reference PotentialField::evaluate(double t) {
   } else {
     r.pose.theta = last_theta_;
     r.omega = 0.0;
-    r.v_dot = a.dot(Eigen::Vector2d(std::cos(last_theta_), std::sin(last_theta_)));
+    r.v_dot = a.dot(Eigen::Vector2d(cosOf(last_theta_), sinOf(last_theta_)));
     r.omega_dot = 0.0;
   }
   return r;

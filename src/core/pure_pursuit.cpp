@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "sowing_robot/core/kanayama.h"
+#include "sowing_robot/core/trig.h"
 #include "sowing_robot/core/validation.h"
 
 namespace sowing_robot {
@@ -62,11 +63,11 @@ Pose2D PurePursuit::carrot(const Reference& ref, double L) {
   const double th = ref.pose.theta, dth = kappa_r * s;
   Pose2D c;
   if (std::fabs(dth) < 1e-9) {
-    c.x = ref.pose.x + s * std::cos(th);
-    c.y = ref.pose.y + s * std::sin(th);
+    c.x = ref.pose.x + s * cosOf(th);
+    c.y = ref.pose.y + s * sinOf(th);
   } else {
-    c.x = ref.pose.x + (std::sin(th + dth) - std::sin(th)) / kappa_r;
-    c.y = ref.pose.y - (std::cos(th + dth) - std::cos(th)) / kappa_r;
+    c.x = ref.pose.x + (sinOf(th + dth) - sinOf(th)) / kappa_r;
+    c.y = ref.pose.y - (cosOf(th + dth) - cosOf(th)) / kappa_r;
   }
   c.theta = wrapAngle(th + dth);
   return c;
@@ -80,8 +81,8 @@ VelocityCommand PurePursuit::compute(const Reference& ref, const Pose2D& actual,
   // The carrot in the robot frame and its rate along the measured motion (carrot moving at v_r).
   const PostureError pc = Kanayama::postureError(c, actual);
   const double xl = pc.xe, yl = pc.ye;
-  const double xl_dot = ref.v * std::cos(pc.thetae) - v + omega * yl;
-  const double yl_dot = ref.v * std::sin(pc.thetae) - omega * xl;
+  const double xl_dot = ref.v * cosOf(pc.thetae) - v + omega * yl;
+  const double yl_dot = ref.v * sinOf(pc.thetae) - omega * xl;
   const double d2 = xl * xl + yl * yl;
   double kappa = 0.0, kappa_dot = 0.0;
   if (d2 > 1e-12) {
@@ -90,7 +91,7 @@ VelocityCommand PurePursuit::compute(const Reference& ref, const Pose2D& actual,
   }
   // Desired speed: v_r (+ along-track feedback on the reference point's error, Kanayama's xe).
   const PostureError e = Kanayama::postureError(ref.pose, actual);
-  const double xe_dot = omega * e.ye - v + ref.v * std::cos(e.thetae);
+  const double xe_dot = omega * e.ye - v + ref.v * cosOf(e.thetae);
   double speed = ref.v + params_.k_along * e.xe;
   double speed_dot = ref.v_dot + params_.k_along * xe_dot;
   if (regulated_ && speed > 0.0) {

@@ -4,6 +4,7 @@
 #include <limits>
 #include <type_traits>
 
+#include "sowing_robot/core/trig.h"
 #include "sowing_robot/core/validation.h"
 
 namespace sowing_robot {
@@ -69,8 +70,7 @@ struct LoopRun {
     // With Kanayama: cos/sin of that yaw, which Kanayama needs, and so does the plant's step when the
     // quaternion round trip gave the heading back to the bit (about two steps in three): computed once.
     if constexpr (kanayama) {
-      cos_yaw = std::cos(pose.theta);
-      sin_yaw = std::sin(pose.theta);
+      sinCos(pose.theta, sin_yaw, cos_yaw);
     }
     const Reference& ref = reference.next(t);  // the source's copy, valid until the next call
     double ex, ey, eth;

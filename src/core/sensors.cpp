@@ -3,6 +3,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "sowing_robot/core/trig.h"
 #include "sowing_robot/core/validation.h"
 
 namespace sowing_robot {
@@ -127,7 +128,7 @@ Odometry2D EncoderOdometry::update(double phi_r, double phi_l, double dt) {
 
   const double ds = 0.5 * (ds_r + ds_l), b = 2.0 * L_, dth = (ds_r - ds_l) / b;
   Pose2D& p = out_.pose;
-  const double mid = p.theta + 0.5 * dth, c = std::cos(mid), s = std::sin(mid);
+  const double mid = p.theta + 0.5 * dth, c = cosOf(mid), s = sinOf(mid);
   // Jacobians at the pose before the update: F in (x, y, theta), G in (Δs_R, Δs_L).
   Eigen::Matrix3d F = Eigen::Matrix3d::Identity();
   F(0, 2) = -ds * s;

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "sowing_robot/core/rotation.h"
+#include "sowing_robot/core/trig.h"
 #include "sowing_robot/core/types.h"
 #include "sowing_robot/core/validation.h"
 
@@ -136,7 +137,7 @@ void TractionPlant::setSoil(const SoilMap& soil) {
 
 void TractionPlant::locateContacts() {
   if (soil_.empty()) return;
-  const double c = std::cos(state_[THETA]), s = std::sin(state_[THETA]), L = nominal_.L;
+  const double c = cosOf(state_[THETA]), s = sinOf(state_[THETA]), L = nominal_.L;
   const Eigen::Vector2d axle(state_[X], state_[Y]), left(-s * L, c * L);
   ground_[RIGHT] = 1 + soil_.patchAt(axle - left);
   ground_[LEFT] = 1 + soil_.patchAt(axle + left);
@@ -163,7 +164,9 @@ double TractionPlant::kineticEnergy() const {
 }
 
 bool TractionPlant::step(double tau_right, double tau_left, double dt) {
-  return stepWithHeading(tau_right, tau_left, dt, std::cos(state_[THETA]), std::sin(state_[THETA]));
+  double c, s;
+  sinCos(state_[THETA], s, c);
+  return stepWithHeading(tau_right, tau_left, dt, c, s);
 }
 
 bool TractionPlant::step(double tau_right, double tau_left, double dt, double theta, double cos_theta,
@@ -189,8 +192,7 @@ bool TractionPlant::stepWithHeading(double tau_right, double tau_left, double dt
   const double dist_step = disturbance_.frequency * h;
   if (disturbance_.sinusoidal) {
     const double angle = disturbance_.frequency * (time_ + 0.5 * h);
-    dist_s = std::sin(angle);
-    dist_c = std::cos(angle);
+    sinCos(angle, dist_s, dist_c);
   }
   const double amplitude = disturbance_.sinusoidal ? disturbance_.amplitude : 0.0;
   locateContacts();

@@ -1,4 +1,5 @@
 #include "sowing_robot/core/traction_run.h"
+#include "sowing_robot/core/trig.h"
 
 #include <algorithm>
 #include <cmath>
@@ -33,7 +34,7 @@ TractionRunResult runTractionClosedLoop(const Scenario& sc, const TractionParams
     const Pose2D pose{s[X], s[Y], yawThroughQuaternion(s[THETA])};
     // cos/sin of the controllers' yaw, for Kanayama and (when the quaternion gave the heading back to the
     // bit) the plant's step: one sincos for both, as in runClosedLoop.
-    const double cos_yaw = std::cos(pose.theta), sin_yaw = std::sin(pose.theta);
+    const double cos_yaw = cosOf(pose.theta), sin_yaw = sinOf(pose.theta);
     const Reference ref = reference.next(t);
     double ex, ey, eth;
     worldErrors(ref, pose, ex, ey, eth);

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "sowing_robot/core/trig.h"
 #include "sowing_robot/ros/component_params.h"
 
 namespace sowing_robot {
@@ -95,7 +96,7 @@ void TractionModel::step(double tau_right, double tau_left, double dt) {
   if (cfg_.traction.draft_force > 0.0) {
     // The tool point of the state the torque answers (t_k): the same rows and pose in every run.
     const core::State& s = plant_.state();
-    const double c = std::cos(s[core::THETA]), sn = std::sin(s[core::THETA]);
+    const double c = core::cosOf(s[core::THETA]), sn = core::sinOf(s[core::THETA]);
     const Eigen::Vector2d p(s[core::X] + c * cfg_.tool.x() - sn * cfg_.tool.y(),
                             s[core::Y] + sn * cfg_.tool.x() + c * cfg_.tool.y());
     std::lock_guard<std::mutex> lock(mutex_);

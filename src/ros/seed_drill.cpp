@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "sowing_robot/core/trig.h"
 #include "sowing_robot/ros/component_params.h"
 #include "sowing_robot/ros/msg_checks.h"
 #include "sowing_robot/ros/urdf_params.h"
@@ -95,7 +96,7 @@ void SeedDrillNode::referenceCallback(const ReferenceState::ConstPtr& msg) {
 
 void SeedDrillNode::update(const nav_msgs::Odometry& odom, bool tool_down) {
   const core::Pose2D pose = poseOf(odom);
-  const double c = std::cos(pose.theta), s = std::sin(pose.theta);
+  const double c = core::cosOf(pose.theta), s = core::sinOf(pose.theta);
   const Eigen::Vector2d tool(pose.x + c * tool_x_ - s * tool_y_, pose.y + s * tool_x_ + c * tool_y_);
   Eigen::Vector2d seed;
   if (!drill_->update(tool, tool_down, seed)) return;

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "sowing_robot/core/node_settings.h"
+#include "sowing_robot/core/trig.h"
 #include "sowing_robot/core/types.h"
 #include "sowing_robot/core/validation.h"
 #include "sowing_robot/ros/component_params.h"
@@ -176,7 +177,7 @@ void StateEstimator::step(const nav_msgs::Odometry& odom, const sensor_msgs::Imu
     // The increments that odometry's midpoint integration turns into this pose change.
     in.dtheta = core::wrapAngle(b.theta - a.theta);
     const double mid = a.theta + 0.5 * in.dtheta;
-    in.distance = (b.x - a.x) * std::cos(mid) + (b.y - a.y) * std::sin(mid);
+    in.distance = (b.x - a.x) * core::cosOf(mid) + (b.y - a.y) * core::sinOf(mid);
     in.covariance = increment_covariance_;  // the quantisation of the two encoders (core/ekf.h says why)
     in.has_rate = imu.angular_velocity_covariance[0] >= 0.0;  // -1: no rate in this message
     in.rate = rate;

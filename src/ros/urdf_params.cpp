@@ -1,5 +1,6 @@
 #include "sowing_robot/ros/urdf_params.h"
 
+#include "sowing_robot/core/trig.h"
 #include "sowing_robot/core/validation.h"
 
 #include <urdf_parser/urdf_parser.h>
@@ -287,7 +288,7 @@ std::string projectGeometry(const urdf::Geometry& g, const Eigen::Isometry3d& t,
   auto circle = [&](const Eigen::Vector3d& centre, const Eigen::Vector3d& e1, const Eigen::Vector3d& e2, double r) {
     for (int k = 0; k < kCircle; ++k) {
       const double a = 2.0 * M_PI * k / kCircle;
-      add(centre + r * (std::cos(a) * e1 + std::sin(a) * e2));
+      add(centre + r * (core::cosOf(a) * e1 + core::sinOf(a) * e2));
     }
   };
   switch (g.type) {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cmath>
+#include "sowing_robot/core/trig.h"
 
 namespace sowing_robot {
 namespace core {
@@ -31,7 +32,7 @@ inline void rotateHeading(double cos0, double sin0, double delta, double& cos_ou
     rotateBySeries(cos0, sin0, delta, cos_out, sin_out);
     return;
   }
-  const double cd = std::cos(delta), sd = std::sin(delta);
+  const double cd = cosOf(delta), sd = sinOf(delta);
   cos_out = cos0 * cd - sin0 * sd;
   sin_out = sin0 * cd + cos0 * sd;
 }

@@ -21,6 +21,7 @@
 #include "sowing_robot/core/plant.h"
 #include "sowing_robot/core/reference.h"
 #include "sowing_robot/core/sliding_mode.h"
+#include "sowing_robot/core/trig.h"
 
 namespace sowing_robot {
 namespace core {
@@ -66,8 +67,7 @@ inline double crossTrack(const LoopSample& s) {
   // sin(+-0) = +-0 and cos(+-0) = 1 exactly: a line or a row along x needs no sincos every period.
   double sn = th, c = 1.0;
   if (th != 0.0) {
-    sn = std::sin(th);
-    c = std::cos(th);
+    sinCos(th, sn, c);
   }
   return -sn * s.ex + c * s.ey;
 }

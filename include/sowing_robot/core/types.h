@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include "sowing_robot/core/trig.h"
 
 namespace sowing_robot {
 namespace core {
@@ -49,7 +50,8 @@ inline double secondsFromNanos(std::int64_t ns) {
 /// The yaw that survives a trip through a geometry_msgs quaternion (z = sin(t/2), w = cos(t/2)) and
 /// back, so that the runner sees what the nodes see in nav_msgs/Odometry.
 inline double yawThroughQuaternion(double theta) {
-  const double z = std::sin(0.5 * theta), w = std::cos(0.5 * theta);
+  double z, w;
+  sinCos(0.5 * theta, z, w);
   return std::atan2(2.0 * w * z, 1.0 - 2.0 * z * z);
 }
 

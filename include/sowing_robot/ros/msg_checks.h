@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 
+#include "sowing_robot/core/trig.h"
 #include "sowing_robot/core/types.h"
 
 namespace sowing_robot {
@@ -21,8 +22,7 @@ inline core::Pose2D poseOf(const nav_msgs::Odometry& o) {
 /// The quaternion of a yaw about z, as core::yawThroughQuaternion builds it (poseOf inverts it).
 inline geometry_msgs::Quaternion yawQuaternion(double theta) {
   geometry_msgs::Quaternion q;
-  q.z = std::sin(0.5 * theta);
-  q.w = std::cos(0.5 * theta);
+  core::sinCos(0.5 * theta, q.z, q.w);
   return q;
 }
 
