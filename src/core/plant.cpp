@@ -125,6 +125,27 @@ SOWING_INLINE void Plant::disturbanceAt(double t, double& right, double& left) {
   left = cached_disturbance_left_;
 }
 
+SOWING_INLINE void Plant::disturbancePairAt(Plant& a, double ta, Plant& b, double tb, double& right_a, double& left_a,
+                                            double& right_b, double& left_b) {
+  if constexpr (kHaveLanes2) {
+    // Both due (the usual case at t + h/2 and t + h): sinusoid's operations on both angles at once, each
+    // lane the scalar sinCos's bits (test_trig), stored in the caches that disturbanceAt then reads.
+    const PlantDisturbance &da = a.disturbance_, &db = b.disturbance_;
+    if (da.sinusoidal && db.sinusoidal && ta != a.cached_disturbance_time_ && tb != b.cached_disturbance_time_) {
+      Lanes2 s, c;
+      sinCos(Lanes2(da.frequency * ta, db.frequency * tb), s, c);
+      a.cached_disturbance_right_ = da.amplitude * s.first();
+      a.cached_disturbance_left_ = da.amplitude * c.first();
+      b.cached_disturbance_right_ = db.amplitude * s.second();
+      b.cached_disturbance_left_ = db.amplitude * c.second();
+      a.cached_disturbance_time_ = ta;
+      b.cached_disturbance_time_ = tb;
+    }
+  }
+  a.disturbanceAt(ta, right_a, left_a);
+  b.disturbanceAt(tb, right_b, left_b);
+}
+
 bool Plant::step(double tau_right, double tau_left, double dt) {
   double c, s;
   sinCos(state_[THETA], s, c);
@@ -277,8 +298,7 @@ void Plant::stepPair(Plant& a, const HeadingStep& in_a, Plant& b, const HeadingS
                                       Lanes2(a.nominal_.R), Lanes2(a.nominal_.L)};
     auto stage = [&](int k, Lanes2 v, Lanes2 w, Lanes2 heading_increment) SOWING_LAMBDA_INLINE {
       double dra, dla, drb, dlb;
-      a.disturbanceAt(stageTime(ta, h, k), dra, dla);
-      b.disturbanceAt(stageTime(tb, h, k), drb, dlb);
+      disturbancePairAt(a, stageTime(ta, h, k), b, stageTime(tb, h, k), dra, dla, drb, dlb);
       Lanes2 c, sn;
       const double inc_a = heading_increment.first(), inc_b = heading_increment.second();
       if (std::fabs(inc_a) <= 0.05 && std::fabs(inc_b) <= 0.05) {  // rotateHeading's series, both lanes

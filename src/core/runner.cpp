@@ -58,20 +58,50 @@ struct LoopRun {
 
   /// Period k up to its torques (tau_right, tau_left, for stepPlant()). False: the run ends at k (the state
   /// diverged, or stop() said so) and the plant must not step.
-  bool control(std::int64_t k) {
-    const double t = secondsFromNanos(k * sc.control_period_ns);
+  bool control(std::int64_t k) { return observe() && controlObserved(k); }
+
+  /// The state as the controllers receive it in nav_msgs/Odometry (pose, and with Kanayama cos/sin of its
+  /// yaw, which Kanayama needs, and so does the plant's step when the quaternion round trip gave the
+  /// heading back to the bit, about two steps in three: computed once). False: the state diverged.
+  bool observe() {
     const State& s = plant.state();
     if (!finiteSum(s)) {
       result.diverged = true;
       return false;
     }
-    // What the controllers receive in nav_msgs/Odometry.
     pose = Pose2D{s[X], s[Y], yawThroughQuaternion(s[THETA])};
-    // With Kanayama: cos/sin of that yaw, which Kanayama needs, and so does the plant's step when the
-    // quaternion round trip gave the heading back to the bit (about two steps in three): computed once.
-    if constexpr (kanayama) {
-      sinCos(pose.theta, sin_yaw, cos_yaw);
+    if constexpr (kanayama) sinCos(pose.theta, sin_yaw, cos_yaw);
+    return true;
+  }
+
+  /// observe() of two runs, their sin/cos in two lanes (each lane the scalar's bits) when both are finite.
+  static void observePair(LoopRun& a, LoopRun& b, bool& seen_a, bool& seen_b) {
+    if constexpr (kHaveLanes2) {
+      const State &sa = a.plant.state(), &sb = b.plant.state();
+      if (finiteSum(sa) && finiteSum(sb)) {
+        a.pose = Pose2D{sa[X], sa[Y], 0.0};
+        b.pose = Pose2D{sb[X], sb[Y], 0.0};
+        yawsThroughQuaternion(sa[THETA], sb[THETA], a.pose.theta, b.pose.theta);
+        if constexpr (kanayama) {
+          Lanes2 s, c;
+          sinCos(Lanes2(a.pose.theta, b.pose.theta), s, c);
+          a.sin_yaw = s.first();
+          a.cos_yaw = c.first();
+          b.sin_yaw = s.second();
+          b.cos_yaw = c.second();
+        }
+        seen_a = seen_b = true;
+        return;
+      }
     }
+    seen_a = a.observe();
+    seen_b = b.observe();
+  }
+
+  /// control(k) after observe().
+  bool controlObserved(std::int64_t k) {
+    const double t = secondsFromNanos(k * sc.control_period_ns);
+    const State& s = plant.state();
     const Reference& ref = reference.next(t);  // the source's copy, valid until the next call
     double ex, ey, eth;
     worldErrors(ref, pose, ex, ey, eth);
@@ -160,7 +190,9 @@ template <typename Outer, typename Inner>
 std::array<RunResult, 2> loopPair(LoopRun<Outer, Inner, RunTally>& a, LoopRun<Outer, Inner, RunTally>& b) {
   const std::int64_t n = a.n;
   for (std::int64_t k = 0; k <= n; ++k) {
-    const bool go_a = a.control(k), go_b = b.control(k);
+    bool seen_a, seen_b;
+    LoopRun<Outer, Inner, RunTally>::observePair(a, b, seen_a, seen_b);
+    const bool go_a = seen_a && a.controlObserved(k), go_b = seen_b && b.controlObserved(k);
     if (!(go_a && go_b)) {
       for (auto* run : {&a, &b}) {
         if (!(run == &a ? go_a : go_b)) continue;

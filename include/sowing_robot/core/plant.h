@@ -87,6 +87,9 @@ class Plant {
   State derivativeWithHeading(const State& s, double cos_th, double sin_th, double applied_right,
                               double applied_left) const;
   void disturbanceAt(double t, double& right, double& left);  // sinusoidalDisturbance, memoised
+  // disturbanceAt of two plants, their two sinCos in one when both are due (stepPair)
+  static void disturbancePairAt(Plant& a, double ta, Plant& b, double tb, double& right_a, double& left_a,
+                                double& right_b, double& left_b);
   bool stepWithHeading(double tau_right, double tau_left, double dt, double cos0, double sin0);
   void drawNoise(double& right, double& left);  // the step's torque noise (0, 0 when off)
   void addIncrement(double x, double y, double theta, double v, double omega, double phi_r, double phi_l, double dt);
