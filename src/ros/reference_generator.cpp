@@ -81,12 +81,12 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
   }
   if (field_) {
     ros::NodeHandle potential(pnh, "potential");
-    reconfigure_ = std::make_unique<dynamic_reconfigure::Server<ReferenceGeneratorConfig>>(potential);
+    reconfigure_ = std::make_unique<ReconfigureServer<ReferenceGeneratorConfig>>(potential);
     // The server would start from the .cfg defaults where a key is not set: hand it the gains in force.
     ReferenceGeneratorConfig in_force;
     toConfig(core::potentialFieldTable(), field.potential, in_force);
-    reconfigure_->updateConfig(in_force);
-    reconfigure_->setCallback([this](ReferenceGeneratorConfig& c, uint32_t level) { reconfigure(c, level); });
+    reconfigure_->server.updateConfig(in_force);
+    reconfigure_->server.setCallback([this](ReferenceGeneratorConfig& c, uint32_t level) { reconfigure(c, level); });
   }
   // A subscriber that connects late (a restarted controller) is sent the references already out for
   // the times still ahead: the loop may be waiting for one of them.

@@ -5,8 +5,10 @@
 #pragma once
 
 #include <dynamic_reconfigure/server.h>
+
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
+#include "sowing_robot/ros/reconfigure_bridge.h"
 
 #include <memory>
 
@@ -47,8 +49,8 @@ class KinematicController {
   bool lockstep_;                // run/mode: wait for the paired reference, never time out
   double input_timeout_ = 0.05;  // [s] sim (shorter than torque_controller's: see config/controllers.yaml)
   // Live gains (reconfigure_bridge.h): validated like the start-up values, a rejected change keeps the old.
-  std::unique_ptr<dynamic_reconfigure::Server<KinematicControllerConfig>> kanayama_reconfigure_;
-  std::unique_ptr<dynamic_reconfigure::Server<PurePursuitConfig>> pure_pursuit_reconfigure_;
+  std::unique_ptr<ReconfigureServer<KinematicControllerConfig>> kanayama_reconfigure_;
+  std::unique_ptr<ReconfigureServer<PurePursuitConfig>> pure_pursuit_reconfigure_;
   ReadyAnnouncer ready_;  // plant_sim waits for it before step 0
 };
 

@@ -6,6 +6,7 @@
 #include <dynamic_reconfigure/Config.h>
 #include <dynamic_reconfigure/server.h>
 #include <ros/console.h>
+#include <boost/thread/recursive_mutex.hpp>
 
 #include <memory>
 #include <stdexcept>
@@ -108,18 +109,27 @@ void applyReconfigure(const char* node, const core::ParamTable<S>& table, const 
   ROS_INFO("%s: gains now %s", node, table.describe(p).c_str());
 }
 
+/// A dynamic_reconfigure server that locks a mutex of its own: one constructed without would log a WARN
+/// ("updateConfig() called on a dynamic_reconfigure::Server that provides its own mutex") at every start,
+/// where the node hands it the values in force.
+template <typename Config>
+struct ReconfigureServer {
+  explicit ReconfigureServer(const ros::NodeHandle& nh) : server(mutex, nh) {}
+  boost::recursive_mutex mutex;  // declared first: built before the server, destroyed after it
+  dynamic_reconfigure::Server<Config> server;
+};
+
 /// A dynamic_reconfigure server on `nh` that starts from the values in force (not the .cfg's defaults,
 /// so its first callback changes nothing) and calls `callback(config)` on every change.
 template <typename Config, typename S, typename Callback>
-std::unique_ptr<dynamic_reconfigure::Server<Config>> startReconfigure(const ros::NodeHandle& nh,
-                                                                      const core::ParamTable<S>& table,
-                                                                      const S& in_force, Callback callback) {
-  auto server = std::make_unique<dynamic_reconfigure::Server<Config>>(nh);
+std::unique_ptr<ReconfigureServer<Config>> startReconfigure(const ros::NodeHandle& nh, const core::ParamTable<S>& table,
+                                                            const S& in_force, Callback callback) {
+  auto reconfigure = std::make_unique<ReconfigureServer<Config>>(nh);
   Config c;
   toConfig(table, in_force, c);
-  server->updateConfig(c);
-  server->setCallback([callback](Config& config, uint32_t) { callback(config); });
-  return server;
+  reconfigure->server.updateConfig(c);
+  reconfigure->server.setCallback([callback](Config& config, uint32_t) { callback(config); });
+  return reconfigure;
 }
 
 }  // namespace sowing_robot

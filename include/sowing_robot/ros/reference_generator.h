@@ -11,10 +11,12 @@
 #pragma once
 
 #include <dynamic_reconfigure/server.h>
+
 #include <nav_msgs/Path.h>
 #include <ros/ros.h>
 #include <rosgraph_msgs/Clock.h>
 #include <visualization_msgs/MarkerArray.h>
+#include "sowing_robot/ros/reconfigure_bridge.h"
 
 #include <cstdint>
 #include <deque>
@@ -70,8 +72,8 @@ class ReferenceGenerator {
   std::int64_t period_ns_ = 1000000;  ///< control period (control_rate) [ns]
   std::unique_ptr<PathBuffer> path_;  // reference_path (spacing from the parameters)
   double path_spacing_ = 0.1;         // [m] between stored reference path points
-  std::unique_ptr<dynamic_reconfigure::Server<ReferenceGeneratorConfig>> reconfigure_;  // type field only
-  ReadyAnnouncer ready_;  // plant_sim waits for it before step 0
+  std::unique_ptr<ReconfigureServer<ReferenceGeneratorConfig>> reconfigure_;  // type field only
+  ReadyAnnouncer ready_;                                                      // plant_sim waits for it before step 0
 };
 
 }  // namespace sowing_robot

@@ -7,8 +7,10 @@
 #pragma once
 
 #include <dynamic_reconfigure/server.h>
+
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
+#include "sowing_robot/ros/reconfigure_bridge.h"
 
 #include <memory>
 
@@ -43,8 +45,8 @@ class TorqueController {
   double input_timeout_ = 0.1;  // [s] sim
   bool stale_ = false;          // the last output was the zero hold
   // Live gains (reconfigure_bridge.h): validated like the start-up values, a rejected change keeps the old.
-  std::unique_ptr<dynamic_reconfigure::Server<TorqueControllerConfig>> smc_reconfigure_;
-  std::unique_ptr<dynamic_reconfigure::Server<WheelPidConfig>> pid_reconfigure_;
+  std::unique_ptr<ReconfigureServer<TorqueControllerConfig>> smc_reconfigure_;
+  std::unique_ptr<ReconfigureServer<WheelPidConfig>> pid_reconfigure_;
   ros::Subscriber odom_sub_, desired_sub_;
   ros::Publisher torque_pub_, state_pub_;
   StampPair<nav_msgs::Odometry, DesiredVelocity> inputs_;
