@@ -271,7 +271,8 @@ std::vector<RunRow> runBenchmark(const BenchScenario& bench, std::int64_t runs, 
     return parallelRows(
         runs, threads, progress,
         [&]() { return oneByOne([&bench](std::int64_t i) { return estimatedBenchRow(bench, i); }); }, loads);
-  const std::int64_t period_steps = seriesEvery(bench);
+  RunExtras extras;
+  extras.series_every = seriesEvery(bench);
   if (bench.track != TrackKind::field) {
     std::unique_ptr<ReferenceSource> proto;
     if (bench.track == TrackKind::line)
@@ -279,8 +280,6 @@ std::vector<RunRow> runBenchmark(const BenchScenario& bench, std::int64_t runs, 
     else
       proto = std::make_unique<SineReference>(bench.sine);
     // Two runs at a time in lockstep (measurePair), each with its own reference.
-    RunExtras extras;
-    extras.series_every = period_steps;
     return parallelRows(
         runs, threads, progress, [&]() { return pairedRuns(base, spec, *proto, extras); }, loads);
   }
@@ -289,10 +288,8 @@ std::vector<RunRow> runBenchmark(const BenchScenario& bench, std::int64_t runs, 
   return parallelRows(
       runs, threads, progress,
       [&]() {
-        return oneByOne([&bench, &base, &spec, period_steps](std::int64_t i) {
+        return oneByOne([&bench, &base, &spec, &extras](std::int64_t i) {
           const RunDraw draw = drawRun(spec, base, i);
-          RunExtras extras;
-          extras.series_every = period_steps;
           return fieldRow(bench, applyDraw(base, spec, draw), extras,
                           [&spec, &draw](const Scenario& sc, ReferenceSource& reference, const RunExtras& e) {
                             return measure(sc, reference, spec, draw, e);
