@@ -72,8 +72,8 @@ std::string fmt(const char* f, double a, double b = 0.0) {
 
 ApproachCurve::ApproachCurve(const Eigen::Vector2d& p0, double heading, double a0, double l0, double psi0, double span)
     : p0_(p0),
-      u_(cosOf(heading), sinOf(heading)),
-      n_(-sinOf(heading), cosOf(heading)),
+      u_(unitVector(heading)),
+      n_(-u_.y(), u_.x()),
       heading_(heading),
       a0_(a0),
       l0_(l0),
@@ -128,7 +128,7 @@ void ApproachCurve::evaluate(double s, Eigen::Vector2d& p, double& theta, double
 ApproachPlan planApproach(const Eigen::Vector2d& p0, double heading, const Pose2D& start, const ApproachLimits& lim,
                           const std::vector<Obstacle>& obstacles) {
   ApproachPlan plan;
-  const Eigen::Vector2d u(cosOf(heading), sinOf(heading)), n(-u.y(), u.x());
+  const Eigen::Vector2d u = unitVector(heading), n(-u.y(), u.x());
   const Eigen::Vector2d d = Eigen::Vector2d(start.x, start.y) - p0;
   const double a0 = d.dot(u), l0 = d.dot(n), psi0 = wrapAngle(start.theta - heading);
   if (d.norm() <= kOnRowDistance && std::fabs(psi0) <= kOnRowHeading) return plan;

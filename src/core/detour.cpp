@@ -31,10 +31,12 @@ std::string indexList(const std::vector<std::size_t>& v) {
 /// Cycloidal rise 0 -> 1 over tau in [0, 1]: value and derivatives with respect to tau.
 void cycloid(double tau, double& f, double& f1, double& f2, double& f3) {
   const double w = 2.0 * M_PI;
-  f = tau - sinOf(w * tau) / w;
-  f1 = 1.0 - cosOf(w * tau);
-  f2 = w * sinOf(w * tau);
-  f3 = w * w * cosOf(w * tau);
+  double s, c;
+  sinCos(w * tau, s, c);
+  f = tau - s / w;
+  f1 = 1.0 - c;
+  f2 = w * s;
+  f3 = w * w * c;
 }
 
 /// An obstacle in row coordinates.
@@ -128,7 +130,7 @@ RowPlan planRow(int row, const Eigen::Vector2d& p0, double heading, double lengt
                 AvoidanceStatus& status) {
   RowPlan plan;
   plan.stop = length;
-  const Eigen::Vector2d u(cosOf(heading), sinOf(heading)), n(-u.y(), u.x());
+  const Eigen::Vector2d u = unitVector(heading), n(-u.y(), u.x());
   const double clearance = params.pathClearance(influence) + kPlanSlack;
   std::vector<Local> loc(obstacles.size());
   std::vector<std::vector<std::size_t>> groups;

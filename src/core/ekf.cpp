@@ -114,12 +114,16 @@ void Ekf::reset(double t, const Vector& mean, const Matrix& covariance) {
 Ekf::Vector Ekf::motion(const Vector6& a) {
   const double mid = a(THETA) + 0.5 * a(4), u = a(5);
   Vector s;
-  s << a(X) + u * cosOf(mid), a(Y) + u * sinOf(mid), wrapAngle(a(THETA) + a(4)), a(BIAS);
+  double sn, c;
+  sinCos(mid, sn, c);
+  s << a(X) + u * c, a(Y) + u * sn, wrapAngle(a(THETA) + a(4)), a(BIAS);
   return s;
 }
 
 Eigen::Matrix<double, 4, 6> Ekf::motionJacobian(const Vector6& a) {
-  const double mid = a(THETA) + 0.5 * a(4), u = a(5), c = cosOf(mid), s = sinOf(mid);
+  const double mid = a(THETA) + 0.5 * a(4), u = a(5);
+  double s, c;
+  sinCos(mid, s, c);
   Eigen::Matrix<double, 4, 6> f = Eigen::Matrix<double, 4, 6>::Zero();
   f(X, X) = 1.0;
   f(X, THETA) = -u * s;

@@ -148,7 +148,9 @@ EstimatedRunResult loop(const Scenario& sc, const EstimatedRunConfig& cfg, P& pl
         EkfStepInput in;
         in.dtheta = wrapAngle(odom_pose.theta - last_odom.theta);
         const double mid = last_odom.theta + 0.5 * in.dtheta;
-        in.distance = (odom_pose.x - last_odom.x) * cosOf(mid) + (odom_pose.y - last_odom.y) * sinOf(mid);
+        double s_mid, c_mid;
+        sinCos(mid, s_mid, c_mid);
+        in.distance = (odom_pose.x - last_odom.x) * c_mid + (odom_pose.y - last_odom.y) * s_mid;
         in.covariance = increment_covariance;
         in.has_rate = true;
         in.rate = yaw_rate;
@@ -178,7 +180,8 @@ EstimatedRunResult loop(const Scenario& sc, const EstimatedRunConfig& cfg, P& pl
     // The plant's tool rule on the true tool point of the state this step starts from (TractionModel::step).
     bool tool_down = false;
     if (draft && k < n) {
-      const double c = cosOf(s[THETA]), sn = sinOf(s[THETA]);
+      double sn, c;
+      sinCos(s[THETA], sn, c);
       const Eigen::Vector2d p(s[X] + c * cfg.tool.x() - sn * cfg.tool.y(), s[Y] + sn * cfg.tool.x() + c * cfg.tool.y());
       tool_down = tool_rule.update(p);
       traction->setToolDown(tool_down);

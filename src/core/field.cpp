@@ -112,9 +112,11 @@ void HeadlandTurn::segmentState(const Segment& g, double tau, double& theta, dou
     return;
   }
   const double dk = g.k1 - g.k0, w = M_PI / g.length;
-  kappa = g.k0 + 0.5 * dk * (1.0 - cosOf(w * tau));
-  theta = g.theta0 + g.k0 * tau + 0.5 * dk * (tau - sinOf(w * tau) / w);
-  dkappa = 0.5 * dk * w * sinOf(w * tau);
+  double s, c;
+  sinCos(w * tau, s, c);
+  kappa = g.k0 + 0.5 * dk * (1.0 - c);
+  theta = g.theta0 + g.k0 * tau + 0.5 * dk * (tau - s / w);
+  dkappa = 0.5 * dk * w * s;
 }
 
 Eigen::Vector2d HeadlandTurn::integrate(const Segment& g, double a, double b) {
@@ -124,7 +126,7 @@ Eigen::Vector2d HeadlandTurn::integrate(const Segment& g, double a, double b) {
   for (int i = 0; i < 5; ++i) {
     double th, k, dk;
     segmentState(g, a + kGaussX[i] * h, th, k, dk);
-    sum += kGaussW[i] * Eigen::Vector2d(cosOf(th), sinOf(th));
+    sum += kGaussW[i] * unitVector(th);
   }
   return h * sum;
 }
@@ -235,7 +237,7 @@ void HeadlandTurn::evaluate(double s, Eigen::Vector2d& p, double& theta, double&
 
 Eigen::Vector2d FieldPath::rowStart(int i) const {
   const double h = params_.heading;
-  const Eigen::Vector2d u(cosOf(h), sinOf(h));
+  const Eigen::Vector2d u = unitVector(h);
   const Eigen::Vector2d side = (params_.rows_to_left ? 1.0 : -1.0) * Eigen::Vector2d(-u.y(), u.x());
   Eigen::Vector2d p = Eigen::Vector2d(params_.start_x, params_.start_y) + (i * params_.row_spacing) * side;
   if (i % 2 == 1) p += params_.row_length * u;
@@ -310,7 +312,7 @@ FieldPath::FieldPath(const FieldParams& params, const std::vector<Obstacle>& obs
       t.s0 = s;
       t.length = turn_.length();
       t.turn = true;
-      t.p0 = row.p0 + params_.row_length * Eigen::Vector2d(cosOf(h), sinOf(h));
+      t.p0 = row.p0 + params_.row_length * unitVector(h);
       t.heading = h;
       t.side = (params_.rows_to_left ? 1.0 : -1.0) * (i % 2 == 0 ? 1.0 : -1.0);
       elements_.push_back(t);
@@ -426,10 +428,12 @@ void FieldPath::arcLength(double t, double& s, double& sd, double& sdd, double& 
     return;
   }
   const double dv = ph.v1 - ph.v0, w = M_PI / ph.duration;
-  s = ph.s0 + ph.v0 * tau + 0.5 * dv * (tau - sinOf(w * tau) / w);
-  sd = ph.v0 + 0.5 * dv * (1.0 - cosOf(w * tau));
-  sdd = 0.5 * dv * w * sinOf(w * tau);
-  sddd = 0.5 * dv * w * w * cosOf(w * tau);
+  double sn, c;
+  sinCos(w * tau, sn, c);
+  s = ph.s0 + ph.v0 * tau + 0.5 * dv * (tau - sn / w);
+  sd = ph.v0 + 0.5 * dv * (1.0 - c);
+  sdd = 0.5 * dv * w * sn;
+  sddd = 0.5 * dv * w * w * c;
 }
 
 TargetState FieldPath::at(double t) const {
@@ -449,7 +453,8 @@ TargetState FieldPath::at(double t) const {
     Eigen::Vector2d local;
     double th_l, k_l, dk_l;
     turn_.evaluate(sigma, local, th_l, k_l, dk_l);
-    const double c = cosOf(el.heading), sn = sinOf(el.heading);
+    double sn, c;
+    sinCos(el.heading, sn, c);
     const double ly = el.side * local.y();
     p = el.p0 + Eigen::Vector2d(c * local.x() - sn * ly, sn * local.x() + c * ly);
     theta = el.heading + el.side * th_l;
@@ -462,7 +467,7 @@ TargetState FieldPath::at(double t) const {
       // On a detour: p = p0 + sigma u + y(sigma) n with sigma' = sd (along-row speed).
       double y, y1, y2, y3;
       dt.lateral(sigma, y, y1, y2, y3);
-      const Eigen::Vector2d u(cosOf(el.heading), sinOf(el.heading)), nl(-u.y(), u.x());
+      const Eigen::Vector2d u = unitVector(el.heading), nl(-u.y(), u.x());
       const Eigen::Vector2d tang = u + y1 * nl;
       TargetState out;
       out.p = el.p0 + sigma * u + y * nl;
@@ -473,10 +478,10 @@ TargetState FieldPath::at(double t) const {
       out.tool_down = t < duration_ && sigma >= el.tool_from;
       return out;
     }
-    p = el.p0 + sigma * Eigen::Vector2d(cosOf(el.heading), sinOf(el.heading));
+    p = el.p0 + sigma * unitVector(el.heading);
     theta = el.heading;
   }
-  const Eigen::Vector2d T(cosOf(theta), sinOf(theta)), N(-T.y(), T.x());
+  const Eigen::Vector2d T = unitVector(theta), N(-T.y(), T.x());
   TargetState out;
   out.p = p;
   out.v = sd * T;

@@ -49,7 +49,8 @@ FieldRunReport runField(const FieldRunSetup& setup) {
     const State& x = *s.state;
     const Pose2D pose{x[X], x[Y], x[THETA]};
     contacts.update(s.t, pose);
-    const double c = cosOf(x[THETA]), sn = sinOf(x[THETA]);
+    double sn, c;
+    sinCos(x[THETA], sn, c);
     const Eigen::Vector2d tool(x[X] + c * setup.tool.x() - sn * setup.tool.y(),
                                x[Y] + sn * setup.tool.x() + c * setup.tool.y());
     Eigen::Vector2d seed;

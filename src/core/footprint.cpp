@@ -87,14 +87,16 @@ double Footprint::signedDistance(const Eigen::Vector2d& q) const {
 
 double Footprint::distanceToCircle(const Pose2D& pose, const Eigen::Vector2d& centre, double radius) const {
   // The centre in base_link: rotate the offset by -theta.
-  const double c = cosOf(pose.theta), s = sinOf(pose.theta);
+  double s, c;
+  sinCos(pose.theta, s, c);
   const Eigen::Vector2d w = centre - Eigen::Vector2d(pose.x, pose.y);
   const Eigen::Vector2d q(c * w.x() + s * w.y(), -s * w.x() + c * w.y());
   return signedDistance(q) - radius;
 }
 
 std::vector<Eigen::Vector2d> Footprint::placed(const Pose2D& pose) const {
-  const double c = cosOf(pose.theta), s = sinOf(pose.theta);
+  double s, c;
+  sinCos(pose.theta, s, c);
   std::vector<Eigen::Vector2d> out;
   out.reserve(vertices_.size());
   for (const auto& v : vertices_) out.emplace_back(pose.x + c * v.x() - s * v.y(), pose.y + s * v.x() + c * v.y());

@@ -45,11 +45,15 @@ bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 }  // namespace
 
 PostureError Kanayama::postureError(const Pose2D& r, const Pose2D& a) {
-  return postureErrorWith(r, a, cosOf(a.theta), sinOf(a.theta));
+  double s, c;
+  sinCos(a.theta, s, c);
+  return postureErrorWith(r, a, c, s);
 }
 
 VelocityCommand Kanayama::compute(const Reference& ref, const Pose2D& actual, double v, double omega) const {
-  return compute(ref, actual, cosOf(actual.theta), sinOf(actual.theta), v, omega);
+  double s, c;
+  sinCos(actual.theta, s, c);
+  return compute(ref, actual, c, s, v, omega);
 }
 
 VelocityCommand Kanayama::compute(const Reference& ref, const Pose2D& actual, double cos_theta, double sin_theta,

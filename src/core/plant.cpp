@@ -322,7 +322,7 @@ void Plant::stepPair(Plant& a, const HeadingStep& in_a, Plant& b, const HeadingS
 }
 
 Eigen::Vector2d Plant::centreOfMass() const {
-  return {state_[X] + nominal_.d * cosOf(state_[THETA]), state_[Y] + nominal_.d * sinOf(state_[THETA])};
+  return Eigen::Vector2d(state_[X], state_[Y]) + nominal_.d * unitVector(state_[THETA]);
 }
 
 }  // namespace core

@@ -67,7 +67,7 @@ PotentialFieldParams::PotentialFieldParams() { potentialFieldTable().applyDefaul
 
 std::string PotentialFieldParams::validate() const { return potentialFieldTable().checkRanges(*this); }
 
-LineTarget::LineTarget(const RowLine& row) : row_(row), u_(cosOf(row.heading), sinOf(row.heading)) {}
+LineTarget::LineTarget(const RowLine& row) : row_(row), u_(unitVector(row.heading)) {}
 
 TargetState LineTarget::at(double t) const {
   TargetState s;
@@ -183,7 +183,7 @@ double PotentialField::sideFor(std::size_t i, const Eigen::Vector2d& p, const Ta
     ++count;
   }
   centroid /= count;
-  const Eigen::Vector2d left(-sinOf(target.heading), cosOf(target.heading));
+  const Eigen::Vector2d u = unitVector(target.heading), left(-u.y(), u.x());
   const double offset = (p - centroid).dot(left);
   if (offset > params_.side_band) return 1.0;
   if (offset < -params_.side_band) return -1.0;
@@ -259,7 +259,7 @@ double PotentialField::minObstacleClearance(const Eigen::Vector2d& p) const {
 Eigen::Vector2d PotentialField::mu(const Eigen::Vector2d& p, const TargetState& target, Eigen::Matrix2d* jac) const {
   Eigen::Vector2d f = Eigen::Vector2d::Zero();
   if (params_.gain <= 0.0) return f;
-  const Eigen::Vector2d left(-sinOf(target.heading), cosOf(target.heading));
+  const Eigen::Vector2d u = unitVector(target.heading), left(-u.y(), u.x());
   const double k = params_.gain, kt = params_.tangential_ratio;
   for (std::size_t i = 0; i < obstacles_.size(); ++i) {
     const Obstacle& o = obstacles_[i];
@@ -355,7 +355,7 @@ Reference PotentialField::evaluate(double t) {
   } else {
     r.pose.theta = last_theta_;
     r.omega = 0.0;
-    r.v_dot = a.dot(Eigen::Vector2d(cosOf(last_theta_), sinOf(last_theta_)));
+    r.v_dot = a.dot(unitVector(last_theta_));
     r.omega_dot = 0.0;
   }
   return r;

@@ -63,11 +63,16 @@ Pose2D PurePursuit::carrot(const Reference& ref, double L) {
   const double th = ref.pose.theta, dth = kappa_r * s;
   Pose2D c;
   if (std::fabs(dth) < 1e-9) {
-    c.x = ref.pose.x + s * cosOf(th);
-    c.y = ref.pose.y + s * sinOf(th);
+    double sn, cs;
+    sinCos(th, sn, cs);
+    c.x = ref.pose.x + s * cs;
+    c.y = ref.pose.y + s * sn;
   } else {
-    c.x = ref.pose.x + (sinOf(th + dth) - sinOf(th)) / kappa_r;
-    c.y = ref.pose.y - (cosOf(th + dth) - cosOf(th)) / kappa_r;
+    double s0, c0, s1, c1;
+    sinCos(th, s0, c0);
+    sinCos(th + dth, s1, c1);
+    c.x = ref.pose.x + (s1 - s0) / kappa_r;
+    c.y = ref.pose.y - (c1 - c0) / kappa_r;
   }
   c.theta = wrapAngle(th + dth);
   return c;
@@ -81,8 +86,10 @@ VelocityCommand PurePursuit::compute(const Reference& ref, const Pose2D& actual,
   // The carrot in the robot frame and its rate along the measured motion (carrot moving at v_r).
   const PostureError pc = Kanayama::postureError(c, actual);
   const double xl = pc.xe, yl = pc.ye;
-  const double xl_dot = ref.v * cosOf(pc.thetae) - v + omega * yl;
-  const double yl_dot = ref.v * sinOf(pc.thetae) - omega * xl;
+  double sin_e, cos_e;
+  sinCos(pc.thetae, sin_e, cos_e);
+  const double xl_dot = ref.v * cos_e - v + omega * yl;
+  const double yl_dot = ref.v * sin_e - omega * xl;
   const double d2 = xl * xl + yl * yl;
   double kappa = 0.0, kappa_dot = 0.0;
   if (d2 > 1e-12) {

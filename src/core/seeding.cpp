@@ -16,7 +16,7 @@ std::vector<RowSegment> rowsOf(const FieldParams& field) {
   for (int i = 0; i < field.rows; ++i) {
     const double h = field.heading + (i % 2 == 0 ? 0.0 : M_PI);
     const Eigen::Vector2d a = path.rowStart(i);
-    rows.push_back({a, a + field.row_length * Eigen::Vector2d(cosOf(h), sinOf(h))});
+    rows.push_back({a, a + field.row_length * unitVector(h)});
   }
   return rows;
 }

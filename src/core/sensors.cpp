@@ -128,7 +128,9 @@ Odometry2D EncoderOdometry::update(double phi_r, double phi_l, double dt) {
 
   const double ds = 0.5 * (ds_r + ds_l), b = 2.0 * L_, dth = (ds_r - ds_l) / b;
   Pose2D& p = out_.pose;
-  const double mid = p.theta + 0.5 * dth, c = cosOf(mid), s = sinOf(mid);
+  const double mid = p.theta + 0.5 * dth;
+  double s, c;
+  sinCos(mid, s, c);
   // Jacobians at the pose before the update: F in (x, y, theta), G in (Δs_R, Δs_L).
   Eigen::Matrix3d F = Eigen::Matrix3d::Identity();
   F(0, 2) = -ds * s;

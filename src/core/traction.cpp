@@ -137,7 +137,9 @@ void TractionPlant::setSoil(const SoilMap& soil) {
 
 void TractionPlant::locateContacts() {
   if (soil_.empty()) return;
-  const double c = cosOf(state_[THETA]), s = sinOf(state_[THETA]), L = nominal_.L;
+  double s, c;
+  sinCos(state_[THETA], s, c);
+  const double L = nominal_.L;
   const Eigen::Vector2d axle(state_[X], state_[Y]), left(-s * L, c * L);
   ground_[RIGHT] = 1 + soil_.patchAt(axle - left);
   ground_[LEFT] = 1 + soil_.patchAt(axle + left);

@@ -34,7 +34,8 @@ TractionRunResult runTractionClosedLoop(const Scenario& sc, const TractionParams
     const Pose2D pose{s[X], s[Y], yawThroughQuaternion(s[THETA])};
     // cos/sin of the controllers' yaw, for Kanayama and (when the quaternion gave the heading back to the
     // bit) the plant's step: one sincos for both, as in runClosedLoop.
-    const double cos_yaw = cosOf(pose.theta), sin_yaw = sinOf(pose.theta);
+    double sin_yaw, cos_yaw;
+    sinCos(pose.theta, sin_yaw, cos_yaw);
     const Reference ref = reference.next(t);
     double ex, ey, eth;
     worldErrors(ref, pose, ex, ey, eth);

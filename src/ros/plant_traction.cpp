@@ -96,7 +96,8 @@ void TractionModel::step(double tau_right, double tau_left, double dt) {
   if (cfg_.traction.draft_force > 0.0) {
     // The tool point of the state the torque answers (t_k): the same rows and pose in every run.
     const core::State& s = plant_.state();
-    const double c = core::cosOf(s[core::THETA]), sn = core::sinOf(s[core::THETA]);
+    double sn, c;
+    core::sinCos(s[core::THETA], sn, c);
     const Eigen::Vector2d p(s[core::X] + c * cfg_.tool.x() - sn * cfg_.tool.y(),
                             s[core::Y] + sn * cfg_.tool.x() + c * cfg_.tool.y());
     std::lock_guard<std::mutex> lock(mutex_);

@@ -96,7 +96,8 @@ void SeedDrillNode::referenceCallback(const ReferenceState::ConstPtr& msg) {
 
 void SeedDrillNode::update(const nav_msgs::Odometry& odom, bool tool_down) {
   const core::Pose2D pose = poseOf(odom);
-  const double c = core::cosOf(pose.theta), s = core::sinOf(pose.theta);
+  double s, c;
+  core::sinCos(pose.theta, s, c);
   const Eigen::Vector2d tool(pose.x + c * tool_x_ - s * tool_y_, pose.y + s * tool_x_ + c * tool_y_);
   Eigen::Vector2d seed;
   if (!drill_->update(tool, tool_down, seed)) return;

@@ -177,7 +177,9 @@ void StateEstimator::step(const nav_msgs::Odometry& odom, const sensor_msgs::Imu
     // The increments that odometry's midpoint integration turns into this pose change.
     in.dtheta = core::wrapAngle(b.theta - a.theta);
     const double mid = a.theta + 0.5 * in.dtheta;
-    in.distance = (b.x - a.x) * core::cosOf(mid) + (b.y - a.y) * core::sinOf(mid);
+    double s, c;
+    core::sinCos(mid, s, c);
+    in.distance = (b.x - a.x) * c + (b.y - a.y) * s;
     in.covariance = increment_covariance_;  // the quantisation of the two encoders (core/ekf.h says why)
     in.has_rate = imu.angular_velocity_covariance[0] >= 0.0;  // -1: no rate in this message
     in.rate = rate;

@@ -288,7 +288,9 @@ std::string projectGeometry(const urdf::Geometry& g, const Eigen::Isometry3d& t,
   auto circle = [&](const Eigen::Vector3d& centre, const Eigen::Vector3d& e1, const Eigen::Vector3d& e2, double r) {
     for (int k = 0; k < kCircle; ++k) {
       const double a = 2.0 * M_PI * k / kCircle;
-      add(centre + r * (core::cosOf(a) * e1 + core::sinOf(a) * e2));
+      double s, c;
+      core::sinCos(a, s, c);
+      add(centre + r * (c * e1 + s * e2));
     }
   };
   switch (g.type) {

@@ -38,7 +38,7 @@ class Kanayama {
   /// differentiation (and no filter lag) enters the inner loop. A non-finite input gives the stop
   /// command (all zero), never a NaN: the safe output of a stateless controller.
   VelocityCommand compute(const Reference& ref, const Pose2D& actual, double v, double omega) const;
-  /// compute() with cos_theta = cosOf(actual.theta), sin_theta = sinOf(actual.theta) supplied by a
+  /// compute() with cos_theta, sin_theta = sinCos(actual.theta) supplied by a
   /// caller that needs them too (runClosedLoop shares them with the plant's step): the same numbers.
   VelocityCommand compute(const Reference& ref, const Pose2D& actual, double cos_theta, double sin_theta, double v,
                           double omega) const;

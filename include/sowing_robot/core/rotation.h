@@ -32,7 +32,8 @@ inline void rotateHeading(double cos0, double sin0, double delta, double& cos_ou
     rotateBySeries(cos0, sin0, delta, cos_out, sin_out);
     return;
   }
-  const double cd = cosOf(delta), sd = sinOf(delta);
+  double sd, cd;
+  sinCos(delta, sd, cd);
   cos_out = cos0 * cd - sin0 * sd;
   sin_out = sin0 * cd + cos0 * sd;
 }

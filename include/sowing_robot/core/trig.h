@@ -27,6 +27,8 @@
 #include <cstdint>
 #include <cstring>
 
+#include <Eigen/Core>
+
 #include "sowing_robot/core/lanes2.h"
 
 namespace sowing_robot {
@@ -127,6 +129,13 @@ inline void sinCos(double x, double& sin_x, double& cos_x) {
       cos_x = s;
       break;
   }
+}
+
+/// (cos h, sin h), the unit vector of heading h, from one sinCos.
+inline Eigen::Vector2d unitVector(double heading) {
+  double s, c;
+  sinCos(heading, s, c);
+  return {c, s};
 }
 
 /// sin x, the same bits as sinCos's.
