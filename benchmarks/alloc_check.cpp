@@ -11,11 +11,11 @@
 #include <string>
 #include <vector>
 
-#include "sowing_robot/core/kanayama.h"
-#include "sowing_robot/core/plant.h"
-#include "sowing_robot/core/runner.h"
-#include "sowing_robot/core/sliding_mode.h"
-#include "sowing_robot/core/tuning.h"
+#include "sowing_robot/core/control/kanayama.h"
+#include "sowing_robot/core/control/sliding_mode.h"
+#include "sowing_robot/core/evaluation/tuning.h"
+#include "sowing_robot/core/model/plant.h"
+#include "sowing_robot/core/simulation/runner.h"
 #include "thesis_scenario.h"
 
 namespace {

@@ -15,12 +15,12 @@
 
 #include <vector>
 
-#include "sowing_robot/core/benchmark.h"
-#include "sowing_robot/core/plant.h"
-#include "sowing_robot/core/pso.h"
-#include "sowing_robot/core/runner.h"
-#include "sowing_robot/core/traction_run.h"
-#include "sowing_robot/core/tuning.h"
+#include "sowing_robot/core/evaluation/benchmark.h"
+#include "sowing_robot/core/evaluation/pso.h"
+#include "sowing_robot/core/evaluation/tuning.h"
+#include "sowing_robot/core/model/plant.h"
+#include "sowing_robot/core/simulation/runner.h"
+#include "sowing_robot/core/simulation/traction_run.h"
 #include "thesis_scenario.h"
 
 using namespace sowing_robot;

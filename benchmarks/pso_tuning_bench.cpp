@@ -16,7 +16,7 @@
 #include <thread>
 #include <vector>
 
-#include "sowing_robot/core/tuning.h"
+#include "sowing_robot/core/evaluation/tuning.h"
 
 using namespace sowing_robot::core;
 

@@ -6,9 +6,9 @@
 
 #include <vector>
 
-#include "sowing_robot/core/potential_field.h"
-#include "sowing_robot/core/reference.h"
-#include "sowing_robot/core/runner.h"
+#include "sowing_robot/core/common/reference.h"
+#include "sowing_robot/core/planning/potential_field.h"
+#include "sowing_robot/core/simulation/runner.h"
 
 namespace sowing_robot {
 namespace bench {

@@ -14,20 +14,20 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include "sowing_robot/core/ekf.h"
-#include "sowing_robot/core/estimated_run.h"
-#include "sowing_robot/core/field.h"
-#include "sowing_robot/core/kanayama.h"
-#include "sowing_robot/core/node_settings.h"
-#include "sowing_robot/core/plant.h"
-#include "sowing_robot/core/pure_pursuit.h"
-#include "sowing_robot/core/sensors.h"
-#include "sowing_robot/core/sliding_mode.h"
-#include "sowing_robot/core/soil_map.h"
-#include "sowing_robot/core/traction.h"
-#include "sowing_robot/core/tuning.h"
-#include "sowing_robot/core/validation.h"
-#include "sowing_robot/core/wheel_pid.h"
+#include "sowing_robot/core/common/validation.h"
+#include "sowing_robot/core/control/kanayama.h"
+#include "sowing_robot/core/control/pure_pursuit.h"
+#include "sowing_robot/core/control/sliding_mode.h"
+#include "sowing_robot/core/control/wheel_pid.h"
+#include "sowing_robot/core/estimation/ekf.h"
+#include "sowing_robot/core/evaluation/tuning.h"
+#include "sowing_robot/core/model/plant.h"
+#include "sowing_robot/core/model/sensors.h"
+#include "sowing_robot/core/model/soil_map.h"
+#include "sowing_robot/core/model/traction.h"
+#include "sowing_robot/core/planning/field.h"
+#include "sowing_robot/core/settings/node_settings.h"
+#include "sowing_robot/core/simulation/estimated_run.h"
 
 namespace sowing_robot {
 namespace bench {
@@ -401,7 +401,7 @@ core::BenchScenario loadScenarioFileImpl(const std::string& path) {
   // Issue 16 in the benchmark: the plant (traction:), the sensors (sensors:), the estimator (estimator:) and
   // what the controllers are fed (feedback:), each block through the nodes' parameter table with the nodes'
   // keys (traction/..., sensors/..., estimator/...), so a key, a range and an error read as plant_sim's and
-  // state_estimator's. Any of them puts the scenario on the estimated loop (core/estimated_bench.h).
+  // state_estimator's. Any of them puts the scenario on the estimated loop (core/evaluation/estimated_bench.h).
   const YAML::Node traction = root["traction"], sensors = root["sensors"], estimator = root["estimator"],
                    feedback = root["feedback"];
   if (traction || sensors || estimator || feedback) {

@@ -18,9 +18,9 @@
 #include <mutex>
 #include <thread>
 
-#include "sowing_robot/ros/failure_log.h"
+#include "sowing_robot/ros/common/failure_log.h"
 #include "sowing_robot/ros/kinematic_controller.h"
-#include "sowing_robot/ros/plant_sim.h"
+#include "sowing_robot/ros/plant_sim/plant_sim.h"
 #include "sowing_robot/ros/reference_generator.h"
 #include "sowing_robot/ros/run_monitor.h"
 #include "sowing_robot/ros/seed_drill.h"

@@ -29,9 +29,9 @@
 #include <string>
 #include <vector>
 
-#include "sowing_robot/ros/failure_log.h"
-#include "sowing_robot/ros/param_reader.h"
-#include "sowing_robot/ros/ready_roster.h"
+#include "sowing_robot/ros/common/failure_log.h"
+#include "sowing_robot/ros/common/param_reader.h"
+#include "sowing_robot/ros/common/ready_roster.h"
 
 namespace {
 volatile std::sig_atomic_t g_stop = 0;

@@ -24,9 +24,9 @@
 #include <vector>
 
 #include "sowing_robot/bench/scenario_loader.h"
-#include "sowing_robot/core/benchmark.h"
-#include "sowing_robot/core/estimated_bench.h"
-#include "sowing_robot/core/runner.h"
+#include "sowing_robot/core/evaluation/benchmark.h"
+#include "sowing_robot/core/evaluation/estimated_bench.h"
+#include "sowing_robot/core/simulation/runner.h"
 
 using namespace sowing_robot::core;
 namespace bench = sowing_robot::bench;
@@ -213,9 +213,10 @@ int main(int argc, char** argv) {
   bool realism = false;
   for (const auto& b : scenarios) realism = realism || b.realism.has_value();
   std::string csv = runsCsvHeader(realism), envelopes = envelopeCsvHeader();
-  std::string report = "# Controller benchmark\n\n" + std::to_string(seeds) +
-                       " seeded runs per scenario and controller, in-process (`benchmark`, core/benchmark.h); every "
-                       "run can be repeated alone from its row of runs.csv.\n\nGains:\n\n";
+  std::string report =
+      "# Controller benchmark\n\n" + std::to_string(seeds) +
+      " seeded runs per scenario and controller, in-process (`benchmark`, core/evaluation/benchmark.h); every "
+      "run can be repeated alone from its row of runs.csv.\n\nGains:\n\n";
   for (std::size_t p = 0; p < pairs.size(); ++p)
     report += "- " + pairs[p].controllerName() + ": " + gains_source[p] + "\n";
   report += "\nScenarios:\n\n";

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "sowing_robot/core/param_catalog.h"
+#include "sowing_robot/core/settings/param_catalog.h"
 
 int main(int argc, char** argv) {
   using namespace sowing_robot::core;

@@ -3,10 +3,10 @@
 // one FATAL line and becomes its exit code (2, 3).
 #include <ros/ros.h>
 
-#include "sowing_robot/ros/failure_log.h"
-#include "sowing_robot/ros/node_failure.h"
-#include "sowing_robot/ros/param_reader.h"
-#include "sowing_robot/ros/plant_sim.h"
+#include "sowing_robot/ros/common/failure_log.h"
+#include "sowing_robot/ros/common/node_failure.h"
+#include "sowing_robot/ros/common/param_reader.h"
+#include "sowing_robot/ros/plant_sim/plant_sim.h"
 
 int main(int argc, char** argv) {
   ros::init(argc, argv, "plant_sim");

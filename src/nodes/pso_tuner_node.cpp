@@ -2,8 +2,8 @@
 // A bad parameter (NodeFailure) becomes one FATAL line and exit 1.
 #include <ros/ros.h>
 
-#include "sowing_robot/ros/failure_log.h"
-#include "sowing_robot/ros/param_reader.h"
+#include "sowing_robot/ros/common/failure_log.h"
+#include "sowing_robot/ros/common/param_reader.h"
 #include "sowing_robot/ros/pso_tuner.h"
 
 int main(int argc, char** argv) {

@@ -1,5 +1,5 @@
 // Standalone reference_generator node: the wrapper class does the work.
-#include "sowing_robot/ros/node_main.h"
+#include "sowing_robot/ros/common/node_main.h"
 #include "sowing_robot/ros/reference_generator.h"
 
 int main(int argc, char** argv) {

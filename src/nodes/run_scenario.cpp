@@ -25,10 +25,10 @@
 #include <string>
 #include <vector>
 
-#include "sowing_robot/core/field_run.h"
-#include "sowing_robot/core/runner.h"
-#include "sowing_robot/core/traction_run.h"
-#include "sowing_robot/core/validation.h"
+#include "sowing_robot/core/common/validation.h"
+#include "sowing_robot/core/simulation/field_run.h"
+#include "sowing_robot/core/simulation/runner.h"
+#include "sowing_robot/core/simulation/traction_run.h"
 
 using namespace sowing_robot::core;
 

@@ -1,5 +1,5 @@
 // Standalone torque_controller node: the wrapper class does the work.
-#include "sowing_robot/ros/node_main.h"
+#include "sowing_robot/ros/common/node_main.h"
 #include "sowing_robot/ros/torque_controller.h"
 
 int main(int argc, char** argv) {

@@ -13,10 +13,10 @@
 #include <utility>
 #include <vector>
 
-#include "sowing_robot/core/metrics.h"
-#include "sowing_robot/core/reference.h"
-#include "sowing_robot/core/runner.h"
-#include "sowing_robot/core/tuning.h"
+#include "sowing_robot/core/common/reference.h"
+#include "sowing_robot/core/evaluation/tuning.h"
+#include "sowing_robot/core/simulation/metrics.h"
+#include "sowing_robot/core/simulation/runner.h"
 
 namespace py_core {
 

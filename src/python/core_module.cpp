@@ -1,8 +1,8 @@
 // sowing_robot.core: the ROS-free core seen from Python (pybind11). One definition of the metrics and
 // the closed loop: analyze_bag, the tests and notebooks call this code instead of copies of it.
-//   MetricsAccumulator, metrics(), time_domain_metrics(), metrics_table()  (core/metrics.h)
-//   run_closed_loop(), run()      (core/runner.h on the line; run: any controller pair and parameters)
-//   tune(), tunable_gains(), gains_yaml()                                  (core/tuning.h: the PSO tuner)
+//   MetricsAccumulator, metrics(), time_domain_metrics(), metrics_table()  (core/simulation/metrics.h)
+//   run_closed_loop(), run()      (core/simulation/runner.h on the line; run: any controller pair and parameters)
+//   tune(), tunable_gains(), gains_yaml()                                  (core/evaluation/tuning.h: the PSO tuner)
 // Arrays in are 1-D float64 NumPy arrays (anything convertible); metrics out are plain dicts
 // {"x": {"ise": .., ..., "peak": ..}, "y": {...}, "theta": {...}}, so they compare with == to the bit.
 #include <array>
@@ -138,12 +138,12 @@ py::dict tunePy(const std::string& controller, const py::object& params, const p
 PYBIND11_MODULE(core, m) {
   m.doc() = R"doc(The ROS-free sowing_robot core (C++), for Python.
 
-Metrics (include/sowing_robot/core/metrics.h): trapezoidal ISE/ITSE/IAE/ITAE and the time-domain
+Metrics (include/sowing_robot/core/simulation/metrics.h): trapezoidal ISE/ITSE/IAE/ITAE and the time-domain
 figures (rise/settling time, overshoot, peak) of the world-frame tracking errors. Results are dicts
 {"x": {...}, "y": {...}, "theta": {...}} with the keys of FIELDS, computed by the same code as
 run_monitor, run_scenario and the PSO tuner, so they are equal (==) to theirs.
 
-Closed loop (include/sowing_robot/core/runner.h): run_closed_loop() steps plant, Kanayama and the
+Closed loop (include/sowing_robot/core/simulation/runner.h): run_closed_loop() steps plant, Kanayama and the
 sliding-mode controller on the thesis's line, as the lockstep node pipeline does.)doc";
   m.attr("AXES") = py::make_tuple("x", "y", "theta");
   py::list fields;

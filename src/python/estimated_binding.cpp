@@ -1,13 +1,13 @@
-// sowing_robot.core.run_estimated: core::runEstimatedLoop (core/estimated_run.h) from Python: the closed loop
-// with the traction plant, the seeded sensors and the controllers fed the truth, the encoder odometry or the
-// EKF's estimate, scored on the truth. Its blocks take the nodes' keys (plant_sim's traction/ and sensors/,
-// state_estimator's estimator/), checked by the same tables, so a key or a range reads as the node's.
+// sowing_robot.core.run_estimated: core::runEstimatedLoop (core/simulation/estimated_run.h) from Python: the closed
+// loop with the traction plant, the seeded sensors and the controllers fed the truth, the encoder odometry or the EKF's
+// estimate, scored on the truth. Its blocks take the nodes' keys (plant_sim's traction/ and sensors/, state_estimator's
+// estimator/), checked by the same tables, so a key or a range reads as the node's.
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "core_bindings.h"
-#include "sowing_robot/core/estimated_run.h"
+#include "sowing_robot/core/simulation/estimated_run.h"
 
 namespace py_core {
 namespace {

@@ -1,10 +1,10 @@
 #include "sowing_robot/ros/kinematic_controller.h"
 
-#include "sowing_robot/core/runner.h"
-#include "sowing_robot/core/validation.h"
-#include "sowing_robot/ros/component_params.h"
-#include "sowing_robot/ros/msg_checks.h"
-#include "sowing_robot/ros/reconfigure_bridge.h"
+#include "sowing_robot/core/common/validation.h"
+#include "sowing_robot/core/simulation/runner.h"
+#include "sowing_robot/ros/common/component_params.h"
+#include "sowing_robot/ros/common/msg_checks.h"
+#include "sowing_robot/ros/common/reconfigure_bridge.h"
 
 namespace sowing_robot {
 

@@ -12,8 +12,8 @@
 #include <fstream>
 #include <stdexcept>
 
-#include "sowing_robot/core/validation.h"
-#include "sowing_robot/ros/component_params.h"
+#include "sowing_robot/core/common/validation.h"
+#include "sowing_robot/ros/common/component_params.h"
 
 namespace sowing_robot {
 
@@ -37,7 +37,7 @@ std::string defaultOutput() {
 /// ~gains: a list of {name: str, lower: number, upper: number}. "" or one line naming the bad entry.
 std::string parseGains(const ros::NodeHandle& pnh, const core::Scenario& base, std::vector<core::GainBounds>& out) {
   const std::string full = pnh.resolveName("gains");
-  if (!pnh.hasParam("gains")) {  // every tunable gain of the pair, in its search bounds (core/tuning.h)
+  if (!pnh.hasParam("gains")) {  // every tunable gain of the pair, in its search bounds (core/evaluation/tuning.h)
     out = core::defaultGainBounds(base);
     return "";
   }

@@ -5,13 +5,13 @@
 #include <stdexcept>
 #include <string>
 
-#include "sowing_robot/core/seeding.h"
-#include "sowing_robot/core/validation.h"
-#include "sowing_robot/ros/component_params.h"
-#include "sowing_robot/ros/msg_checks.h"
-#include "sowing_robot/ros/node_failure.h"
-#include "sowing_robot/ros/reconfigure_bridge.h"
-#include "sowing_robot/ros/urdf_params.h"
+#include "sowing_robot/core/common/validation.h"
+#include "sowing_robot/core/planning/seeding.h"
+#include "sowing_robot/ros/common/component_params.h"
+#include "sowing_robot/ros/common/msg_checks.h"
+#include "sowing_robot/ros/common/node_failure.h"
+#include "sowing_robot/ros/common/reconfigure_bridge.h"
+#include "sowing_robot/ros/common/urdf_params.h"
 
 namespace sowing_robot {
 

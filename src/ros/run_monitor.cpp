@@ -5,12 +5,12 @@
 #include <cstdint>
 #include <cstdio>
 
-#include "sowing_robot/core/lockstep.h"
-#include "sowing_robot/core/runner.h"
-#include "sowing_robot/core/validation.h"
-#include "sowing_robot/ros/component_params.h"
-#include "sowing_robot/ros/failure_log.h"
-#include "sowing_robot/ros/msg_checks.h"
+#include "sowing_robot/core/common/validation.h"
+#include "sowing_robot/core/simulation/lockstep.h"
+#include "sowing_robot/core/simulation/runner.h"
+#include "sowing_robot/ros/common/component_params.h"
+#include "sowing_robot/ros/common/failure_log.h"
+#include "sowing_robot/ros/common/msg_checks.h"
 
 namespace sowing_robot {
 

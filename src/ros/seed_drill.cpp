@@ -6,10 +6,10 @@
 #include <cmath>
 #include <cstdio>
 
-#include "sowing_robot/core/trig.h"
-#include "sowing_robot/ros/component_params.h"
-#include "sowing_robot/ros/msg_checks.h"
-#include "sowing_robot/ros/urdf_params.h"
+#include "sowing_robot/core/numerics/trig.h"
+#include "sowing_robot/ros/common/component_params.h"
+#include "sowing_robot/ros/common/msg_checks.h"
+#include "sowing_robot/ros/common/urdf_params.h"
 
 namespace sowing_robot {
 

@@ -2,13 +2,13 @@
 
 #include <cmath>
 
-#include "sowing_robot/core/node_settings.h"
-#include "sowing_robot/core/trig.h"
-#include "sowing_robot/core/types.h"
-#include "sowing_robot/core/validation.h"
-#include "sowing_robot/ros/component_params.h"
-#include "sowing_robot/ros/msg_checks.h"
-#include "sowing_robot/ros/node_failure.h"
+#include "sowing_robot/core/common/types.h"
+#include "sowing_robot/core/common/validation.h"
+#include "sowing_robot/core/numerics/trig.h"
+#include "sowing_robot/core/settings/node_settings.h"
+#include "sowing_robot/ros/common/component_params.h"
+#include "sowing_robot/ros/common/msg_checks.h"
+#include "sowing_robot/ros/common/node_failure.h"
 
 namespace sowing_robot {
 namespace {
@@ -180,7 +180,7 @@ void StateEstimator::step(const nav_msgs::Odometry& odom, const sensor_msgs::Imu
     double s, c;
     core::sinCos(mid, s, c);
     in.distance = (b.x - a.x) * c + (b.y - a.y) * s;
-    in.covariance = increment_covariance_;  // the quantisation of the two encoders (core/ekf.h says why)
+    in.covariance = increment_covariance_;  // the quantisation of the two encoders (core/estimation/ekf.h says why)
     in.has_rate = imu.angular_velocity_covariance[0] >= 0.0;  // -1: no rate in this message
     in.rate = rate;
     in.rate_variance = knownVariance(imu.angular_velocity_covariance[8]);

@@ -11,7 +11,7 @@ def bits(metrics):
 
 
 def sec_of_ns(ns):
-    """ros::Time(ns).toSec(), as secondsFromNanos in core/types.h."""
+    """ros::Time(ns).toSec(), as secondsFromNanos in core/common/types.h."""
     return float(ns // 10**9) + 1e-9 * float(ns % 10**9)
 
 

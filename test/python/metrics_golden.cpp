@@ -23,8 +23,8 @@
 #include <vector>
 
 #include "golden_file.h"
-#include "sowing_robot/core/metrics.h"
-#include "sowing_robot/core/types.h"
+#include "sowing_robot/core/common/types.h"
+#include "sowing_robot/core/simulation/metrics.h"
 
 using namespace sowing_robot::core;
 

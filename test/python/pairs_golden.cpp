@@ -24,9 +24,9 @@
 #include <vector>
 
 #include "golden_file.h"
-#include "sowing_robot/core/reference.h"
-#include "sowing_robot/core/runner.h"
-#include "sowing_robot/core/tuning.h"
+#include "sowing_robot/core/common/reference.h"
+#include "sowing_robot/core/evaluation/tuning.h"
+#include "sowing_robot/core/simulation/runner.h"
 
 using namespace sowing_robot::core;
 

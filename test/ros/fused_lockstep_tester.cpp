@@ -1,6 +1,6 @@
 // rostest (fused_lockstep.test): the node pipeline in lockstep with feedback:=fused (plant_sim's sensors,
 // state_estimator, the controllers on odometry/filtered) against the in-process loop with the EKF in it
-// (core/estimated_run.h) on the same parameters, read from the nodes' own namespaces (the scenario and the
+// (core/simulation/estimated_run.h) on the same parameters, read from the nodes' own namespaces (the scenario and the
 // controller pair as pipeline_tester reads them; plant_sim's sensors/..., state_estimator's estimator/...).
 // Every period's true pose (ground_truth) and estimate (odometry/filtered) must equal the in-process ones
 // bit for bit. Fails without what it protects: an in-process loop that fed the controllers at another step,
@@ -14,11 +14,11 @@
 #include <cmath>
 #include <map>
 
-#include "sowing_robot/core/estimated_run.h"
-#include "sowing_robot/core/validation.h"
-#include "sowing_robot/ros/component_params.h"
-#include "sowing_robot/ros/msg_checks.h"
-#include "sowing_robot/ros/param_reader.h"
+#include "sowing_robot/core/common/validation.h"
+#include "sowing_robot/core/simulation/estimated_run.h"
+#include "sowing_robot/ros/common/component_params.h"
+#include "sowing_robot/ros/common/msg_checks.h"
+#include "sowing_robot/ros/common/param_reader.h"
 
 using namespace sowing_robot;
 

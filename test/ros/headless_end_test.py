@@ -40,7 +40,7 @@ class HeadlessEnd(unittest.TestCase):
     def test_normal_end(self):
         self.check_normal_end(11671)
 
-    # Hung 1 in ~10 under load before plant_sim waited for every node by name (ros/ready_roster.h): a
+    # Hung 1 in ~10 under load before plant_sim waited for every node by name (ros/common/ready_roster.h): a
     # 25 s line run could end before run_monitor had loaded into the manager.
     def test_normal_end_nodelets(self):
         self.check_normal_end(11672, "nodelets:=true")

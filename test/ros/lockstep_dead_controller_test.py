@@ -17,7 +17,7 @@ every lockstep_timeout wall seconds it says what it is waiting for.
   number of wheel_torque publishers (0); after lockstep_give_up wall seconds it exits 3 with a FATAL line
   naming the missing input (a third plant_sim in /given_up, with a 3 s limit).
 
-Protections checked (PlantSim::runLockstep, src/ros/plant_sim.cpp): the "lockstep stalled" ROS_ERROR in
+Protections checked (PlantSim::runLockstep, src/ros/plant_sim/plant_sim.cpp): the "lockstep stalled" ROS_ERROR in
 the wait for a torque, the re-publication of the stalled state, and the "lockstep waiting for the loop"
 ROS_WARN before step 0, and the give-up (exit 3); the protocol itself is core::LockstepProtocol.
 And ReferenceGenerator::replayTo (src/ros/reference_generator.cpp), and the controllers' lockstep wait

@@ -100,7 +100,7 @@ class NodeletForms(unittest.TestCase):
     # Found by this test: the forms once differed in one fix-gate decision (12 fixes gated as nodelets, 11 as
     # processes): the fix came on a connection of its own, and whether it came before the estimate passed
     # its stamp + fix/delay depended on the threads. state_estimator now keeps the plant's fix schedule
-    # (fix_source, core/fix_await.h) and holds a step until the fixes due by it have come.
+    # (fix_source, core/estimation/fix_await.h) and holds a step until the fixes due by it have come.
     def test_traction_fused(self):
         self.check_traction_acted(self.check_forms_agree((11683, 11684), "feedback:=fused"))
 

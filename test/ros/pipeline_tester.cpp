@@ -10,8 +10,8 @@
 #include <cmath>
 
 #include "sowing_robot/TrackingError.h"
-#include "sowing_robot/core/runner.h"
-#include "sowing_robot/ros/component_params.h"
+#include "sowing_robot/core/simulation/runner.h"
+#include "sowing_robot/ros/common/component_params.h"
 
 using namespace sowing_robot;
 

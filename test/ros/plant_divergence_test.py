@@ -5,7 +5,7 @@ saying the state diverged, exit code 2, and no diverged state ever published on 
 As a nodelet the same divergence must stop that run only: one FATAL line, no more states, and the
 manager with its other nodelets (here a second plant_sim) running on.
 
-Protection checked: SimulatedPlant::step() (src/ros/plant_sim_plant.cpp), the |v| > max_speed /
+Protection checked: SimulatedPlant::step() (src/ros/plant_sim/simulated_plant.cpp), the |v| > max_speed /
 non-finite check after every step, whose failure run() throws as a NodeFailure (kDiverged) that
 plant_sim's main turns into exit 2 and PlantSimNodelet into a stopped run. plant_sim does not clip
 incoming torques (max_torque is the torque controller's limit), so a finite torque can drive the state

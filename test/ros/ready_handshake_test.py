@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """rostest: plant_sim takes step 0 only when every node of its wait_for list has announced itself on the
-latched topic /ready (ros/ready_roster.h), however long that takes, and says whom it waits for.
+latched topic /ready (ros/common/ready_roster.h), however long that takes, and says whom it waits for.
 
 The fixture's plant_sim waits for the three loop nodes and for "ghost", a name only this test announces.
 While ghost is missing the loop is complete by subscriber counts, so without the roster the plant would

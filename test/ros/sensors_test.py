@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """rostest (sensors.test): a lockstep run with the controllers fed by the wheel encoders' odom.
 Checks, per stamp: the run reaches its end; odom differs from ground_truth (tick quantisation), but by no
-more than the quantisation bound of core/sensors.h (heading R res / L, position R res + distance R res / L);
+more than the quantisation bound of core/model/sensors.h (heading R res / L, position R res + distance R res / L);
 imu comes every step with its bias; every fix is stamped on the 1/rate grid with the true position AT ITS
 STAMP (not at its arrival, latency later), the last one sent is the one stamped duration - latency (the later
 ones are still in flight when the run ends), and none is stamped in the dropout window.

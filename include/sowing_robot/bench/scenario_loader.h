@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "sowing_robot/core/benchmark.h"
-#include "sowing_robot/core/runner.h"
+#include "sowing_robot/core/evaluation/benchmark.h"
+#include "sowing_robot/core/simulation/runner.h"
 
 namespace sowing_robot {
 namespace bench {

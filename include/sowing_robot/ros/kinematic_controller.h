@@ -1,6 +1,6 @@
 // kinematic_controller: reference + odom -> desired body velocities and the tracking error for plotting
 // and metrics. The outer controller is chosen by `outer`: Kanayama (eqs 4.1-4.2), pure pursuit or nav2's
-// Regulated Pure Pursuit (core/pure_pursuit.h), each live-tunable by dynamic_reconfigure
+// Regulated Pure Pursuit (core/control/pure_pursuit.h), each live-tunable by dynamic_reconfigure
 // (cfg/KinematicController.cfg, cfg/PurePursuit.cfg: the server of the controller in use).
 #pragma once
 
@@ -8,7 +8,7 @@
 
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
-#include "sowing_robot/ros/reconfigure_bridge.h"
+#include "sowing_robot/ros/common/reconfigure_bridge.h"
 
 #include <memory>
 
@@ -17,11 +17,11 @@
 #include "sowing_robot/PurePursuitConfig.h"
 #include "sowing_robot/ReferenceState.h"
 #include "sowing_robot/TrackingError.h"
-#include "sowing_robot/core/controllers.h"
-#include "sowing_robot/core/kanayama.h"
-#include "sowing_robot/core/pure_pursuit.h"
-#include "sowing_robot/ros/ready_roster.h"
-#include "sowing_robot/ros/stamp_pair.h"
+#include "sowing_robot/core/control/controllers.h"
+#include "sowing_robot/core/control/kanayama.h"
+#include "sowing_robot/core/control/pure_pursuit.h"
+#include "sowing_robot/ros/common/ready_roster.h"
+#include "sowing_robot/ros/common/stamp_pair.h"
 
 namespace sowing_robot {
 

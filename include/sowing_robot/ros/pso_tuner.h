@@ -10,10 +10,10 @@
 #include <string>
 #include <vector>
 
-#include "sowing_robot/core/pso.h"
-#include "sowing_robot/core/reference.h"
-#include "sowing_robot/core/runner.h"
-#include "sowing_robot/core/tuning.h"
+#include "sowing_robot/core/common/reference.h"
+#include "sowing_robot/core/evaluation/pso.h"
+#include "sowing_robot/core/evaluation/tuning.h"
+#include "sowing_robot/core/simulation/runner.h"
 
 namespace sowing_robot {
 

@@ -16,7 +16,7 @@
 #include <ros/ros.h>
 #include <rosgraph_msgs/Clock.h>
 #include <visualization_msgs/MarkerArray.h>
-#include "sowing_robot/ros/reconfigure_bridge.h"
+#include "sowing_robot/ros/common/reconfigure_bridge.h"
 
 #include <cstdint>
 #include <deque>
@@ -26,10 +26,10 @@
 #include "sowing_robot/FieldPlan.h"
 #include "sowing_robot/ReferenceGeneratorConfig.h"
 #include "sowing_robot/ReferenceState.h"
-#include "sowing_robot/core/field.h"
-#include "sowing_robot/core/reference.h"
-#include "sowing_robot/ros/path_buffer.h"
-#include "sowing_robot/ros/ready_roster.h"
+#include "sowing_robot/core/common/reference.h"
+#include "sowing_robot/core/planning/field.h"
+#include "sowing_robot/ros/common/path_buffer.h"
+#include "sowing_robot/ros/common/ready_roster.h"
 
 namespace sowing_robot {
 

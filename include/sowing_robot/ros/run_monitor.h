@@ -18,10 +18,10 @@
 #include <thread>
 
 #include "sowing_robot/ReferenceState.h"
-#include "sowing_robot/core/metrics.h"
-#include "sowing_robot/ros/node_failure.h"
-#include "sowing_robot/ros/ready_roster.h"
-#include "sowing_robot/ros/stamp_pair.h"
+#include "sowing_robot/core/simulation/metrics.h"
+#include "sowing_robot/ros/common/node_failure.h"
+#include "sowing_robot/ros/common/ready_roster.h"
+#include "sowing_robot/ros/common/stamp_pair.h"
 
 namespace sowing_robot {
 

@@ -12,10 +12,10 @@
 
 #include "sowing_robot/FieldPlan.h"
 #include "sowing_robot/ReferenceState.h"
-#include "sowing_robot/core/node_settings.h"
-#include "sowing_robot/core/seeding.h"
-#include "sowing_robot/ros/ready_roster.h"
-#include "sowing_robot/ros/stamp_pair.h"
+#include "sowing_robot/core/planning/seeding.h"
+#include "sowing_robot/core/settings/node_settings.h"
+#include "sowing_robot/ros/common/ready_roster.h"
+#include "sowing_robot/ros/common/stamp_pair.h"
 
 namespace sowing_robot {
 

@@ -1,8 +1,8 @@
-// state_estimator: the EKF of core/ekf.h between the sensors and the controllers (feedback:=fused).
+// state_estimator: the EKF of core/estimation/ekf.h between the sensors and the controllers (feedback:=fused).
 // odom (encoder dead reckoning) + imu (yaw rate) paired by stamp -> one odometry/filtered per odom
 // stamp; fix (late position fixes) applied at their measurement stamp once the estimate is
 // estimator/fix/delay newer, so which fixes an estimate holds depends on stamps only (repeatable runs).
-// In lockstep with fix_source set, a step waits for the fixes due by it (core/fix_await.h).
+// In lockstep with fix_source set, a step waits for the fixes due by it (core/estimation/fix_await.h).
 #pragma once
 
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
@@ -13,10 +13,10 @@
 #include <deque>
 #include <memory>
 
-#include "sowing_robot/core/ekf.h"
-#include "sowing_robot/core/fix_await.h"
-#include "sowing_robot/ros/ready_roster.h"
-#include "sowing_robot/ros/stamp_pair.h"
+#include "sowing_robot/core/estimation/ekf.h"
+#include "sowing_robot/core/estimation/fix_await.h"
+#include "sowing_robot/ros/common/ready_roster.h"
+#include "sowing_robot/ros/common/stamp_pair.h"
 
 namespace sowing_robot {
 

@@ -1,16 +1,16 @@
 // torque_controller: desired + measured velocities -> wheel torques. The inner controller is chosen by
 // `inner`: the sliding-mode controller (eqs 4.7-4.22; `mode` atsmc or tsmc) or the wheel-velocity PID
-// (core/wheel_pid.h), each with its gains live-tunable by dynamic_reconfigure (cfg/TorqueController.cfg,
+// (core/control/wheel_pid.h), each with its gains live-tunable by dynamic_reconfigure (cfg/TorqueController.cfg,
 // cfg/WheelPid.cfg: the server of the controller in use). Publishes its state on ~state: the
 // sliding variables and adaptive estimates, or for the PID the same record with s_v = s_omega = 0 and
-// the nominal m0, I0 (core/controllers.h, InnerOutput).
+// the nominal m0, I0 (core/control/controllers.h, InnerOutput).
 #pragma once
 
 #include <dynamic_reconfigure/server.h>
 
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
-#include "sowing_robot/ros/reconfigure_bridge.h"
+#include "sowing_robot/ros/common/reconfigure_bridge.h"
 
 #include <memory>
 
@@ -19,10 +19,10 @@
 #include "sowing_robot/TorqueControllerState.h"
 #include "sowing_robot/WheelPidConfig.h"
 #include "sowing_robot/WheelTorque.h"
-#include "sowing_robot/core/controllers.h"
-#include "sowing_robot/core/sliding_mode.h"
-#include "sowing_robot/ros/ready_roster.h"
-#include "sowing_robot/ros/stamp_pair.h"
+#include "sowing_robot/core/control/controllers.h"
+#include "sowing_robot/core/control/sliding_mode.h"
+#include "sowing_robot/ros/common/ready_roster.h"
+#include "sowing_robot/ros/common/stamp_pair.h"
 
 namespace sowing_robot {
 

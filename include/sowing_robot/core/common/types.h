@@ -1,0 +1,76 @@
+// Plain data passed between the core blocks (and mirrored one-to-one by the ROS messages).
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include "sowing_robot/core/numerics/trig.h"
+
+namespace sowing_robot {
+namespace core {
+
+/// Planar posture of the axle midpoint [m, m, rad].
+struct Pose2D {
+  double x = 0.0, y = 0.0, theta = 0.0;
+};
+
+/// Reference posture with the velocities and accelerations the controllers need.
+struct Reference {
+  Pose2D pose;
+  double v = 0.0;          ///< [m/s]
+  double omega = 0.0;      ///< [rad/s]
+  double v_dot = 0.0;      ///< [m/s^2]
+  double omega_dot = 0.0;  ///< [rad/s^2]
+  bool tool_down = true;   ///< on a sowing row
+};
+
+/// Output of the kinematic controller.
+struct VelocityCommand {
+  double v = 0.0, omega = 0.0;          ///< [m/s], [rad/s]
+  double v_dot = 0.0, omega_dot = 0.0;  ///< [m/s^2], [rad/s^2]
+};
+
+/// Wheel torques [N·m].
+struct WheelTorques {
+  double right = 0.0, left = 0.0;
+};
+
+/// Wrap an angle to (-pi, pi].
+inline double wrapAngle(double a) {
+  if (a > -M_PI && a <= M_PI) return a;  // what remainder() returns here anyway, without its cost
+  a = std::remainder(a, 2.0 * M_PI);
+  return a <= -M_PI ? a + 2.0 * M_PI : a;
+}
+
+/// Seconds of a nanosecond count, computed exactly as ros::Time::toSec() does, so that the in-process
+/// runner and the node pipeline see bit-identical times.
+inline double secondsFromNanos(std::int64_t ns) {
+  return static_cast<double>(ns / 1000000000) + 1e-9 * static_cast<double>(ns % 1000000000);
+}
+
+/// The yaw that survives a trip through a geometry_msgs quaternion (z = sin(t/2), w = cos(t/2)) and
+/// back, so that the runner sees what the nodes see in nav_msgs/Odometry.
+inline double yawThroughQuaternion(double theta) {
+  double z, w;
+  sinCos(0.5 * theta, z, w);
+  return std::atan2(2.0 * w * z, 1.0 - 2.0 * z * z);
+}
+
+#if defined(__SSE2__)
+/// yawThroughQuaternion of two headings, the sin/cos and products in two lanes: each the scalar's bits.
+inline void yawsThroughQuaternion(double theta_a, double theta_b, double& yaw_a, double& yaw_b) {
+  Lanes2 z, w;
+  sinCos(Lanes2(0.5 * theta_a, 0.5 * theta_b), z, w);
+  const Lanes2 y = Lanes2(2.0) * w * z, x = Lanes2(1.0) - Lanes2(2.0) * z * z;
+  yaw_a = std::atan2(y.first(), x.first());
+  yaw_b = std::atan2(y.second(), x.second());
+}
+#endif
+
+/// True when every argument is a finite number.
+template <typename... T>
+bool allFinite(T... v) {
+  return (std::isfinite(v) && ...);
+}
+
+}  // namespace core
+}  // namespace sowing_robot

@@ -1,0 +1,212 @@
+// A field of parallel rows driven in alternating directions and chained by headland U-turns, as a
+// target for the potential field (so obstacles on the rows are avoided and every quantity the
+// controllers need stays continuous).
+//
+// Geometry: row i runs from start_i to start_i + row_length u_i with u_i = +-(cos heading, sin heading)
+// (even rows along the heading, odd rows back); start_{i+1} is start_i's end moved by row_spacing
+// sideways. The headland turns are curvature-continuous: the curvature goes through cosine ramps
+// (|dkappa/ds| <= max_curvature_rate) and holds, and its profile is symmetric, so a turn ends exactly
+// row_spacing to the side at the same along-row position, heading reversed:
+//   * wide enough (spacing large against min_turn_radius): 0 -> kappa -> 0, a "rounded semicircle";
+//   * too narrow: a bulb (Omega) turn 0 -> -lambda kappa_max -> kappa_max -> -lambda kappa_max -> 0,
+//     first swinging away from the next row, with lambda in (0, 1] and, if needed, arcs at -kappa_max.
+// Speed: row_speed on the rows, turn_speed on the turns; every change is a half-cosine speed ramp
+// (|v_dot| <= max_accel, v_dot continuous) done on the row, so the turn is entered at turn_speed.
+// The last row ends at rest.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "sowing_robot/core/common/reference.h"
+#include "sowing_robot/core/common/types.h"
+#include "sowing_robot/core/planning/approach.h"
+#include "sowing_robot/core/planning/detour.h"
+#include "sowing_robot/core/planning/potential_field.h"
+
+namespace sowing_robot {
+namespace core {
+
+/// Defaults, ranges, units and meanings: fieldTable() (keys field/... and potential/...).
+struct FieldParams {
+  FieldParams();
+  int rows;                 ///< number of rows N, >= 1
+  double row_length;        ///< [m], > 0
+  double row_spacing;       ///< distance between neighbouring rows [m], > 0
+  double start_x, start_y;  ///< start of the first row [m] (thesis: (0, 3))
+  double heading;           ///< direction of the first row [rad]
+  bool rows_to_left;        ///< the second row lies left of the first one's direction
+  double row_speed;         ///< v_r [m/s], > 0
+  double turn_speed;        ///< speed on the headland turns [m/s], in (0, row_speed]
+  double min_turn_radius;   ///< the turns keep |kappa| <= 1/min_turn_radius [m], > 0
+  double max_accel;         ///< peak |v_dot| of the speed ramps [m/s^2], > 0
+  /// Peak |dkappa/ds| in the turns [1/m^2]; must be >= 1/(2 min_turn_radius^2) so a ramp to the
+  /// largest curvature fits in a half turn.
+  double max_curvature_rate;
+  bool start_from_rest;  ///< false: the path starts at row_speed (as the thesis line)
+  /// With a start_pose and avoidance.plan_detours: the path starts at the robot, on an approach that
+  /// joins the first row within the detours' bounds (approach.h); false: it starts at the row start.
+  bool approach;
+  double approach_settle;  ///< the tool stays up this far past the approach's join [m], >= 0
+  /// The robot's start pose [m, m, rad]. Not a parameter: the caller sets it (the node from plant_sim's
+  /// start/{x, y, theta}, as avoidance.footprint_radius from the URDF). Unset: no approach.
+  std::optional<Pose2D> start_pose;
+  PotentialFieldParams potential;  ///< alpha, beta, repulsion (see PotentialField)
+  AvoidanceParams avoidance;       ///< planned detours around the inflated obstacles (detour.h)
+  std::string validate() const;
+};
+/// field/{rows, row_length, row_spacing, start_x, start_y, heading, rows_to_left, row_speed, turn_speed,
+/// min_turn_radius, max_accel, max_curvature_rate, start_from_rest, approach, approach_settle} and potential/...
+/// (potentialFieldTable()).
+const ParamTable<FieldParams>& fieldTable();
+
+/// One headland U-turn in a local frame: starts at the origin heading along +x, turns left and ends at
+/// (0, width) heading along -x. Built once; evaluation does not allocate.
+class HeadlandTurn {
+ public:
+  HeadlandTurn() = default;
+  /// Throws std::invalid_argument if no turn fits (validate FieldParams first).
+  HeadlandTurn(double width, double max_curvature, double max_curvature_rate);
+
+  double length() const { return length_; }                 ///< arc length [m]
+  double peakCurvature() const { return peak_curvature_; }  ///< max |kappa| [1/m]
+  bool isBulb() const { return bulb_; }                     ///< true for an Omega turn (swings away first)
+  /// Position [m], heading [rad], curvature [1/m] and dkappa/ds [1/m^2] at arc length s (clamped).
+  void evaluate(double s, Eigen::Vector2d& p, double& theta, double& kappa, double& dkappa) const;
+
+ private:
+  struct Segment {
+    double s0 = 0.0, length = 0.0;  ///< start and length along the turn [m]
+    double k0 = 0.0, k1 = 0.0;      ///< curvature at start and end (a cosine ramp if they differ) [1/m]
+    double theta0 = 0.0;            ///< heading at the start [rad]
+    double node_step = 0.0;         ///< spacing of the stored positions [m]
+    std::size_t first_node = 0;     ///< index of its first stored position
+    int nodes = 0;                  ///< stored positions inside it (its start included)
+  };
+  /// Curvature levels 0 -> -lambda k -> k -> -lambda k -> 0 holding -lambda k for `away` [m];
+  /// false if the heading cannot add up to pi.
+  bool build(double k, double lambda, double away, double rate);
+  static void segmentState(const Segment& g, double tau, double& theta, double& kappa, double& dkappa);
+  static Eigen::Vector2d integrate(const Segment& g, double a, double b);  ///< int_a^b (cos, sin) theta
+
+  std::vector<Segment> segments_;
+  std::vector<Eigen::Vector2d> nodes_;
+  Eigen::Vector2d end_ = Eigen::Vector2d::Zero();
+  double length_ = 0.0, peak_curvature_ = 0.0;
+  bool bulb_ = false;
+};
+
+/// The whole field as a target trajectory (rows, turns and the speed profile); a pure function of t.
+/// With obstacles and avoidance.plan_detours, the rows carry planned detours (detour.h) driven at their
+/// detour speed, and the path ends early, at rest, before a group it cannot pass. With a plan, approach
+/// and a start_pose off the row start, the path begins at that pose on an approach (tool up) that joins
+/// the first row; the part of the row before the join is not driven.
+class FieldPath : public TargetTrajectory {
+ public:
+  /// Throws std::invalid_argument on invalid parameters or obstacles.
+  explicit FieldPath(const FieldParams& params, const std::vector<Obstacle>& obstacles = {});
+  TargetState at(double t) const override;
+  std::unique_ptr<TargetTrajectory> clone() const override { return std::make_unique<FieldPath>(*this); }
+
+  double duration() const { return duration_; }    ///< time at which the target stops [s]
+  double length() const { return total_length_; }  ///< path length [m]
+  const HeadlandTurn& turn() const { return turn_; }
+  /// True when the path at time t is on a headland turn (tool up).
+  bool onTurn(double t) const;
+  /// Start point of row i [m].
+  Eigen::Vector2d rowStart(int i) const;
+  /// The plan: its status and its detours (empty without obstacles or with plan_detours false).
+  const AvoidanceStatus& status() const { return status_; }
+  const std::vector<Detour>& detours() const { return detours_; }
+  /// True when the path starts on an approach; approach().why says why a needed one did not fit (the
+  /// path then starts at the row start and status().within_bounds is false).
+  bool hasApproach() const { return has_approach_; }
+  const ApproachPlan& approach() const { return approach_; }
+
+ private:
+  struct Element {
+    double s0 = 0.0, length = 0.0;
+    std::size_t detour_first = 0, detour_count = 0;  ///< its detours in detours_ (rows only)
+    bool turn = false;
+    bool approach = false;   ///< the approach from the start pose (tool up)
+    double along0 = 0.0;     ///< along-row position where a row's driven part starts (the join) [m]
+    double tool_from = 0.0;  ///< along-row position from which the tool may go down (join + settle) [m]
+    Eigen::Vector2d p0 = Eigen::Vector2d::Zero();
+    double heading = 0.0;  ///< direction at the start [rad]
+    double side = 1.0;     ///< +1 left turn, -1 right turn
+  };
+  /// From t0: s0 + v0 tau (+ half-cosine ramp to v1 over `duration` when v1 != v0).
+  struct Phase {
+    double t0 = 0.0, s0 = 0.0, duration = 0.0, v0 = 0.0, v1 = 0.0;
+  };
+  void addPhase(double distance, double v0, double v1);
+  /// Plans approach_ from params_.start_pose to `row` (the first, planned); v_out: its end speed.
+  void planApproach(const Element& row, double v_out, const std::vector<Obstacle>& obstacles);
+  /// Speed phases of one row of `length` from v_in to v_out through its detours' speed windows.
+  /// An approach of length `lead` (driven at lead_speed after its start ramp) comes first when lead > 0.
+  void addRowPhases(double length, double v_in, double v_out, const Element& row, double lead = 0.0,
+                    double lead_speed = 0.0);
+  void arcLength(double t, double& s, double& sd, double& sdd, double& sddd) const;
+
+  FieldParams params_;
+  HeadlandTurn turn_;
+  std::vector<Element> elements_;
+  std::vector<Phase> phases_;
+  std::vector<Detour> detours_;
+  AvoidanceStatus status_;
+  ApproachPlan approach_;
+  bool has_approach_ = false;
+  double duration_ = 0.0, total_length_ = 0.0;
+};
+
+/// Reference for a whole field: PotentialField tracking of a FieldPath.
+class FieldReference : public ReferenceSource {
+ public:
+  /// Throws std::invalid_argument on invalid parameters or obstacles. With avoidance.plan_detours the
+  /// path is planned around the obstacles (FieldPath) and the repulsion gets repulsionObstacles().
+  explicit FieldReference(const FieldParams& params, std::vector<Obstacle> obstacles = {});
+
+  std::unique_ptr<ReferenceSource> clone() const override;
+
+  /// True once the path has ended (t >= duration()); the reference then stops at the last row's end.
+  bool finished(double t) const { return t >= duration_; }
+  double duration() const { return duration_; }  ///< [s]
+
+  /// Replace the obstacles at run time (throws std::invalid_argument, keeping the old ones). With a plan,
+  /// the path is re-planned as if the new list had been known from the start; the reference point and
+  /// its velocity are kept, so where the new plan differs from the old one at the current time (the
+  /// obstacle came too close ahead to plan for) the potential field pulls the reference onto it and
+  /// status().within_bounds turns false.
+  void setObstacles(std::vector<Obstacle> obstacles);
+  /// The obstacles as given (not inflated).
+  const std::vector<Obstacle>& obstacles() const { return obstacles_; }
+  /// The plan's status: the node logs it and publishes it (a stop, no safe way, bounds not held).
+  const AvoidanceStatus& status() const { return status_; }
+  /// See PotentialField::setGains.
+  void setGains(double alpha, double beta, double gain, double tangential_ratio) {
+    field_.setGains(alpha, beta, gain, tangential_ratio);
+  }
+  const PotentialField& potentialField() const { return field_; }
+  const FieldPath& path() const { return static_cast<const FieldPath&>(field_.target()); }
+  const FieldParams& params() const { return params_; }
+
+ protected:
+  void restart() override { field_.reset(); }
+  /// Reference at t; tool_down = true on rows, false on turns and once finished.
+  Reference evaluate(double t) override { return field_.next(t); }
+
+ private:
+  FieldParams params_;
+  std::vector<Obstacle> obstacles_;
+  PotentialField field_;
+  double duration_ = 0.0;
+  AvoidanceStatus status_;
+};
+
+}  // namespace core
+}  // namespace sowing_robot

@@ -1,0 +1,102 @@
+// The in-process closed loop with an estimate in the loop (issue 16's missing piece): the plant (the
+// no-slip Plant, or the TractionPlant with soil patches and the tool's draft), the seeded sensors
+// (sensors.h), and a feedback mode: the controllers are fed the truth, the encoder odometry, or the EKF's
+// estimate (ekf.h), while the metrics are taken on the TRUTH (as run_monitor scores ground_truth in the
+// node pipeline).
+//
+// The order of operations mirrors the node pipeline in lockstep (sim.launch feedback:=..., traction:=...),
+// so that the two give the same numbers:
+//   period k, t_k = k * period (stamp grid, secondsFromNanos as ros::Time::toSec):
+//     plant_sim publishes ground_truth (the state), odom (the encoders' last update), imu (the yaw rate
+//       measured at the last update) and the fixes delivered by t_k (PositionFixSensor::due);
+//     state_estimator (fused): pushes the fixes into its FixQueue (estimator/fix/delay), then at the first
+//       period resets the EKF at the odometry's pose, later predicts over the increments that turn the
+//       previous odometry pose into this one (the poses through the quaternion round trip, as poseOf reads
+//       them) with the yaw rate and encoderIncrementCovariance(), then fuses the queue's due fixes;
+//     the outer and inner controllers get the fed pose (through the quaternion) and its twist: truth (v,
+//       omega of the state), odometry (the encoders' windowed v, omega), fused (the encoders' v and the
+//       gyro's rate less the estimated bias);
+//     the tool rule (traction with a draft) sees the true tool point; the plant steps; the sensors
+//       update on the new state at t_{k+1} (encoders, yaw rate, fix sampling), as SimulatedPlant::step.
+// With feedback ground_truth the sensors still run (their output unused), so a run's numbers do not
+// depend on it; the controllers then see exactly what runClosedLoop's see (test_estimated_run: equal bit
+// for bit to runClosedLoop, and to runTractionClosedLoop with the traction plant at phase 0).
+//
+// One loop over both plants (a template in estimated_run.cpp) replaces neither runClosedLoop (its hot
+// path stays as it is) nor runTractionClosedLoop (kept for its callers); both are its special cases.
+#pragma once
+
+#include <Eigen/Core>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "sowing_robot/core/estimation/ekf.h"
+#include "sowing_robot/core/model/sensors.h"
+#include "sowing_robot/core/model/soil_map.h"
+#include "sowing_robot/core/model/traction.h"
+#include "sowing_robot/core/planning/seeding.h"
+#include "sowing_robot/core/simulation/runner.h"
+
+namespace sowing_robot {
+namespace core {
+
+/// What the controllers close the loop on (sim.launch feedback:=).
+enum class Feedback { ground_truth, odometry, fused };
+/// "ground_truth", "odometry", "fused".
+const char* feedbackName(Feedback f);
+/// Parses a name; "" on success, else one line naming the allowed ones.
+std::string parseFeedback(const std::string& name, Feedback& out);
+
+/// Everything the estimated loop adds to a Scenario.
+struct EstimatedRunConfig {
+  Feedback feedback = Feedback::ground_truth;
+  /// Set: the traction plant with these parameters (its `enabled` is not looked at); unset: the no-slip Plant.
+  std::optional<TractionParams> traction;
+  std::vector<SoilPatch> patches;    ///< traction only
+  Eigen::Vector2d tool{-0.45, 0.0};  ///< the tool point in base_link (the URDF's tool_link) [m]
+  /// The rows the plant's tool rule (tool_engagement.h) lowers the tool on while traction->draft_force > 0.
+  std::vector<RowSegment> tool_rows;
+  bool tool_rows_open_ended = false;
+  SeedingParams seeding;  ///< the tool rule's parameters (detour_margin as config/seed_drill.yaml: 4 m)
+  SensorParams sensors;   ///< sensors.yaml defaults
+  EkfParams estimator;    ///< estimator.yaml defaults (feedback fused)
+
+  /// "" or the first bad parameter as one line naming its key.
+  std::string validate() const;
+};
+
+/// One period as the estimated loop sees it: the LoopSample on the truth (errors against the truth), and
+/// what the controllers were fed.
+struct EstimatedSample {
+  const LoopSample* loop;
+  Pose2D fed;               ///< the pose the controllers got (truth, odometry or estimate), yaw through the quaternion
+  double fed_v, fed_omega;  ///< the twist they got
+  double slip_right = 0.0, slip_left = 0.0;  ///< traction: the wheels' slip ratios at this state
+  bool tool_down = false;                    ///< traction with a draft: the tool is down over the next step
+};
+
+struct EstimatedRunResult {
+  RunResult run;                ///< metrics on the truth
+  double max_abs_slip = 0.0;    ///< traction: largest |slip ratio| of either wheel after a step
+  double tool_down_time = 0.0;  ///< traction with a draft: time the tool was down [s]
+  /// Position error of the fed pose against the truth over the periods run [m] (0 for ground_truth).
+  double fed_error_rms = 0.0, fed_error_max = 0.0;
+  /// Heading error of the fed pose [rad], largest |.| over the run.
+  double fed_heading_error_max = 0.0;
+  /// Position error of the encoder odometry alone [m] at the end and its largest (any feedback).
+  double odometry_error_final = 0.0, odometry_error_max = 0.0;
+  FixCounts fixes;  ///< fused: what happened to the fixes
+  long fixes_lost_from_queue = 0;
+};
+
+/// Runs the scenario (plant, timing, start, disturbance incl. its phase, the outer/inner pair of
+/// scenario.outer/inner with their gains) with `config`'s plant, sensors and feedback on `reference`.
+/// trace (optional) sees every period. Throws std::invalid_argument when a parameter set does not validate.
+EstimatedRunResult runEstimatedLoop(const Scenario& scenario, const EstimatedRunConfig& config,
+                                    ReferenceSource& reference, bool keep_samples = true,
+                                    const std::function<void(const EstimatedSample&)>& trace = {});
+
+}  // namespace core
+}  // namespace sowing_robot

@@ -1,0 +1,501 @@
+#include "sowing_robot/core/evaluation/benchmark.h"
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <limits>
+#include <memory>
+#include <mutex>
+#include <stdexcept>
+#include <thread>
+
+#include "sowing_robot/core/common/validation.h"
+#include "sowing_robot/core/evaluation/bench_row.h"
+#include "sowing_robot/core/evaluation/estimated_bench.h"
+
+namespace sowing_robot {
+namespace core {
+
+namespace {
+
+std::uint64_t splitmix64(std::uint64_t x) {
+  x += 0x9e3779b97f4a7c15ULL;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
+  return x ^ (x >> 31);
+}
+
+/// Draw k of run `index`, in [0, 1) with 53 bits.
+double unit(std::uint64_t base_seed, std::int64_t index, int k) {
+  const std::uint64_t run = splitmix64(splitmix64(base_seed) + static_cast<std::uint64_t>(index));
+  return static_cast<double>(splitmix64(run + static_cast<std::uint64_t>(k)) >> 11) * 0x1.0p-53;
+}
+
+std::string checkUniform(const char* name, const Uniform& u) {
+  if (!allFinite(u.lo, u.hi)) return std::string(name) + " bounds must be finite";
+  if (u.lo > u.hi) return std::string(name) + ": lo " + formatNumber(u.lo) + " > hi " + formatNumber(u.hi);
+  return "";
+}
+
+RunRow measure(const Scenario& sc, ReferenceSource& reference, const MonteCarloSpec& spec, const RunDraw& draw,
+               const RunExtras& extras = {}) {
+  RunRow row;
+  row.draw = draw;
+  RowMeter meter(row, sc, spec, extras);
+  // Without a body or a last reference to follow, the row's per-period figures are a RunTally the loop
+  // adds up itself (no callback per period); the same numbers either way.
+  const RunResult r = meter.needsEveryPeriod()
+                          ? runClosedLoop(sc, reference, true, [&](const LoopSample& s) { meter.add(s); })
+                          : runClosedLoop(sc, reference, true, meter.tally());
+  meter.finish(r);
+  return row;
+}
+
+/// measure() of two runs at once (runClosedLoopPair): the same two rows. Runs whose meters need every
+/// period (a body, a last reference) are measured one after the other.
+void measurePair(const Scenario& sa, ReferenceSource& ra, const RunDraw& da, RunRow& row_a, const Scenario& sb,
+                 ReferenceSource& rb, const RunDraw& db, RunRow& row_b, const MonteCarloSpec& spec,
+                 const RunExtras& extras) {
+  if (extras.contacts != nullptr || extras.last_reference != nullptr) {
+    row_a = measure(sa, ra, spec, da, extras);
+    row_b = measure(sb, rb, spec, db, extras);
+    return;
+  }
+  row_a.draw = da;
+  row_b.draw = db;
+  RowMeter meter_a(row_a, sa, spec, extras), meter_b(row_b, sb, spec, extras);
+  const std::array<RunResult, 2> r = runClosedLoopPair(sa, ra, meter_a.tally(), sb, rb, meter_b.tally(), true);
+  meter_a.finish(r[0]);
+  meter_b.finish(r[1]);
+}
+
+/// A parallelRows worker for seeded runs of `base`: runs i and i + 1 of a batch in lockstep (measurePair),
+/// each on its own clone of `reference`; a batch of one run alone (measure). Either way a row is its run's.
+auto pairedRuns(const Scenario& base, const MonteCarloSpec& spec, const ReferenceSource& reference,
+                const RunExtras& extras) {
+  std::shared_ptr<ReferenceSource> ref_a = reference.clone(), ref_b = reference.clone();
+  return [&base, &spec, ref_a, ref_b, extras](std::int64_t i, int count, RunRow* rows) {
+    const RunDraw draw_a = drawRun(spec, base, i);
+    if (count == 1) {
+      rows[0] = measure(applyDraw(base, spec, draw_a), *ref_a, spec, draw_a, extras);
+      return;
+    }
+    const RunDraw draw_b = drawRun(spec, base, i + 1);
+    measurePair(applyDraw(base, spec, draw_a), *ref_a, draw_a, rows[0], applyDraw(base, spec, draw_b), *ref_b, draw_b,
+                rows[1], spec, extras);
+  };
+}
+
+/// Throws std::invalid_argument naming the first of runs 0..runs-1 whose drawn scenario does not validate
+/// (e.g. a mismatch outside the plant's range): checked before any run starts, so no partial result.
+void refuseBadDraws(const Scenario& base, const MonteCarloSpec& spec, std::int64_t runs) {
+  for (std::int64_t i = 0; i < runs; ++i) {
+    const std::string e = applyDraw(base, spec, drawRun(spec, base, i)).validate();
+    if (!e.empty()) throw std::invalid_argument("a drawn run does not validate: " + e);
+  }
+}
+
+/// CPU time of the calling thread [s] (0 where the clock is missing: the load figures are then 0, and
+/// nothing else depends on them).
+double threadCpuSeconds() {
+  timespec ts{};
+  if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts) != 0) return 0.0;
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+/// Runs 0..runs-1 on `threads` threads, two at a time: make() is called once per thread and returns that
+/// thread's run(i, count, rows), which writes runs i .. i + count - 1 (count 1 or 2) into rows[0 .. count-1]
+/// with its own references and state. Row i lands at index i whatever thread ran it (and whichever run it
+/// was paired with: a pair's rows are those of the two runs alone). loads (optional): each thread's runs
+/// and CPU time, thread t's in (*loads)[t].
+template <typename MakeWorker>
+std::vector<RunRow> parallelRows(std::int64_t runs, int threads, const std::function<void(std::int64_t)>& progress,
+                                 const MakeWorker& make, std::vector<WorkerLoad>* loads = nullptr) {
+  if (threads <= 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  threads = static_cast<int>(std::min<std::int64_t>(threads, (runs + 1) / 2));
+  std::vector<WorkerLoad> load(static_cast<std::size_t>(threads));
+  std::vector<RunRow> rows(static_cast<std::size_t>(runs));
+  std::atomic<std::int64_t> next{0};
+  std::int64_t done = 0;
+  std::mutex progress_mutex;
+  std::exception_ptr failure;
+  std::mutex failure_mutex;
+  auto worker = [&](WorkerLoad& mine) {
+    const double cpu0 = threadCpuSeconds();
+    try {
+      auto run = make();
+      for (std::int64_t i = next.fetch_add(2); i < runs; i = next.fetch_add(2)) {
+        const int count = static_cast<int>(std::min<std::int64_t>(2, runs - i));
+        run(i, count, &rows[static_cast<std::size_t>(i)]);
+        mine.runs += count;
+        if (progress) {
+          std::lock_guard<std::mutex> lock(progress_mutex);
+          for (int j = 0; j < count; ++j) progress(++done);
+        }
+      }
+    } catch (...) {
+      std::lock_guard<std::mutex> lock(failure_mutex);
+      if (!failure) failure = std::current_exception();
+      next = runs;  // the others stop after their current runs
+    }
+    mine.cpu_seconds = threadCpuSeconds() - cpu0;
+  };
+  if (threads == 1) {
+    worker(load[0]);
+  } else {
+    std::vector<std::thread> pool;
+    for (int t = 0; t < threads; ++t) pool.emplace_back(worker, std::ref(load[static_cast<std::size_t>(t)]));
+    for (auto& t : pool) t.join();
+  }
+  if (failure) std::rethrow_exception(failure);
+  if (loads != nullptr) *loads = load;
+  return rows;
+}
+
+/// A parallelRows worker from a one-run function run(i) -> RunRow: the runs of a batch one by one.
+template <typename RunOne>
+auto oneByOne(RunOne run) {
+  return [run](std::int64_t i, int count, RunRow* rows) {
+    for (int j = 0; j < count; ++j) rows[j] = run(i + j);
+  };
+}
+
+/// Nearest-rank quantile of sorted values.
+double quantile(const std::vector<double>& sorted, double q) {
+  const auto n = static_cast<double>(sorted.size());
+  const auto k = static_cast<std::size_t>(std::max(1.0, std::ceil(q * n)));
+  return sorted[k - 1];
+}
+
+}  // namespace
+
+std::string csvNumber(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+std::string shortNumber(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.4g", v);
+  return buf;
+}
+
+std::string MonteCarloSpec::validate() const {
+  std::string e = firstError(
+      {checkUniform("mass_scale", mass_scale), checkUniform("inertia_scale", inertia_scale),
+       checkUniform("amplitude", amplitude), checkUniform("phase", phase), checkUniform("start_dx", start_dx),
+       checkUniform("start_dy", start_dy), checkUniform("start_dtheta", start_dtheta),
+       checkNonNegative("noise_std", noise_std, "N·m"), checkNonNegative("settle_time", settle_time, "s"),
+       checkPositive("cross_track_threshold", cross_track_threshold, "m")});
+  if (e.empty() && !(mass_scale.lo > 0.0 && inertia_scale.lo > 0.0)) e = "mass_scale and inertia_scale must be > 0";
+  if (e.empty() && amplitude.lo < 0.0) e = "amplitude must be >= 0";
+  return e;
+}
+
+RunDraw drawRun(const MonteCarloSpec& spec, const Scenario& base, std::int64_t index) {
+  const std::uint64_t s = spec.base_seed;
+  RunDraw d;
+  d.index = index;
+  d.mass_scale = spec.mass_scale.at(unit(s, index, 0));
+  d.inertia_scale = spec.inertia_scale.at(unit(s, index, 1));
+  d.amplitude = spec.amplitude.at(unit(s, index, 2));
+  d.phase = spec.phase.at(unit(s, index, 3));
+  d.noise_seed = splitmix64(splitmix64(splitmix64(s) + static_cast<std::uint64_t>(index)) + 4) >>
+                 33;  // noise/seed is an int parameter
+  d.start_x = base.start.x + spec.start_dx.at(unit(s, index, 5));
+  d.start_y = base.start.y + spec.start_dy.at(unit(s, index, 6));
+  d.start_theta = wrapAngle(base.start.theta + spec.start_dtheta.at(unit(s, index, 7)));
+  d.sensor_seed = splitmix64(splitmix64(splitmix64(s) + static_cast<std::uint64_t>(index)) + 8) >> 33;
+  return d;
+}
+
+Scenario applyDraw(const Scenario& base, const MonteCarloSpec& spec, const RunDraw& d) {
+  Scenario sc = base;
+  sc.disturbance.mass_scale = d.mass_scale;
+  sc.disturbance.inertia_scale = d.inertia_scale;
+  sc.disturbance.sinusoidal = d.amplitude > 0.0;
+  sc.disturbance.amplitude = d.amplitude;
+  sc.disturbance_phase = d.phase;
+  sc.disturbance.noise_std = spec.noise_std;
+  sc.disturbance.seed = d.noise_seed;
+  sc.start = {d.start_x, d.start_y, d.start_theta};
+  return sc;
+}
+
+std::vector<RunRow> runMonteCarlo(const Scenario& base, const ReferenceSource& reference, const MonteCarloSpec& spec,
+                                  std::int64_t runs, int threads, const std::function<void(std::int64_t)>& progress) {
+  if (runs < 1) throw std::invalid_argument("the number of runs (seeds) must be >= 1, not " + std::to_string(runs));
+  const std::string e = firstError({spec.validate(), base.validate()});
+  if (!e.empty()) throw std::invalid_argument(e);
+  refuseBadDraws(base, spec, runs);
+  return parallelRows(runs, threads, progress, [&]() { return pairedRuns(base, spec, reference, RunExtras{}); });
+}
+
+std::string BenchScenario::validate() const {
+  std::string e = firstError({spec.validate(), base.validate()});
+  if (!e.empty()) return e;
+  if (!(envelope_period > 0.0 && std::isfinite(envelope_period))) return "envelope_period must be > 0";
+  e = estimatedBenchCheck(*this);
+  if (!e.empty()) return e;
+  switch (track) {
+    case TrackKind::line:
+      if (!allFinite(line_x0, line_v_r, line_y)) return "line: x0, v_r and y must be finite";
+      return "";
+    case TrackKind::sine: return sine.validate();
+    case TrackKind::field:
+      e = field.validate();
+      if (!e.empty()) return e;
+      for (const Obstacle& o : obstacles) {
+        e = o.validate();
+        if (!e.empty()) return "obstacle: " + e;
+      }
+      if (!(finish_tolerance > 0.0)) return "finish_tolerance must be > 0";
+      return "";
+  }
+  return "unknown track";
+}
+
+std::vector<RunRow> runBenchmark(const BenchScenario& bench, std::int64_t runs, int threads,
+                                 const std::function<void(std::int64_t)>& progress, std::vector<WorkerLoad>* loads) {
+  if (runs < 1) throw std::invalid_argument("the number of runs (seeds) must be >= 1, not " + std::to_string(runs));
+  const std::string e = bench.validate();
+  if (!e.empty()) throw std::invalid_argument(e);
+  const MonteCarloSpec& spec = bench.spec;
+  const Scenario& base = bench.base;
+  refuseBadDraws(base, spec, runs);
+  if (bench.realism)  // sensors, traction or an estimate in the loop (issue 16): estimated_bench.h
+    return parallelRows(
+        runs, threads, progress,
+        [&]() { return oneByOne([&bench](std::int64_t i) { return estimatedBenchRow(bench, i); }); }, loads);
+  RunExtras extras;
+  extras.series_every = seriesEvery(bench);
+  if (bench.track != TrackKind::field) {
+    std::unique_ptr<ReferenceSource> proto;
+    if (bench.track == TrackKind::line)
+      proto = std::make_unique<LineReference>(bench.line_v_r, bench.line_y, bench.line_x0);
+    else
+      proto = std::make_unique<SineReference>(bench.sine);
+    // Two runs at a time in lockstep (measurePair), each with its own reference.
+    return parallelRows(
+        runs, threads, progress, [&]() { return pairedRuns(base, spec, *proto, extras); }, loads);
+  }
+  // Field: the path starts at the drawn start (the approach), so each run builds its own reference, and its
+  // duration grows by the approach's extra time, as run_scenario --field does.
+  return parallelRows(
+      runs, threads, progress,
+      [&]() {
+        return oneByOne([&bench, &base, &spec, &extras](std::int64_t i) {
+          const RunDraw draw = drawRun(spec, base, i);
+          return fieldRow(bench, applyDraw(base, spec, draw), extras,
+                          [&spec, &draw](const Scenario& sc, ReferenceSource& reference, const RunExtras& e) {
+                            return measure(sc, reference, spec, draw, e);
+                          });
+        });
+      },
+      loads);
+}
+
+Envelope crossTrackEnvelope(const std::vector<RunRow>& rows, double period) {
+  Envelope env;
+  env.period = period;
+  std::size_t n = 0;
+  for (const RunRow& r : rows) n = std::max(n, r.cross_track_series.size());
+  std::vector<double> v;
+  for (std::size_t k = 0; k < n; ++k) {
+    v.clear();
+    double max_abs = 0.0;
+    for (const RunRow& r : rows) {
+      if (k >= r.cross_track_series.size()) continue;
+      double x = r.cross_track_series[k];
+      if (std::isnan(x)) x = std::numeric_limits<double>::infinity();
+      v.push_back(x);
+      max_abs = std::max(max_abs, std::fabs(x));
+    }
+    std::sort(v.begin(), v.end());
+    env.p05.push_back(quantile(v, 0.05));
+    env.p25.push_back(quantile(v, 0.25));
+    env.p50.push_back(quantile(v, 0.50));
+    env.p75.push_back(quantile(v, 0.75));
+    env.p95.push_back(quantile(v, 0.95));
+    env.max_abs.push_back(max_abs);
+  }
+  return env;
+}
+
+std::string envelopeCsvHeader() { return "scenario,controller,t,p05,p25,p50,p75,p95,max_abs\n"; }
+
+std::string envelopeCsvLines(const std::string& scenario, const std::string& controller, const Envelope& e) {
+  // Six digits: a figure's data (micrometres of cross-track), not a run to repeat (runs.csv has full precision).
+  auto six = [](double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.6g", v);
+    return std::string(buf);
+  };
+  std::string out;
+  for (std::size_t k = 0; k < e.p50.size(); ++k)
+    out += scenario + "," + controller + "," + six(static_cast<double>(k) * e.period) + "," + six(e.p05[k]) + "," +
+           six(e.p25[k]) + "," + six(e.p50[k]) + "," + six(e.p75[k]) + "," + six(e.p95[k]) + "," + six(e.max_abs[k]) +
+           "\n";
+  return out;
+}
+
+Statistic statistic(std::vector<double> v) {
+  Statistic s;
+  v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return std::isnan(x); }), v.end());
+  if (v.empty()) {
+    s.mean = s.std = s.p95 = s.worst = std::numeric_limits<double>::quiet_NaN();
+    return s;
+  }
+  const double inf = std::numeric_limits<double>::infinity();
+  std::sort(v.begin(), v.end());
+  s.worst = v.back();
+  s.p95 = v[static_cast<std::size_t>(std::ceil(0.95 * static_cast<double>(v.size()))) - 1];  // nearest rank
+  for (double x : v)
+    if (!std::isfinite(x)) {
+      s.mean = s.std = inf;
+      return s;
+    }
+  double sum = 0.0;
+  for (double x : v) sum += x;
+  s.mean = sum / static_cast<double>(v.size());
+  double sq = 0.0;
+  for (double x : v) sq += (x - s.mean) * (x - s.mean);
+  s.std = v.size() > 1 ? std::sqrt(sq / static_cast<double>(v.size() - 1)) : 0.0;
+  return s;
+}
+
+const std::vector<std::string>& metricColumns() {
+  static const std::vector<std::string> columns = [] {
+    std::vector<std::string> c;
+    for (const char* axis : {"x", "y", "theta"})
+      for (const char* m : {"ise", "itse", "iae", "itae", "rise_time", "settling_time", "overshoot"})
+        c.push_back(std::string(m) + "_" + axis);
+    for (const char* m : {"effort", "chattering", "time_at_limit", "worst_cross_track", "final_cross_track"})
+      c.push_back(m);
+    return c;
+  }();
+  return columns;
+}
+
+std::vector<double> metricValues(const RunRow& r) {
+  std::vector<double> v;
+  v.reserve(metricColumns().size());
+  for (const AxisMetrics& m : r.metrics)
+    for (double x : {m.ise, m.itse, m.iae, m.itae, m.rise_time, m.settling_time, m.overshoot}) v.push_back(x);
+  for (double x : {r.effort, r.chattering, r.time_at_limit, r.worst_cross_track, r.final_cross_track}) v.push_back(x);
+  return v;
+}
+
+std::string runsCsvHeader(bool realism) {
+  std::string h =
+      "scenario,controller,seed,mass_scale,inertia_scale,amplitude,phase,noise_seed,start_x,start_y,start_theta";
+  for (const auto& c : metricColumns()) h += "," + c;
+  return h + ",contacts,min_clearance,end_distance,diverged,success,failure" + (realism ? estimatedCsvHeader() : "") +
+         "\n";
+}
+
+std::string runsCsvLines(const std::string& scenario, const std::string& controller, const std::vector<RunRow>& rows,
+                         bool realism) {
+  std::string out;
+  for (const RunRow& r : rows) {
+    const RunDraw& d = r.draw;
+    out += scenario + "," + controller + "," + std::to_string(d.index) + "," + csvNumber(d.mass_scale) + "," +
+           csvNumber(d.inertia_scale) + "," + csvNumber(d.amplitude) + "," + csvNumber(d.phase) + "," +
+           std::to_string(d.noise_seed) + "," + csvNumber(d.start_x) + "," + csvNumber(d.start_y) + "," +
+           csvNumber(d.start_theta);
+    for (double x : metricValues(r)) out += "," + csvNumber(x);
+    out += "," + std::to_string(r.contacts) + "," + csvNumber(r.min_clearance) + "," + csvNumber(r.end_distance);
+    out += std::string(",") + (r.diverged ? "1" : "0") + "," + (r.success ? "1" : "0") + "," + r.failure;
+    out += (realism ? estimatedCsvFields(r) : "") + "\n";
+  }
+  return out;
+}
+
+namespace {
+const char* const kFailureReasons[] = {"diverged", "contact", "not finished", "cross-track"};
+
+double successRate(const std::vector<RunRow>& rows) {
+  std::int64_t ok = 0;
+  for (const RunRow& r : rows) ok += r.success;
+  return rows.empty() ? 0.0 : 100.0 * static_cast<double>(ok) / static_cast<double>(rows.size());
+}
+
+std::vector<double> column(const std::vector<RunRow>& rows, const std::function<double(const RunRow&)>& f) {
+  std::vector<double> v;
+  v.reserve(rows.size());
+  for (const RunRow& r : rows) v.push_back(f(r));
+  return v;
+}
+}  // namespace
+
+std::string reportSection(const std::string& scenario, const std::string& controller, const std::vector<RunRow>& rows) {
+  std::int64_t ok = 0;
+  for (const RunRow& r : rows) ok += r.success;
+  std::string out = "## " + scenario + " / " + controller + "\n\n";
+  out += "runs " + std::to_string(rows.size()) + ", success " + std::to_string(ok) + " (" +
+         shortNumber(successRate(rows)) + " %); failures:";
+  bool first = true;
+  for (const char* reason : kFailureReasons) {
+    std::int64_t n = 0;
+    for (const RunRow& r : rows) n += r.failure == reason;
+    out += std::string(first ? " " : ", ") + reason + " " + std::to_string(n);
+    first = false;
+  }
+  out += "\n\n";
+  const std::vector<double> clearance = column(rows, [](const RunRow& r) { return r.min_clearance; });
+  if (std::any_of(clearance.begin(), clearance.end(), [](double c) { return !std::isnan(c); })) {
+    std::int64_t touched = 0;
+    double lowest = std::numeric_limits<double>::infinity();
+    for (const RunRow& r : rows) {
+      touched += r.contacts > 0;
+      if (!std::isnan(r.min_clearance)) lowest = std::min(lowest, r.min_clearance);
+    }
+    out += "body against the obstacles: runs with a contact " + std::to_string(touched) + ", smallest body clearance " +
+           shortNumber(lowest) + " m\n\n";
+  }
+  if (!rows.empty() && rows.front().realism) out += estimatedReportLine(rows);
+  out += "| metric | mean | std | p95 | worst |\n|---|---:|---:|---:|---:|\n";
+  const auto& cols = metricColumns();
+  std::vector<std::vector<double>> values(cols.size());
+  for (const RunRow& r : rows) {
+    const std::vector<double> v = metricValues(r);
+    for (std::size_t c = 0; c < cols.size(); ++c) values[c].push_back(v[c]);
+  }
+  for (std::size_t c = 0; c < cols.size(); ++c) {
+    const Statistic s = statistic(values[c]);
+    out += "| " + cols[c] + " | " + shortNumber(s.mean) + " | " + shortNumber(s.std) + " | " + shortNumber(s.p95) +
+           " | " + shortNumber(s.worst) + " |\n";
+  }
+  return out + "\n";
+}
+
+std::string summaryHeader() {
+  return "| scenario | controller | runs | success % | failures | ITAE y mean | worst cross-track mean / p95 [m] | "
+         "effort mean [N²m²s] | chattering mean [N·m] | time at limit mean [s] |\n"
+         "|---|---|---:|---:|---|---:|---:|---:|---:|---:|\n";
+}
+
+std::string summaryLine(const std::string& scenario, const std::string& controller, const std::vector<RunRow>& rows) {
+  std::string failures;
+  for (const char* reason : kFailureReasons) {
+    std::int64_t n = 0;
+    for (const RunRow& r : rows) n += r.failure == reason;
+    if (n > 0) failures += (failures.empty() ? "" : ", ") + std::string(reason) + " " + std::to_string(n);
+  }
+  const Statistic itae = statistic(column(rows, [](const RunRow& r) { return r.metrics[AXIS_Y].itae; }));
+  const Statistic worst = statistic(column(rows, [](const RunRow& r) { return r.worst_cross_track; }));
+  const Statistic effort = statistic(column(rows, [](const RunRow& r) { return r.effort; }));
+  const Statistic chat = statistic(column(rows, [](const RunRow& r) { return r.chattering; }));
+  const Statistic limit = statistic(column(rows, [](const RunRow& r) { return r.time_at_limit; }));
+  return "| " + scenario + " | " + controller + " | " + std::to_string(rows.size()) + " | " +
+         shortNumber(successRate(rows)) + " | " + (failures.empty() ? "-" : failures) + " | " + shortNumber(itae.mean) +
+         " | " + shortNumber(worst.mean) + " / " + shortNumber(worst.p95) + " | " + shortNumber(effort.mean) + " | " +
+         shortNumber(chat.mean) + " | " + shortNumber(limit.mean) + " |\n";
+}
+
+}  // namespace core
+}  // namespace sowing_robot

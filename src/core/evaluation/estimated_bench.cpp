@@ -1,0 +1,145 @@
+#include "sowing_robot/core/evaluation/estimated_bench.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <memory>
+#include <stdexcept>
+
+#include "sowing_robot/core/evaluation/bench_row.h"
+#include "sowing_robot/core/planning/seeding.h"
+
+namespace sowing_robot {
+namespace core {
+
+const std::vector<std::string>& availableModels() {
+  static const std::vector<std::string> models{"wet_soil", "estimated_pose"};
+  return models;
+}
+
+namespace {
+
+/// benchmark.cpp's measure() over runEstimatedLoop: the same figures (RowMeter; a truth-fed run without
+/// traction gives its row bit for bit: test_estimated_run), plus the loop's own.
+RunRow measureEstimated(const Scenario& sc, const EstimatedRunConfig& cfg, ReferenceSource& reference,
+                        const MonteCarloSpec& spec, const RunDraw& draw, const RunExtras& extras) {
+  RunRow row;
+  row.draw = draw;
+  RowMeter meter(row, sc, spec, extras);
+  const EstimatedRunResult er =
+      runEstimatedLoop(sc, cfg, reference, true, [&](const EstimatedSample& es) { meter.add(*es.loop); });
+  meter.finish(er.run);
+  row.realism = true;
+  row.max_slip = er.max_abs_slip;
+  row.tool_down_time = er.tool_down_time;
+  row.fed_error_rms = er.fed_error_rms;
+  row.fed_error_max = er.fed_error_max;
+  row.odometry_error_max = er.odometry_error_max;
+  row.fixes_applied = er.fixes.applied;
+  row.fixes_refused = er.fixes.refused();
+  return row;
+}
+
+}  // namespace
+
+std::string estimatedBenchCheck(const BenchScenario& b) {
+  const auto& available = availableModels();
+  for (const std::string& m : b.requires_models) {
+    if (std::find(available.begin(), available.end(), m) == available.end())
+      return "scenario " + b.name + " needs the " + m + " model, which is not available";
+    if (m == "wet_soil" && !(b.realism && b.realism->traction))
+      return "scenario " + b.name + " requires wet_soil but its traction is not enabled (traction/enabled: true)";
+    if (m == "estimated_pose" && !(b.realism && b.realism->feedback != Feedback::ground_truth))
+      return "scenario " + b.name + " requires estimated_pose but its feedback is ground_truth (feedback: fused)";
+  }
+  return b.realism ? b.realism->validate() : "";
+}
+
+RunRow estimatedBenchRow(const BenchScenario& bench, std::int64_t index) {
+  if (!bench.realism) throw std::invalid_argument("estimatedBenchRow: scenario " + bench.name + " has no realism");
+  const MonteCarloSpec& spec = bench.spec;
+  const RunDraw draw = drawRun(spec, bench.base, index);
+  Scenario sc = applyDraw(bench.base, spec, draw);
+  EstimatedRunConfig cfg = *bench.realism;
+  cfg.sensors.seed = draw.sensor_seed;
+  RunExtras extras;
+  extras.series_every = seriesEvery(bench);
+  if (bench.track == TrackKind::line) {
+    LineReference reference(bench.line_v_r, bench.line_y, bench.line_x0);
+    return measureEstimated(sc, cfg, reference, spec, draw, extras);
+  }
+  if (bench.track == TrackKind::sine) {
+    SineReference reference(bench.sine);
+    return measureEstimated(sc, cfg, reference, spec, draw, extras);
+  }
+  // Field: as runBenchmark's field runs (fieldRow), with the plant's tool rule on the field's rows (as
+  // runField with traction).
+  cfg.tool_rows = rowsOf(bench.field);
+  cfg.tool_rows_open_ended = false;
+  return fieldRow(bench, sc, extras,
+                  [&cfg, &spec, &draw](const Scenario& s, ReferenceSource& reference, const RunExtras& e) {
+                    return measureEstimated(s, cfg, reference, spec, draw, e);
+                  });
+}
+
+std::string estimatedCsvHeader() {
+  return ",sensor_seed,max_slip,tool_down_time,fed_error_rms,fed_error_max,odometry_error_max,fixes_applied,"
+         "fixes_refused";
+}
+
+std::string estimatedCsvFields(const RunRow& r) {
+  if (!r.realism) return ",,nan,nan,nan,nan,nan,,";
+  return "," + std::to_string(r.draw.sensor_seed) + "," + csvNumber(r.max_slip) + "," + csvNumber(r.tool_down_time) +
+         "," + csvNumber(r.fed_error_rms) + "," + csvNumber(r.fed_error_max) + "," + csvNumber(r.odometry_error_max) +
+         "," + std::to_string(r.fixes_applied) + "," + std::to_string(r.fixes_refused);
+}
+
+std::string estimatedReportLine(const std::vector<RunRow>& rows) {
+  std::vector<double> slip, rms, mx, odo;
+  long applied = 0, refused = 0;
+  for (const RunRow& r : rows) {
+    slip.push_back(r.max_slip);
+    rms.push_back(r.fed_error_rms);
+    mx.push_back(r.fed_error_max);
+    odo.push_back(r.odometry_error_max);
+    applied += r.fixes_applied;
+    refused += r.fixes_refused;
+  }
+  const Statistic s = statistic(slip), e = statistic(rms), m = statistic(mx), o = statistic(odo);
+  std::string out = "max |slip ratio| mean " + shortNumber(s.mean) + ", worst " + shortNumber(s.worst) +
+                    "; fed-pose error against the truth: RMS mean " + shortNumber(e.mean) + " m (p95 " +
+                    shortNumber(e.p95) + "), max mean " + shortNumber(m.mean) + " m (worst " + shortNumber(m.worst) +
+                    "); encoder odometry's largest error mean " + shortNumber(o.mean) + " m (worst " +
+                    shortNumber(o.worst) + ")";
+  if (applied + refused > 0)
+    out += "; fixes applied " + std::to_string(applied) + ", refused " + std::to_string(refused);
+  return out + "\n\n";
+}
+
+std::string describeRealism(const BenchScenario& b) {
+  if (!b.realism) return "";
+  const EstimatedRunConfig& c = *b.realism;
+  std::string out = "  Plant: ";
+  if (c.traction) {
+    out += "traction (mu_peak " + shortNumber(c.traction->mu_peak) + ", mu_slide " + shortNumber(c.traction->mu_slide) +
+           ", rolling resistance " + shortNumber(c.traction->rolling_resistance) + ", draft " +
+           shortNumber(c.traction->draft_force) + " N while the tool is down), " + std::to_string(c.patches.size()) +
+           " soil patch(es)";
+    for (const SoilPatch& p : c.patches) out += " [mu_peak " + shortNumber(p.mu_peak) + "]";
+  } else {
+    out += "no slip";
+  }
+  out += "; feedback " + std::string(feedbackName(c.feedback)) +
+         " (sensors: " + std::to_string(c.sensors.encoder.ticks_per_turn) + " ticks/turn, gyro noise " +
+         shortNumber(c.sensors.imu.noise) + " rad/s bias " + shortNumber(c.sensors.imu.bias) + " rad/s, fix " +
+         shortNumber(c.sensors.fix.rate) + " Hz sigma " + shortNumber(c.sensors.fix.sigma) + " m latency " +
+         shortNumber(c.sensors.fix.latency) + " s; their seed drawn per run)";
+  if (c.feedback == Feedback::fused)
+    out += std::string("; EKF with the bias state ") + (c.estimator.estimate_bias ? "on" : "off") + ", fix delay " +
+           shortNumber(c.estimator.fix_delay) + " s, gate " + shortNumber(c.estimator.gate);
+  return out + "; scored on the truth.\n";
+}
+
+}  // namespace core
+}  // namespace sowing_robot

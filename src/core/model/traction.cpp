@@ -1,0 +1,342 @@
+#include "sowing_robot/core/model/traction.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+
+#include "sowing_robot/core/common/types.h"
+#include "sowing_robot/core/common/validation.h"
+#include "sowing_robot/core/numerics/rotation.h"
+#include "sowing_robot/core/numerics/trig.h"
+
+namespace sowing_robot {
+namespace core {
+namespace {
+
+constexpr double kGravity = 9.81;  // [m/s^2]
+
+}  // namespace
+
+const ParamTable<TractionParams>& tractionTable() {
+  using T = TractionParams;
+  static const ParamTable<T> table({
+      flag("traction/enabled", &T::enabled, false,
+           "wheel slip on: the plant integrates each wheel's spin and its soil force; off, today's no-slip plant"),
+      number("traction/mu_peak", &T::mu_peak, 0.6, Limits::closed(0.0, 1000.0), "",
+             "peak friction coefficient of the soil (about 0.2 wet grass, 0.35 dirt track, 0.6 loose moist soil; "
+             "0 = ice; far above 1 only to approach the no-slip plant)"),
+      number("traction/mu_slide", &T::mu_slide, 0.45, Limits::closed(0.0, 1000.0), "",
+             "friction coefficient of a fully sliding wheel (|slip| >= 1); <= mu_peak"),
+      number("traction/slip_peak", &T::slip_peak, 0.15, Limits{0.0, 1.0, true, true}, "",
+             "longitudinal slip ratio at which the friction peaks"),
+      number("traction/slip_stiffness", &T::slip_stiffness, 8.0, Limits::above(0.0, 1e6), "",
+             "slope of friction coefficient over slip ratio at zero slip; >= mu_peak / slip_peak"),
+      number(
+          "traction/rolling_resistance", &T::rolling_resistance, 0.05, Limits::closed(0.0, 1.0), "",
+          "rolling-resistance force / normal load, at each wheel and the caster (0.02 hard track .. 0.15 soft soil)"),
+      number("traction/slip_speed_floor", &T::slip_speed_floor, 0.05, Limits::above(0.0, 1.0), "m/s",
+             "smallest speed the slip ratio is divided by (regularises slip at standstill)"),
+      number("traction/caster_x", &T::caster_x, 0.30, Limits::above(0.0, 5.0), "m",
+             "caster contact ahead of the axle, for the normal loads (URDF caster_joint x)"),
+      integer("traction/substeps", &T::substeps, 4, Limits::closed(1.0, 1000.0), "",
+              "linearly implicit integration sub-steps per plant step"),
+      number("traction/draft_force", &T::draft_force, 0.0, Limits::closed(0.0, 1e5), "N",
+             "draft of the seed drill's tool while it is down, at the tool point (URDF tool_link) against its "
+             "motion; 0 = none (a furrow opener in loose soil: some 10..100 N)"),
+  });
+  return table;
+}
+
+TractionParams::TractionParams() { tractionTable().applyDefaults(*this); }
+
+std::string TractionParams::validate() const {
+  const std::string e = tractionTable().checkRanges(*this);
+  if (!e.empty()) return e;
+  if (mu_slide > mu_peak)
+    return "traction/mu_slide = " + formatNumber(mu_slide) + " must be <= traction/mu_peak = " + formatNumber(mu_peak);
+  if (slip_stiffness * slip_peak < mu_peak)
+    return "traction/slip_stiffness = " + formatNumber(slip_stiffness) +
+           " must be >= traction/mu_peak / traction/slip_peak = " + formatNumber(mu_peak / slip_peak);
+  return "";
+}
+
+double tractionFriction(const TractionParams& p, double kappa, double* slope) {
+  double s;
+  const double mu = FrictionCurve(p).eval(std::fabs(kappa), s);
+  if (slope) *slope = s;
+  return kappa < 0.0 ? -mu : mu;
+}
+
+NormalLoads staticNormalLoads(const RobotParams& robot, double mass_scale, double caster_x) {
+  const double weight = robot.m() * mass_scale * kGravity;
+  // Moments about the axle: weight at mc d / m ahead of it, caster reaction at caster_x.
+  const double caster = std::clamp(robot.mc * mass_scale * robot.d * kGravity / caster_x, 0.0, weight);
+  return {0.5 * (weight - caster), 0.5 * (weight - caster), caster};
+}
+
+TractionPlant::TractionPlant(const RobotParams& nominal, const PlantDisturbance& disturbance,
+                             const TractionParams& traction)
+    : nominal_(nominal),
+      disturbance_(disturbance),
+      traction_(traction),
+      curves_{FrictionCurve(traction)},
+      rr_{traction.rolling_resistance},
+      rng_(disturbance.seed) {
+  const std::string error = firstError({nominal.validate(), disturbance.validate(), traction.validate()});
+  if (!error.empty()) throw std::invalid_argument(error);
+  const double spin = 2.0 * nominal.Iw / (nominal.R * nominal.R);
+  m_b_ = nominal.m0() * disturbance.mass_scale - spin;
+  i_b_ = nominal.I0() * disturbance.inertia_scale - nominal.L * nominal.L * spin;
+  mcd_ = nominal.mc * nominal.d * disturbance.mass_scale;
+  if (!(m_b_ > 0.0) || !(i_b_ > 0.0))
+    throw std::invalid_argument("traction plant: the mismatch leaves no body mass or yaw inertia beside the wheels");
+  sqrt_m_ = std::sqrt(m_b_);
+  sqrt_i_ = std::sqrt(i_b_);
+  inv_sqrt_mi_ = 1.0 / (sqrt_m_ * sqrt_i_);
+  inv_sqrt_m_ = 1.0 / sqrt_m_;
+  inv_sqrt_i_ = 1.0 / sqrt_i_;
+  inv_m_ = 1.0 / m_b_;
+  inv_i_ = 1.0 / i_b_;
+  inv_iw_ = 1.0 / nominal.Iw;
+  inv_floor_ = 1.0 / traction.slip_speed_floor;
+  const double R = nominal.R, L = nominal.L;
+  slip_a_ = R * R * inv_iw_ + inv_m_ + L * L * inv_i_;
+  slip_b_ = inv_m_ - L * L * inv_i_;
+  loads_ = staticNormalLoads(nominal, disturbance.mass_scale, traction.caster_x);
+}
+
+void TractionPlant::setNormalLoads(const NormalLoads& loads) {
+  if (!(loads.right >= 0.0) || !(loads.left >= 0.0) || !(loads.caster >= 0.0) ||
+      !allFinite(loads.right, loads.left, loads.caster))
+    throw std::invalid_argument("traction plant: normal loads must be finite and >= 0");
+  loads_ = loads;
+}
+
+void TractionPlant::setSoil(const SoilMap& soil) {
+  std::vector<FrictionCurve> curves{FrictionCurve(traction_)};
+  std::vector<double> rr{traction_.rolling_resistance};
+  for (std::size_t i = 0; i < soil.patches().size(); ++i) {
+    const SoilPatch& patch = soil.patches()[i];
+    TractionParams p = traction_;
+    p.mu_peak = patch.mu_peak;
+    p.mu_slide = patch.mu_slide;
+    p.rolling_resistance = patch.rolling_resistance;
+    const std::string e = p.validate();
+    if (!e.empty())
+      throw std::invalid_argument("field/patches[" + std::to_string(i) + "] does not fit the slip curve: " + e);
+    curves.emplace_back(p);
+    rr.push_back(patch.rolling_resistance);
+  }
+  soil_ = soil;
+  curves_ = std::move(curves);
+  rr_ = std::move(rr);
+  ground_[0] = ground_[1] = ground_[2] = 0;
+  locateContacts();
+}
+
+void TractionPlant::locateContacts() {
+  if (soil_.empty()) return;
+  double s, c;
+  sinCos(state_[THETA], s, c);
+  const double L = nominal_.L;
+  const Eigen::Vector2d axle(state_[X], state_[Y]), left(-s * L, c * L);
+  ground_[RIGHT] = 1 + soil_.patchAt(axle - left);
+  ground_[LEFT] = 1 + soil_.patchAt(axle + left);
+  ground_[kCaster] = 1 + soil_.patchAt(axle + traction_.caster_x * Eigen::Vector2d(c, s));
+}
+
+void TractionPlant::reset(const State& initial, double t) {
+  if (!initial.allFinite() || !std::isfinite(t)) throw std::invalid_argument("plant reset: non-finite state or time");
+  state_ = initial;
+  time_ = t;
+  wheel_rate_[RIGHT] = (initial[V] + nominal_.L * initial[OMEGA]) / nominal_.R;
+  wheel_rate_[LEFT] = (initial[V] - nominal_.L * initial[OMEGA]) / nominal_.R;
+  slip_[RIGHT] = slip_[LEFT] = force_[RIGHT] = force_[LEFT] = 0.0;
+  draft_f_ = draft_m_ = 0.0;
+  locateContacts();
+  rng_.seed(disturbance_.seed);
+  noise_.reset();
+}
+
+double TractionPlant::kineticEnergy() const {
+  const double v = state_[V], w = state_[OMEGA];
+  return 0.5 * (m_b_ * v * v + i_b_ * w * w +
+                nominal_.Iw * (wheel_rate_[RIGHT] * wheel_rate_[RIGHT] + wheel_rate_[LEFT] * wheel_rate_[LEFT]));
+}
+
+bool TractionPlant::step(double tau_right, double tau_left, double dt) {
+  double c, s;
+  sinCos(state_[THETA], s, c);
+  return stepWithHeading(tau_right, tau_left, dt, c, s);
+}
+
+bool TractionPlant::step(double tau_right, double tau_left, double dt, double theta, double cos_theta,
+                         double sin_theta) {
+  // Bit pattern, not ==: -0.0 == 0.0, but their sines differ in sign.
+  if (std::memcmp(&theta, &state_[THETA], sizeof theta) == 0)
+    return stepWithHeading(tau_right, tau_left, dt, cos_theta, sin_theta);
+  return step(tau_right, tau_left, dt);
+}
+
+// cos_th, sin_th: cos and sin of state_[THETA].
+bool TractionPlant::stepWithHeading(double tau_right, double tau_left, double dt, double cos_th, double sin_th) {
+  if (!allFinite(tau_right, tau_left, dt) || !(dt > 0.0)) return false;
+  double noise_r = 0.0, noise_l = 0.0;
+  if (disturbance_.noise_std > 0.0) {
+    noise_r = disturbance_.noise_std * noise_(rng_);
+    noise_l = disturbance_.noise_std * noise_(rng_);
+  }
+  const int n = traction_.substeps;
+  const double h = dt / n;
+  // The sinusoid at each sub-step's midpoint (second order in the impulse), turned from one sincos.
+  double dist_s = 0.0, dist_c = 0.0;
+  const double dist_step = disturbance_.frequency * h;
+  if (disturbance_.sinusoidal) {
+    const double angle = disturbance_.frequency * (time_ + 0.5 * h);
+    sinCos(angle, dist_s, dist_c);
+  }
+  const double amplitude = disturbance_.sinusoidal ? disturbance_.amplitude : 0.0;
+  locateContacts();
+  double rr_force, rr_moment;
+  rollingResistance(rr_force, rr_moment);
+  draft_f_ = draft_m_ = 0.0;
+  if (tool_down_ && traction_.draft_force > 0.0) {
+    draft(dt, draft_f_, draft_m_);
+    rr_force += draft_f_;
+    rr_moment += draft_m_;
+  }
+  for (int j = 0; j < n; ++j) {
+    substep(tau_right + noise_r + amplitude * dist_s, tau_left + noise_l + amplitude * dist_c, rr_force, rr_moment, h,
+            cos_th, sin_th);
+    if (disturbance_.sinusoidal) rotateHeading(dist_c, dist_s, dist_step, dist_c, dist_s);
+  }
+  time_ += dt;
+  return true;
+}
+
+void TractionPlant::rollingResistance(double& force, double& moment) const {
+  // Non-stiff (rate c N / (floor m) of a few 1/s): once per step, from the step's start.
+  force = moment = 0.0;
+  const double c_r = rr_[ground_[RIGHT]], c_l = rr_[ground_[LEFT]], c_rr = rr_[ground_[kCaster]];
+  if (c_r <= 0.0 && c_l <= 0.0 && c_rr <= 0.0) return;
+  const double v = state_[V], w = state_[OMEGA], L = nominal_.L;
+  const double f_r = -c_r * loads_.right * std::clamp((v + L * w) * inv_floor_, -1.0, 1.0);
+  const double f_l = -c_l * loads_.left * std::clamp((v - L * w) * inv_floor_, -1.0, 1.0);
+  force = f_r + f_l;
+  moment = L * (f_r - f_l);
+  // Caster: against its travel (v, caster_x w); the sideways part goes into the axle's nonholonomic
+  // reaction, its moment about the axle stays.
+  if (loads_.caster > 0.0 && c_rr > 0.0) {
+    const double xc = traction_.caster_x, lateral = xc * w;
+    const double speed = std::sqrt(v * v + lateral * lateral);
+    const double scale = c_rr * loads_.caster / std::max(speed, traction_.slip_speed_floor);
+    force -= scale * v;
+    moment -= scale * lateral * xc;
+  }
+}
+
+void TractionPlant::draft(double dt, double& force, double& moment) const {
+  const double xt = tool_.x(), yt = tool_.y(), v = state_[V], w = state_[OMEGA];
+  const double vx = v - w * yt, vy = w * xt, speed = std::hypot(vx, vy);
+  const double D = traction_.draft_force, floor = traction_.slip_speed_floor;
+  // Force = −c (vx, vy), c = D / max(speed, floor): full D when moving, a linear damper below the floor.
+  // Stiff when D is large against the body (c dt / m >> 1), so semi-implicit, with the tool point's
+  // mobility along the motion, M = (vx²/m + (xt vy − yt vx)²/I) / speed²: c / (1 + dt c M) cannot reverse
+  // the motion in one step, and a draft the motors cannot overcome brings the robot to rest. At speed the
+  // factor is 1 + O(dt D / (m v)) (7e-4 for 10 N at 1 m/s).
+  if (!(speed > 0.0)) {
+    force = moment = 0.0;
+    return;
+  }
+  const double c = D / std::max(speed, floor);
+  const double lever = xt * vy - yt * vx;
+  const double mobility = (vx * vx * inv_m_ + lever * lever * inv_i_) / (speed * speed);
+  const double scale = c / (1.0 + dt * c * mobility);
+  const double fx = -scale * vx, fy = -scale * vy;
+  force = fx;
+  moment = xt * fy - yt * fx;
+}
+
+void TractionPlant::substep(double tau_r, double tau_l, double rr_force, double rr_moment, double h, double& cos_th,
+                            double& sin_th) {
+  const double R = nominal_.R, L = nominal_.L, floor = traction_.slip_speed_floor;
+  const double v = state_[V], w = state_[OMEGA];
+  const double u[2] = {v + L * w, v - L * w};
+  const double n_load[2] = {loads_.right, loads_.left};
+  const double tau[2] = {tau_r, tau_l};
+  double f0[2], k[2];
+  for (int i = 0; i < 2; ++i) {
+    const double rim = R * wheel_rate_[i], s = rim - u[i];
+    const double den = std::max({std::fabs(u[i]), std::fabs(rim), floor});
+    const double inv_den = 1.0 / den, kappa = s * inv_den;
+    // dF/ds for the implicit part. Up to the peak, the larger of the tangent and the secant F/s: the
+    // tangent alone lets a very stiff soil overshoot past zero slip (the curve is concave, its tangent
+    // too flat) and chatter. Past the peak the tangent is negative and small: that branch stays
+    // explicit (slope 0), which keeps the 2×2 system below well posed and the sliding wheel accurate.
+    // Any non-negative slope keeps the linearly implicit Euler step first-order consistent.
+    double jac;
+    const double mu = curves_[ground_[i]].evalForIntegration(std::fabs(kappa), jac);
+    f0[i] = kappa < 0.0 ? -n_load[i] * mu : n_load[i] * mu;
+    k[i] = n_load[i] * jac * inv_den;
+    slip_[i] = kappa;
+  }
+  const double inv_m = inv_m_, inv_i = inv_i_, inv_iw = inv_iw_;
+  // Body accelerations of the contact forces; the COM coupling (mc d w², −mc d w v) comes after, as a
+  // rotation that does no work.
+  const double av0 = (f0[RIGHT] + f0[LEFT] + rr_force) * inv_m;
+  const double aw0 = (L * (f0[RIGHT] - f0[LEFT]) + rr_moment) * inv_i;
+  // Explicit change of each slip velocity over the sub-step, then the implicit correction:
+  // (1 + h A k_i) ds_i + h B k_j ds_j = b_i, A = R²/Iw + 1/m + L²/I, B = 1/m - L²/I (wheel j's force
+  // change reaches wheel i's slip through the body's translation and yaw).
+  // The slip prediction sees the coupling's accelerations too (else a stiff soil would fight the
+  // rotation's velocity change every sub-step).
+  const double av_slip = av0 + mcd_ * w * w * inv_m, aw_slip = aw0 - mcd_ * w * v * inv_i;
+  const double b_r = h * (R * (tau[RIGHT] - R * f0[RIGHT]) * inv_iw - av_slip - L * aw_slip);
+  const double b_l = h * (R * (tau[LEFT] - R * f0[LEFT]) * inv_iw - av_slip + L * aw_slip);
+  const double A = slip_a_, B = slip_b_;
+  const double m11 = 1.0 + h * A * k[RIGHT], m12 = h * B * k[LEFT];
+  const double m21 = h * B * k[RIGHT], m22 = 1.0 + h * A * k[LEFT];
+  const double inv_det = 1.0 / (m11 * m22 - m12 * m21);  // > 0: A > |B|, k >= 0
+  const double ds_r = (m22 * b_r - m12 * b_l) * inv_det, ds_l = (m11 * b_l - m21 * b_r) * inv_det;
+  // Forces at the sub-step's end, capped by the peak grip (the linearisation may overshoot the peak).
+  double f[2];
+  const double mu_r = curves_[ground_[RIGHT]].mu_p, mu_l = curves_[ground_[LEFT]].mu_p;
+  f[RIGHT] = std::clamp(f0[RIGHT] + k[RIGHT] * ds_r, -mu_r * n_load[RIGHT], mu_r * n_load[RIGHT]);
+  f[LEFT] = std::clamp(f0[LEFT] + k[LEFT] * ds_l, -mu_l * n_load[LEFT], mu_l * n_load[LEFT]);
+  force_[RIGHT] = f[RIGHT];
+  force_[LEFT] = f[LEFT];
+  // One force for both sides of the contact: wheel and body exchange exactly the same momentum.
+  const double av = av0 + (f[RIGHT] - f0[RIGHT] + f[LEFT] - f0[LEFT]) * inv_m;
+  const double aw = aw0 + L * (f[RIGHT] - f0[RIGHT] - f[LEFT] + f0[LEFT]) * inv_i;
+  double v1 = v + h * av, w1 = w + h * aw;
+  // The coupling of eq 3.54 turns (√m v, √I w) at the rate mc d w / √(m I) and keeps their length: an
+  // exact rotation (rate frozen at the sub-step's start) conserves the kinetic energy as the ODE does.
+  if (mcd_ != 0.0) {
+    double c, sn;
+    rotateHeading(1.0, 0.0, mcd_ * w * h * inv_sqrt_mi_, c, sn);
+    const double a = sqrt_m_ * v1, b = sqrt_i_ * w1;
+    v1 = (a * c + b * sn) * inv_sqrt_m_;
+    w1 = (b * c - a * sn) * inv_sqrt_i_;
+  }
+  double rate1[2];
+  for (int i = 0; i < 2; ++i) rate1[i] = wheel_rate_[i] + h * (tau[i] - R * f[i]) * inv_iw;
+  // Kinematics (eq 3.13) with the mean velocities, heading at the sub-step's midpoint.
+  const double dtheta = 0.5 * h * (w + w1);
+  double cm, sm;
+  rotateHeading(cos_th, sin_th, 0.5 * dtheta, cm, sm);
+  const double ds = 0.5 * h * (v + v1);
+  state_[X] += ds * cm;
+  state_[Y] += ds * sm;
+  state_[THETA] += dtheta;
+  rotateHeading(cos_th, sin_th, dtheta, cos_th, sin_th);
+  state_[V] = v1;
+  state_[OMEGA] = w1;
+  state_[PHI_R] += 0.5 * h * (wheel_rate_[RIGHT] + rate1[RIGHT]);
+  state_[PHI_L] += 0.5 * h * (wheel_rate_[LEFT] + rate1[LEFT]);
+  wheel_rate_[RIGHT] = rate1[RIGHT];
+  wheel_rate_[LEFT] = rate1[LEFT];
+}
+
+}  // namespace core
+}  // namespace sowing_robot

@@ -1,0 +1,123 @@
+#include "sowing_robot/core/simulation/field_run.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+#include "sowing_robot/core/numerics/trig.h"
+#include "sowing_robot/core/planning/tool_engagement.h"
+#include "sowing_robot/core/simulation/traction_run.h"
+
+namespace sowing_robot {
+namespace core {
+
+Footprint sowingRobotFootprint() {
+  return Footprint::convexHull({{-0.26, -0.19},
+                                {0.36, -0.19},
+                                {0.36, 0.19},
+                                {-0.26, 0.19},
+                                {-0.095, -0.265},
+                                {0.095, -0.265},
+                                {0.095, 0.265},
+                                {-0.095, 0.265}});
+}
+
+FieldRunSetup::FieldRunSetup() {
+  scenario.disturbance.sinusoidal = true;
+  scenario.disturbance.mass_scale = scenario.disturbance.inertia_scale = 1.2;
+  seeding.detour_margin = 4.0;
+  field.avoidance.footprint_radius = footprint.circumscribedRadius();
+}
+
+FieldRunReport runField(const FieldRunSetup& setup) {
+  const std::string e = setup.scenario.validate();
+  if (!e.empty()) throw std::invalid_argument("Scenario: " + e);
+  // The target starts where the robot does (field/approach), as the node does with plant_sim's start.
+  FieldParams field = setup.field;
+  if (!field.start_pose) field.start_pose = setup.scenario.start;
+  FieldReference reference(field, setup.obstacles);
+  ContactMonitor contacts(setup.footprint, setup.obstacles);
+  SeedDrill drill(setup.seeding, rowsOf(setup.field),
+                  setup.scoring_obstacles.empty() ? setup.obstacles : setup.scoring_obstacles,
+                  setup.field.potential.influence_distance);
+  FieldRunReport rep;
+  TractionPlant* traction_plant = nullptr;  // with setup.traction: the plant of the run
+  ToolEngagement tool_rule(setup.seeding, rowsOf(setup.field));
+  const double dt = secondsFromNanos(setup.scenario.control_period_ns);
+  auto trace = [&](const LoopSample& s) {
+    const State& x = *s.state;
+    const Pose2D pose{x[X], x[Y], x[THETA]};
+    contacts.update(s.t, pose);
+    double sn, c;
+    sinCos(x[THETA], sn, c);
+    const Eigen::Vector2d tool(x[X] + c * setup.tool.x() - sn * setup.tool.y(),
+                               x[Y] + sn * setup.tool.x() + c * setup.tool.y());
+    Eigen::Vector2d seed;
+    drill.update(tool, s.reference->tool_down, seed);
+    // The plant's own tool rule on the state the next step starts from (as plant_sim's TractionModel).
+    if (traction_plant && setup.traction->draft_force > 0.0) {
+      traction_plant->setToolDown(tool_rule.update(tool));
+      if (traction_plant->toolDown()) rep.tool_down_time += dt;
+    }
+    const Reference& r = *s.reference;
+    if (s.t >= setup.peaks_from) {
+      rep.peak_yaw_rate = std::max(rep.peak_yaw_rate, std::fabs(x[OMEGA]));
+      rep.peak_lateral = std::max(rep.peak_lateral, std::fabs(x[V] * x[OMEGA]));
+      rep.peak_ref_yaw_rate = std::max(rep.peak_ref_yaw_rate, std::fabs(r.omega));
+      rep.peak_ref_lateral = std::max(rep.peak_ref_lateral, std::fabs(r.v * r.omega));
+      if (r.v > 0.05) rep.peak_ref_curvature = std::max(rep.peak_ref_curvature, std::fabs(r.omega) / r.v);
+    }
+    rep.max_speed = std::max(rep.max_speed, std::fabs(x[V]));
+    if (setup.on_step) setup.on_step(s.t, reference, contacts);
+  };
+  RunResult run;
+  if (setup.traction) {
+    const SoilMap soil(setup.patches);
+    const TractionRunResult tr =
+        runTractionClosedLoop(setup.scenario, *setup.traction, reference, false, trace, [&](TractionPlant& p) {
+          p.setSoil(soil);
+          p.setToolPoint(setup.tool);
+          traction_plant = &p;
+        });
+    run = tr.run;
+    rep.max_slip = tr.max_abs_slip;
+  } else {
+    run = runClosedLoop(setup.scenario, reference, false, trace);
+  }
+  rep.saturated = static_cast<long>(run.saturated_steps);
+  contacts.finish();
+  rep.min_clearance = contacts.minClearance();
+  rep.contacts = contacts.contactCount();
+  rep.events = contacts.events();
+  rep.rows = drill.onRows();
+  rep.detours = drill.detours();
+  rep.end = Eigen::Vector2d(run.final_state[X], run.final_state[Y]);
+  rep.status = reference.status();
+  rep.diverged = run.diverged;
+  return rep;
+}
+
+double approachExtraTime(const FieldRunSetup& setup) {
+  FieldParams with = setup.field;
+  if (!with.start_pose) with.start_pose = setup.scenario.start;
+  FieldParams without = with;
+  without.approach = false;
+  return FieldPath(with, setup.obstacles).duration() - FieldPath(without, setup.obstacles).duration();
+}
+
+std::string FieldRunReport::summary() const {
+  char b[600];
+  std::snprintf(b, sizeof(b),
+                "body clearance %.3f m, contacts %zu, peak yaw rate %.2f rad/s, peak lateral acceleration %.2f m/s^2 "
+                "(reference: %.2f rad/s, %.2f m/s^2, curvature %.2f 1/m), max speed %.2f m/s, seeds on rows %zu "
+                "(max %.1f mm, RMS %.1f mm), on detours %zu (max %.3f m), end (%.2f, %.2f), status %s%s%s%s%s",
+                min_clearance, contacts, peak_yaw_rate, peak_lateral, peak_ref_yaw_rate, peak_ref_lateral,
+                peak_ref_curvature, max_speed, rows.count, 1e3 * rows.max, 1e3 * rows.rms, detours.count, detours.max,
+                end.x(), end.y(), AvoidanceStatus::name(status.code), status.reason.empty() ? "" : ": ",
+                status.reason.c_str(), status.within_bounds ? "" : "; bounds not held: ", status.bounds_note.c_str());
+  return b;
+}
+
+}  // namespace core
+}  // namespace sowing_robot

@@ -1,0 +1,130 @@
+#include "sowing_robot/core/simulation/metrics.h"
+
+#include "sowing_robot/core/common/types.h"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iomanip>
+#include <limits>
+
+namespace sowing_robot {
+namespace core {
+
+void StreamingTimeDomain::result(AxisMetrics& m) const {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  m.rise_time = m.settling_time = nan;
+  m.overshoot = m.peak = 0.0;
+  if (n_ == 0) return;
+  m.peak = peak_;
+  if (!(peak_ > 0.0)) {
+    m.rise_time = m.settling_time = 0.0;
+    return;
+  }
+  m.rise_time = have_t90_ && have_t10_ ? t10_ - t90_ : nan;
+  m.settling_time = settling_;
+  m.overshoot = 100.0 * worst_ / peak_;
+}
+
+void MetricsAccumulator::reset() {
+  count_ = rejected_ = 0;
+  acc_ = {};
+  for (auto& d : time_domain_) d.reset();
+}
+
+std::array<AxisMetrics, AXIS_COUNT> MetricsAccumulator::result() const {
+  auto r = acc_;
+  if (keep_ && count_ > 0) {
+    for (int a = 0; a < AXIS_COUNT; ++a) time_domain_[a].result(r[a]);
+  } else {
+    const double nan = std::numeric_limits<double>::quiet_NaN();  // not computed, not zero
+    for (auto& m : r) m.rise_time = m.settling_time = m.overshoot = m.peak = nan;
+  }
+  return r;
+}
+
+// The definition over a stored series (the reference StreamingTimeDomain is tested against; the Python
+// module's time_domain_metrics).
+void timeDomainMetrics(const std::vector<double>& t, const std::vector<double>& e, AxisMetrics& m) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  m.rise_time = m.settling_time = nan;
+  m.overshoot = m.peak = 0.0;
+  const std::size_t n = e.size();
+  if (n == 0) return;
+  std::size_t ip = 0;
+  for (std::size_t i = 0; i < n; ++i)
+    if (std::fabs(e[i]) > std::fabs(e[ip])) ip = i;
+  const double E = std::fabs(e[ip]);
+  m.peak = E;
+  if (!(E > 0.0)) {
+    m.rise_time = m.settling_time = 0.0;
+    return;
+  }
+  double t90 = nan, t10 = nan;
+  for (std::size_t i = ip; i < n; ++i) {
+    if (std::isnan(t90) && std::fabs(e[i]) <= 0.9 * E) t90 = t[i];
+    if (std::fabs(e[i]) <= 0.1 * E) {
+      t10 = t[i];
+      break;
+    }
+  }
+  m.rise_time = std::isnan(t90) || std::isnan(t10) ? nan : t10 - t90;
+  m.settling_time = t.front();
+  for (std::size_t i = n; i-- > 0;)
+    if (std::fabs(e[i]) > 0.02 * E) {
+      m.settling_time = i + 1 < n ? t[i + 1] : t[i];
+      break;
+    }
+  const double sign = e[ip] > 0.0 ? 1.0 : -1.0;
+  double worst = 0.0;
+  for (std::size_t i = ip; i < n; ++i) worst = std::max(worst, -sign * e[i]);
+  m.overshoot = 100.0 * worst / E;
+}
+
+std::string metricsTable(const std::vector<std::string>& names,
+                         const std::vector<std::array<AxisMetrics, AXIS_COUNT>>& runs) {
+  std::string s = "| metric | axis |";
+  for (const auto& n : names) s += " " + n + " |";
+  s += "\n|---|---|";
+  for (std::size_t i = 0; i < names.size(); ++i) s += "---:|";
+  s += "\n";
+  const char* axes[AXIS_COUNT] = {"x", "y", "theta"};
+  struct Row {
+    const char* name;
+    double AxisMetrics::*field;
+  };
+  const Row rows[] = {{"ISE", &AxisMetrics::ise},
+                      {"ITSE", &AxisMetrics::itse},
+                      {"IAE", &AxisMetrics::iae},
+                      {"ITAE", &AxisMetrics::itae},
+                      {"rise time [s]", &AxisMetrics::rise_time},
+                      {"settling time [s]", &AxisMetrics::settling_time},
+                      {"overshoot [%]", &AxisMetrics::overshoot}};
+  char buf[64];
+  for (const auto& row : rows)
+    for (int a = 0; a < AXIS_COUNT; ++a) {
+      s += std::string("| ") + row.name + " | " + axes[a] + " |";
+      for (const auto& r : runs) {
+        std::snprintf(buf, sizeof buf, " %.4g |", r[a].*row.field);
+        s += buf;
+      }
+      s += "\n";
+    }
+  return s;
+}
+
+bool writeMetricsYaml(const std::string& path, const std::string& label, const std::array<AxisMetrics, AXIS_COUNT>& m) {
+  std::ofstream f(path);
+  if (!f) return false;
+  f << std::setprecision(17) << label << ":\n";
+  const char* axes[] = {"x", "y", "theta"};
+  for (int a = 0; a < AXIS_COUNT; ++a) {
+    f << "  " << axes[a] << ": {ise: " << m[a].ise << ", itse: " << m[a].itse << ", iae: " << m[a].iae
+      << ", itae: " << m[a].itae << ", rise_time: " << m[a].rise_time << ", settling_time: " << m[a].settling_time
+      << ", overshoot: " << m[a].overshoot << "}\n";
+  }
+  return static_cast<bool>(f);
+}
+
+}  // namespace core
+}  // namespace sowing_robot

@@ -1,0 +1,297 @@
+#include "sowing_robot/core/simulation/runner.h"
+
+#include <cmath>
+#include <limits>
+#include <type_traits>
+
+#include "sowing_robot/core/common/validation.h"
+#include "sowing_robot/core/numerics/trig.h"
+
+namespace sowing_robot {
+namespace core {
+
+std::string Scenario::validate() const {
+  std::string e = firstError(
+      {checkPositive("duration", duration, "s"), control_period_ns > 0 ? "" : "control_period must be > 0",
+       allFinite(start.x, start.y, start.theta) ? "" : "start pose must be finite",
+       std::isfinite(disturbance_phase) ? "" : "disturbance_phase must be finite", robot.validate(),
+       disturbance.validate(), kanayama.validate(), sliding.validate(),
+       outer == OuterKind::kanayama ? "" : pure_pursuit.validate(), inner == InnerKind::pid ? pid.validate() : ""});
+  return e;
+}
+
+std::string Scenario::controllerName() const {
+  return std::string(outerName(outer)) + "+" + innerName(inner, sliding.adaptive);
+}
+
+std::int64_t Scenario::steps() const {
+  return static_cast<std::int64_t>(std::llround(duration * 1e9 / static_cast<double>(control_period_ns)));
+}
+
+namespace {
+
+// One run's state through the loop, over concrete controller types (no virtual call when they are final or
+// plain classes): Outer::compute(ref, pose, v, omega) -> VelocityCommand; Inner::update(cmd, v, omega, dt)
+// -> InnerOutput, m0Hat(), i0Hat(). Trace: the public API's std::function (may be empty), or a RunTally
+// (its add() inlined here, and what it does not read of the LoopSample never built). The one-run loop and
+// the two-run loop (runPair) step it the same way: control(k), then the plant, period after period.
+template <typename Outer, typename Inner, typename Trace>
+struct LoopRun {
+  static constexpr bool kanayama = std::is_same_v<Outer, Kanayama>;
+
+  LoopRun(const Scenario& scenario, ReferenceSource& ref, Outer& o, Inner& i, bool keep_samples, Trace& tr,
+          const RunStop& st)
+      : sc(scenario),
+        reference(ref),
+        outer(o),
+        inner(i),
+        trace(tr),
+        stop(st),
+        plant(scenario.robot, scenario.disturbance),
+        n(scenario.steps()),
+        dt(secondsFromNanos(scenario.control_period_ns)),
+        metrics(keep_samples) {
+    plant.reset(startState(sc), phaseStartTime(sc));
+    reference.reset();
+    metrics.reserve(static_cast<std::size_t>(n + 1));
+  }
+
+  /// Period k up to its torques (tau_right, tau_left, for stepPlant()). False: the run ends at k (the state
+  /// diverged, or stop() said so) and the plant must not step.
+  bool control(std::int64_t k) { return observe() && controlObserved(k); }
+
+  /// The state as the controllers receive it in nav_msgs/Odometry (pose, and with Kanayama cos/sin of its
+  /// yaw, which Kanayama needs, and so does the plant's step when the quaternion round trip gave the
+  /// heading back to the bit, about two steps in three: computed once). False: the state diverged.
+  bool observe() {
+    const State& s = plant.state();
+    if (!finiteSum(s)) {
+      result.diverged = true;
+      return false;
+    }
+    pose = Pose2D{s[X], s[Y], yawThroughQuaternion(s[THETA])};
+    if constexpr (kanayama) sinCos(pose.theta, sin_yaw, cos_yaw);
+    return true;
+  }
+
+  /// observe() of two runs, their sin/cos in two lanes (each lane the scalar's bits) when both are finite.
+  static void observePair(LoopRun& a, LoopRun& b, bool& seen_a, bool& seen_b) {
+    if constexpr (kHaveLanes2) {
+      const State &sa = a.plant.state(), &sb = b.plant.state();
+      if (finiteSum(sa) && finiteSum(sb)) {
+        a.pose = Pose2D{sa[X], sa[Y], 0.0};
+        b.pose = Pose2D{sb[X], sb[Y], 0.0};
+        yawsThroughQuaternion(sa[THETA], sb[THETA], a.pose.theta, b.pose.theta);
+        if constexpr (kanayama) {
+          Lanes2 s, c;
+          sinCos(Lanes2(a.pose.theta, b.pose.theta), s, c);
+          a.sin_yaw = s.first();
+          a.cos_yaw = c.first();
+          b.sin_yaw = s.second();
+          b.cos_yaw = c.second();
+        }
+        seen_a = seen_b = true;
+        return;
+      }
+    }
+    seen_a = a.observe();
+    seen_b = b.observe();
+  }
+
+  /// control(k) after observe().
+  bool controlObserved(std::int64_t k) {
+    const double t = secondsFromNanos(k * sc.control_period_ns);
+    const State& s = plant.state();
+    const Reference& ref = reference.next(t);  // the source's copy, valid until the next call
+    double ex, ey, eth;
+    worldErrors(ref, pose, ex, ey, eth);
+    metrics.add(t, ex, ey, eth);
+    // Initialised from the call (not assigned): the controller writes the command in place.
+    const VelocityCommand cmd = [&] {
+      if constexpr (kanayama)
+        return outer.compute(ref, pose, cos_yaw, sin_yaw, s[V], s[OMEGA]);
+      else
+        return outer.compute(ref, pose, s[V], s[OMEGA]);
+    }();
+    // A local, not a member: assigned to one, the result would be copied 16 bytes at a time out of
+    // fields just stored 8 bytes at a time (store-forwarding stalls); the torques are taken field by field.
+    const InnerOutput u = inner.update(cmd, s[V], s[OMEGA], dt);
+    if (u.saturated) ++result.saturated_steps;
+    if constexpr (std::is_same_v<Trace, RunTally>)
+      trace.add({t, &s, &ref, &cmd, &u, inner.m0Hat(), inner.i0Hat(), ex, ey, eth});
+    else if (trace)
+      trace({t, &s, &ref, &cmd, &u, inner.m0Hat(), inner.i0Hat(), ex, ey, eth});
+    result.periods = k;
+    if (stop && k % kStopCheckEvery == kStopCheckEvery - 1 && k < n && stop(metrics)) {
+      result.stopped = true;
+      return false;
+    }
+    tau_right = u.torques.right;
+    tau_left = u.torques.left;
+    return true;
+  }
+
+  /// The plant's step with this period's torques.
+  void stepPlant() {
+    if constexpr (kanayama)
+      plant.step(tau_right, tau_left, dt, pose.theta, cos_yaw, sin_yaw);
+    else
+      plant.step(tau_right, tau_left, dt);
+  }
+  /// The same, as Plant::stepPair's input (a heading that matches no state without Kanayama's cos/sin).
+  Plant::HeadingStep headingStep() const {
+    if constexpr (kanayama)
+      return {tau_right, tau_left, pose.theta, cos_yaw, sin_yaw};
+    else
+      return {tau_right, tau_left, std::numeric_limits<double>::quiet_NaN(), 0.0, 0.0};
+  }
+
+  /// Periods from `from` to the end (or to an earlier end of the run).
+  void runFrom(std::int64_t from) {
+    for (std::int64_t k = from; k <= n; ++k) {
+      if (!control(k)) break;
+      if (k < n) stepPlant();
+    }
+  }
+
+  RunResult finish() {
+    closeRun(result, plant.state(), metrics);
+    return result;
+  }
+
+  const Scenario& sc;
+  ReferenceSource& reference;
+  Outer& outer;
+  Inner& inner;
+  Trace& trace;
+  const RunStop& stop;
+  Plant plant;
+  const std::int64_t n;
+  const double dt;
+  MetricsAccumulator metrics;
+  RunResult result;
+  Pose2D pose;
+  double cos_yaw = 0.0, sin_yaw = 0.0;
+  double tau_right = 0.0, tau_left = 0.0;
+};
+
+template <typename Outer, typename Inner, typename Trace>
+RunResult loop(const Scenario& sc, ReferenceSource& reference, Outer& outer, Inner& inner, bool keep_samples,
+               Trace& trace, const RunStop& stop) {
+  LoopRun<Outer, Inner, Trace> run(sc, reference, outer, inner, keep_samples, trace, stop);
+  run.runFrom(0);
+  return run.finish();
+}
+
+// Two runs of the same length and period in lockstep: each period's control for one, then the other, then
+// both plants in one Plant::stepPair. When one run ends early (diverged), the other goes on alone. Each
+// result is the one-run loop's to the bit: the same calls in the same order for each run.
+template <typename Outer, typename Inner>
+std::array<RunResult, 2> loopPair(LoopRun<Outer, Inner, RunTally>& a, LoopRun<Outer, Inner, RunTally>& b) {
+  const std::int64_t n = a.n;
+  for (std::int64_t k = 0; k <= n; ++k) {
+    bool seen_a, seen_b;
+    LoopRun<Outer, Inner, RunTally>::observePair(a, b, seen_a, seen_b);
+    const bool go_a = seen_a && a.controlObserved(k), go_b = seen_b && b.controlObserved(k);
+    if (!(go_a && go_b)) {
+      for (auto* run : {&a, &b}) {
+        if (!(run == &a ? go_a : go_b)) continue;
+        if (k < n) run->stepPlant();
+        run->runFrom(k + 1);
+      }
+      break;
+    }
+    if (k < n) Plant::stepPair(a.plant, a.headingStep(), b.plant, b.headingStep(), a.dt);
+  }
+  return {a.finish(), b.finish()};
+}
+
+template <typename Outer, typename Trace>
+RunResult withInner(const Scenario& sc, ReferenceSource& reference, Outer& outer, bool keep_samples, Trace& trace,
+                    const RunStop& stop) {
+  if (sc.inner == InnerKind::pid) {
+    InnerAdapter<WheelPid> pid{WheelPid(sc.pid, sc.robot)};
+    return loop(sc, reference, outer, pid, keep_samples, trace, stop);
+  }
+  SlidingModeController smc(sc.sliding, sc.robot);
+  return loop(sc, reference, outer, smc, keep_samples, trace, stop);
+}
+
+template <typename Trace>
+RunResult withOuter(const Scenario& sc, ReferenceSource& reference, bool keep_samples, Trace& trace,
+                    const RunStop& stop) {
+  if (sc.outer == OuterKind::kanayama) {
+    Kanayama kanayama(sc.kanayama);
+    return withInner(sc, reference, kanayama, keep_samples, trace, stop);
+  }
+  PurePursuit pursuit(sc.pure_pursuit, sc.outer == OuterKind::rpp);
+  return withInner(sc, reference, pursuit, keep_samples, trace, stop);
+}
+
+template <typename Outer, typename Inner>
+std::array<RunResult, 2> pairOf(const Scenario& sa, ReferenceSource& ra, RunTally& ta, Outer& oa, Inner& ia,
+                                const Scenario& sb, ReferenceSource& rb, RunTally& tb, Outer& ob, Inner& ib,
+                                bool keep_samples) {
+  const RunStop none;
+  LoopRun<Outer, Inner, RunTally> a(sa, ra, oa, ia, keep_samples, ta, none);
+  LoopRun<Outer, Inner, RunTally> b(sb, rb, ob, ib, keep_samples, tb, none);
+  return loopPair(a, b);
+}
+
+template <typename Outer>
+std::array<RunResult, 2> pairWithInner(const Scenario& sa, ReferenceSource& ra, RunTally& ta, Outer& oa,
+                                       const Scenario& sb, ReferenceSource& rb, RunTally& tb, Outer& ob,
+                                       bool keep_samples) {
+  if (sa.inner == InnerKind::pid) {
+    InnerAdapter<WheelPid> pa{WheelPid(sa.pid, sa.robot)}, pb{WheelPid(sb.pid, sb.robot)};
+    return pairOf(sa, ra, ta, oa, pa, sb, rb, tb, ob, pb, keep_samples);
+  }
+  SlidingModeController ca(sa.sliding, sa.robot), cb(sb.sliding, sb.robot);
+  return pairOf(sa, ra, ta, oa, ca, sb, rb, tb, ob, cb, keep_samples);
+}
+
+}  // namespace
+
+RunResult runClosedLoop(const Scenario& sc, ReferenceSource& reference, bool keep_samples,
+                        const std::function<void(const LoopSample&)>& trace, const RunStop& stop) {
+  return withOuter(sc, reference, keep_samples, trace, stop);
+}
+
+RunResult runClosedLoop(const Scenario& sc, ReferenceSource& reference, bool keep_samples, RunTally& tally) {
+  return withOuter(sc, reference, keep_samples, tally, RunStop{});
+}
+
+std::array<RunResult, 2> runClosedLoopPair(const Scenario& a, ReferenceSource& reference_a, RunTally& tally_a,
+                                           const Scenario& b, ReferenceSource& reference_b, RunTally& tally_b,
+                                           bool keep_samples) {
+  // In lockstep only runs of one shape: the same controller types, period and number of periods.
+  if (!(a.outer == b.outer && a.inner == b.inner && a.control_period_ns == b.control_period_ns &&
+        a.steps() == b.steps()))
+    return {runClosedLoop(a, reference_a, keep_samples, tally_a), runClosedLoop(b, reference_b, keep_samples, tally_b)};
+  if (a.outer == OuterKind::kanayama) {
+    Kanayama ka(a.kanayama), kb(b.kanayama);
+    return pairWithInner(a, reference_a, tally_a, ka, b, reference_b, tally_b, kb, keep_samples);
+  }
+  PurePursuit pa(a.pure_pursuit, a.outer == OuterKind::rpp), pb(b.pure_pursuit, b.outer == OuterKind::rpp);
+  return pairWithInner(a, reference_a, tally_a, pa, b, reference_b, tally_b, pb, keep_samples);
+}
+
+RunResult runClosedLoop(const Scenario& sc, ReferenceSource& reference, OuterController& outer, InnerController& inner,
+                        bool keep_samples, const std::function<void(const LoopSample&)>& trace, const RunStop& stop) {
+  outer.reset();
+  inner.reset();
+  return loop(sc, reference, outer, inner, keep_samples, trace, stop);
+}
+
+std::unique_ptr<OuterController> makeOuterController(const Scenario& sc) {
+  if (sc.outer == OuterKind::kanayama) return std::make_unique<OuterAdapter<Kanayama>>(Kanayama(sc.kanayama));
+  return std::make_unique<OuterAdapter<PurePursuit>>(PurePursuit(sc.pure_pursuit, sc.outer == OuterKind::rpp));
+}
+
+std::unique_ptr<InnerController> makeInnerController(const Scenario& sc) {
+  if (sc.inner == InnerKind::pid) return std::make_unique<InnerAdapter<WheelPid>>(WheelPid(sc.pid, sc.robot));
+  return std::make_unique<InnerAdapter<SlidingModeController>>(SlidingModeController(sc.sliding, sc.robot));
+}
+
+}  // namespace core
+}  // namespace sowing_robot

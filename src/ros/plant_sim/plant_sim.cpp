@@ -1,0 +1,138 @@
+#include "sowing_robot/ros/plant_sim/plant_sim.h"
+
+#include <cmath>
+
+#include "sowing_robot/core/common/validation.h"
+#include "sowing_robot/ros/common/component_params.h"
+#include "sowing_robot/ros/common/urdf_params.h"
+#include "sowing_robot/ros/plant_sim/lockstep.h"
+#include "sowing_robot/ros/plant_sim/realtime.h"
+#include "sowing_robot/ros/plant_sim/traction.h"
+
+namespace sowing_robot {
+
+namespace {
+/// The draft's tool: the seed drill's tool point (URDF link `seed_drill/tool_link`) and its lowering rule
+/// (`seed_drill/engage_distance`), read where sim.launch loads config/seed_drill.yaml (the run's
+/// namespace), so the plant's "tool down" is the drill's. "" or one line naming the bad key.
+std::string loadToolSettings(const ros::NodeHandle& nh, const std::string& urdf, TractionModel::Config& out) {
+  std::string link = "tool_link";
+  nh.param<std::string>("seed_drill/tool_link", link, link);
+  double engage = out.seeding.engage_distance;
+  nh.param("seed_drill/engage_distance", engage, engage);
+  if (!(engage > 0.0) || !std::isfinite(engage))
+    return "parameter " + nh.resolveName("seed_drill/engage_distance") + " must be finite and > 0 (the draft's tool)";
+  out.seeding.engage_distance = engage;
+  double x = 0.0, y = 0.0;
+  const std::string e = linkPositionFromUrdf(urdf, link, x, y);
+  if (!e.empty()) return "the draft's tool point (seed_drill/tool_link): " + e;
+  out.tool = Eigen::Vector2d(x, y);
+  return "";
+}
+}  // namespace
+
+PlantSim::PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh) {
+  ParamReader p(pnh);
+  core::RobotParams robot;
+  p.allow("robot_description");  // a private URDF may override the global one
+  const std::string robot_error = loadRobotParams(pnh, robot);
+  const core::RunSettings run = loadRunSettings(nh, p);
+  core::PlantSimSettings settings;
+  loadTable(p, core::PlantSimSettings::table(), settings);
+  // traction/... and field/patches: validated even when traction is off, so a bad value never waits for
+  // the day it is switched on.
+  TractionModel::Config traction;
+  loadTable(p, core::tractionTable(), traction.traction);
+  std::vector<core::SoilPatch> patches;
+  const std::string patch_error = loadSoilPatches(p, "field/patches", traction.traction, patches);
+  core::SensorParams sensors;
+  loadTable(p, core::sensorsTable(), sensors);
+  // The body checked for contacts is the URDF's collision footprint (the one source of the robot's shape).
+  core::Footprint footprint;
+  std::string key, xml, footprint_error;
+  if (robot_error.empty() && pnh.searchParam("robot_description", key) && pnh.getParam(key, xml))
+    footprint_error = footprintFromUrdf(xml, footprint);
+  const std::string tool_error = traction.traction.enabled && traction.traction.draft_force > 0.0 && robot_error.empty()
+                                     ? loadToolSettings(nh, xml, traction)
+                                     : "";
+  requireValid(p, core::firstError({robot_error, robot_error.empty() ? robot.validate() : "", footprint_error,
+                                    settings.validate(), traction.traction.validate(), patch_error, tool_error,
+                                    sensors.validate()}));
+  cfg_.lockstep = run.lockstep;
+  cfg_.period_ns = run.periodNs();
+  cfg_.duration = run.duration;
+  cfg_.realtime_factor = settings.realtime_factor;
+  cfg_.torque_timeout = settings.torque_timeout;
+  cfg_.publish_rate = settings.publish_rate;
+  cfg_.clock_rate = settings.clock_rate;
+  cfg_.lockstep_retry = settings.lockstep_retry;
+  cfg_.lockstep_timeout = settings.lockstep_timeout;
+  cfg_.lockstep_give_up = settings.lockstep_give_up;
+  cfg_.min_subscribers = settings.min_subscribers;
+  cfg_.wait_for = settings.waitForNames();
+  cfg_.loop_on_odom = settings.loop_topic == "odom";
+  cfg_.startup_delay = settings.startup_delay;
+  cfg_.max_speed = settings.max_speed;
+  cfg_.exit_at_end = settings.exit_at_end;
+  const core::Pose2D start = run.start();
+  const core::PlantDisturbance& disturbance = settings.disturbance;
+
+  SimulatedPlant::Rates rates;
+  rates.period_ns = cfg_.period_ns;
+  rates.publish_rate = cfg_.publish_rate;
+  rates.clock_rate = cfg_.clock_rate;
+  rates.max_speed = cfg_.max_speed;
+  rates.odom_frame = run.odom_frame;
+  rates.base_frame = run.base_frame;
+  std::unique_ptr<PlantModel> model;
+  if (traction.traction.enabled) {
+    traction.soil = core::SoilMap(patches);  // validated above
+    traction.odom_frame = run.odom_frame;
+    try {
+      model = std::make_unique<TractionModel>(nh, robot, disturbance, SimulatedPlant::restAt(start), traction);
+    } catch (const std::invalid_argument& e) {
+      refuseToStart(e.what());
+    }
+  } else if (!patches.empty()) {
+    ROS_WARN("plant_sim: %zu soil patch(es) in field/patches have no effect: traction/enabled is false",
+             patches.size());
+  }
+  plant_ = std::make_unique<SimulatedPlant>(nh, robot, disturbance, start, rates, footprint, std::move(model), sensors);
+  const PlantModel& plant = plant_->model();
+  logSettings("plant_sim", core::RunSettings::table(), run, "run/");
+  logSettings("plant_sim", core::PlantSimSettings::table(), settings);
+  logSettings("plant_sim", core::sensorsTable(), sensors);
+  if (traction.traction.enabled) {
+    logSettings("plant_sim", core::tractionTable(), traction.traction);
+    ROS_INFO("plant_sim: traction plant with %zu soil patch(es); tool point (%.3f, %.3f) m", patches.size(),
+             traction.tool.x(), traction.tool.y());
+  }
+  ROS_INFO("plant_sim: m0 %.4f kg (true %.4f), I0 %.5f kg m^2 (true %.5f)", robot.m0(), plant.trueM0(), robot.I0(),
+           plant.trueI0());
+
+  if (cfg_.lockstep) {
+    LockstepDriver::Config c;
+    c.timing.retry = cfg_.lockstep_retry;
+    c.timing.timeout = cfg_.lockstep_timeout;
+    c.timing.give_up = cfg_.lockstep_give_up;
+    c.timing.startup_delay = cfg_.startup_delay;
+    c.duration = cfg_.duration;
+    c.min_subscribers = cfg_.min_subscribers;
+    c.wait_for = cfg_.wait_for;
+    c.loop_on_odom = cfg_.loop_on_odom;
+    driver_ = std::make_unique<LockstepDriver>(nh, *plant_, c);
+  } else {
+    RealtimeDriver::Config c;
+    c.realtime_factor = cfg_.realtime_factor;
+    c.torque_timeout = cfg_.torque_timeout;
+    driver_ = std::make_unique<RealtimeDriver>(nh, *plant_, c);
+  }
+}
+
+PlantSim::~PlantSim() = default;
+
+void PlantSim::run() { driver_->run(); }
+
+void PlantSim::stop() { driver_->stop(); }
+
+}  // namespace sowing_robot

@@ -1,0 +1,313 @@
+// The in-process loop with an estimate in it (core/simulation/estimated_run.h) and the benchmark rows built on it
+// (core/evaluation/estimated_bench.h): fed the truth it is runClosedLoop / runTractionClosedLoop bit for bit; fed
+// the EKF on the line its error stays bounded; fed the encoders it drifts under slip; the sensors' seed
+// changes the sensor noise and nothing else; a benchmark row through it equals today's row; a robot that
+// stalls on the patch is counted as not finished.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+
+#include "sowing_robot/core/evaluation/benchmark.h"
+#include "sowing_robot/core/evaluation/estimated_bench.h"
+#include "sowing_robot/core/simulation/estimated_run.h"
+#include "sowing_robot/core/simulation/traction_run.h"
+
+using namespace sowing_robot::core;
+
+namespace {
+
+/// The thesis line with the mismatch, the disturbance (and a phase) and the wheel-torque noise: every input
+/// the truth-fed loop must reproduce.
+Scenario line(OuterKind outer, InnerKind inner, bool adaptive = true, double phase = 0.7) {
+  Scenario sc;
+  sc.duration = 6.0;
+  sc.outer = outer;
+  sc.inner = inner;
+  sc.sliding.adaptive = adaptive;
+  sc.disturbance.sinusoidal = true;
+  sc.disturbance.amplitude = 1.0;
+  sc.disturbance.mass_scale = 1.3;
+  sc.disturbance.inertia_scale = 0.9;
+  sc.disturbance.noise_std = 0.1;
+  sc.disturbance.seed = 7;
+  sc.disturbance_phase = phase;
+  return sc;
+}
+
+bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+void expectSameRun(const RunResult& a, const RunResult& b) {
+  for (int ax = 0; ax < AXIS_COUNT; ++ax) {
+    EXPECT_TRUE(sameBits(a.metrics[ax].ise, b.metrics[ax].ise))
+        << ax << ": " << a.metrics[ax].ise << " vs " << b.metrics[ax].ise;
+    EXPECT_TRUE(sameBits(a.metrics[ax].itae, b.metrics[ax].itae)) << ax;
+    EXPECT_TRUE(sameBits(a.metrics[ax].iae, b.metrics[ax].iae)) << ax;
+  }
+  for (int i = 0; i < a.final_state.size(); ++i)
+    EXPECT_TRUE(sameBits(a.final_state[i], b.final_state[i]))
+        << i << ": " << a.final_state[i] << " vs " << b.final_state[i];
+  EXPECT_EQ(a.saturated_steps, b.saturated_steps);
+  EXPECT_EQ(a.periods, b.periods);
+  EXPECT_EQ(a.diverged, b.diverged);
+}
+
+}  // namespace
+
+TEST(EstimatedRun, FedTheTruthItIsRunClosedLoopBitForBit) {
+  for (auto pair : {std::make_tuple(OuterKind::kanayama, InnerKind::sliding_mode, true),
+                    std::make_tuple(OuterKind::kanayama, InnerKind::sliding_mode, false),
+                    std::make_tuple(OuterKind::kanayama, InnerKind::pid, true),
+                    std::make_tuple(OuterKind::rpp, InnerKind::pid, true),
+                    std::make_tuple(OuterKind::rpp, InnerKind::sliding_mode, true),
+                    std::make_tuple(OuterKind::pure_pursuit, InnerKind::sliding_mode, true)}) {
+    const Scenario sc = line(std::get<0>(pair), std::get<1>(pair), std::get<2>(pair));
+    SCOPED_TRACE(sc.controllerName());
+    LineReference ref;
+    const RunResult today = runClosedLoop(sc, ref, true);
+    EstimatedRunConfig cfg;  // ground_truth, no traction; the sensors run and are not looked at
+    const EstimatedRunResult est = runEstimatedLoop(sc, cfg, ref, true);
+    expectSameRun(est.run, today);
+    EXPECT_TRUE(sameBits(est.run.metrics[AXIS_Y].settling_time, today.metrics[AXIS_Y].settling_time));
+    EXPECT_LT(est.fed_error_max, 1e-12);  // the truth itself
+  }
+}
+
+TEST(EstimatedRun, FedTheTruthOnTheTractionPlantItIsRunTractionClosedLoopBitForBit) {
+  Scenario sc = line(OuterKind::kanayama, InnerKind::sliding_mode, true, 0.0);  // that loop has no phase
+  TractionParams t;
+  t.enabled = true;
+  t.mu_peak = 0.35;
+  t.mu_slide = 0.26;
+  SoilPatch wet;
+  wet.polygon = {{-5.0, -5.0}, {0.0, -5.0}, {0.0, 10.0}, {-5.0, 10.0}};  // round the start (x = -1)
+  wet.mu_peak = 0.2;
+  wet.mu_slide = 0.15;
+  wet.rolling_resistance =
+      0.15;  // soft: the patch changes the run (within the curve's linear part grip alone would not)
+  LineReference ref;
+  const TractionRunResult today =
+      runTractionClosedLoop(sc, t, ref, true, {}, [&](TractionPlant& p) { p.setSoil(SoilMap({wet})); });
+  EstimatedRunConfig cfg;
+  cfg.traction = t;
+  cfg.patches = {wet};
+  const EstimatedRunResult est = runEstimatedLoop(sc, cfg, ref, true);
+  expectSameRun(est.run, today.run);
+  EXPECT_TRUE(sameBits(est.max_abs_slip, today.max_abs_slip));
+  EXPECT_GT(est.max_abs_slip, 0.0);
+  // The patch is on the ground (without it the run differs).
+  EstimatedRunConfig bare = cfg;
+  bare.patches.clear();
+  EXPECT_FALSE(sameBits(runEstimatedLoop(sc, bare, ref, true).run.metrics[AXIS_X].ise, today.run.metrics[AXIS_X].ise));
+}
+
+TEST(EstimatedRun, FedTheEkfOnTheLineItsErrorStaysBounded) {
+  const Scenario sc = line(OuterKind::kanayama, InnerKind::sliding_mode, true, 0.0);
+  Scenario longer = sc;
+  longer.duration = 25.0;
+  EstimatedRunConfig cfg;
+  cfg.feedback = Feedback::fused;
+  LineReference ref;
+  const EstimatedRunResult est = runEstimatedLoop(longer, cfg, ref, false);
+  ASSERT_FALSE(est.run.diverged);
+  // The fix (sigma 2 cm at 10 Hz) bounds the estimate: a few centimetres, not metres.
+  EXPECT_LT(est.fed_error_rms, 0.03) << est.fed_error_max;
+  EXPECT_LT(est.fed_error_max, 0.10);
+  EXPECT_GT(est.fed_error_rms, 1e-4);  // it is an estimate, not the truth
+  EXPECT_GT(est.fixes.applied, 200);
+  // Scored on the truth: the row is held to centimetres.
+  EXPECT_LT(std::fabs(est.run.final_state[Y] - 3.0), 0.1);
+  // The truth's ISE y is today's order of magnitude (not a lost loop).
+  const RunResult truth = runClosedLoop(longer, ref, false);
+  EXPECT_LT(est.run.metrics[AXIS_Y].ise, 2.0 * truth.metrics[AXIS_Y].ise + 0.5);
+}
+
+TEST(EstimatedRun, OdometryDriftsUnderSlipAndNotWithout) {
+  Scenario sc = line(OuterKind::kanayama, InnerKind::sliding_mode, true, 0.0);
+  sc.duration = 10.0;
+  LineReference ref;
+  EstimatedRunConfig dry;  // no-slip plant: only the quantisation
+  const EstimatedRunResult a = runEstimatedLoop(sc, dry, ref, false);
+  EXPECT_LT(a.odometry_error_max, 0.02);
+  EstimatedRunConfig wet;
+  TractionParams t;
+  t.enabled = true;
+  t.mu_peak = 0.2;
+  t.mu_slide = 0.15;
+  wet.traction = t;
+  const EstimatedRunResult b = runEstimatedLoop(sc, wet, ref, false);
+  EXPECT_GT(b.max_abs_slip, 0.1);
+  EXPECT_GT(b.odometry_error_max, 10.0 * a.odometry_error_max);
+  EXPECT_GT(b.odometry_error_max, 0.05);
+  // Fed that odometry, the loop sees it and the truth pays.
+  wet.feedback = Feedback::odometry;
+  const EstimatedRunResult c = runEstimatedLoop(sc, wet, ref, false);
+  EXPECT_GT(c.fed_error_max, 0.05);
+}
+
+TEST(EstimatedRun, TheSensorSeedChangesTheSensorNoiseOnly) {
+  const Scenario sc = line(OuterKind::kanayama, InnerKind::sliding_mode, true, 0.0);
+  LineReference ref;
+  EstimatedRunConfig cfg;
+  cfg.sensors.encoder.noise = 0.3;  // every sensor draws
+  cfg.sensors.seed = 1;
+  const EstimatedRunResult t1 = runEstimatedLoop(sc, cfg, ref, false);
+  cfg.sensors.seed = 2;
+  const EstimatedRunResult t2 = runEstimatedLoop(sc, cfg, ref, false);
+  // Fed the truth: the run is the same whatever the sensors draw; the odometry is not.
+  expectSameRun(t1.run, t2.run);
+  EXPECT_FALSE(sameBits(t1.odometry_error_max, t2.odometry_error_max));
+  // Fed the estimate: the seed changes the run, and the same seed repeats it to the bit.
+  cfg.feedback = Feedback::fused;
+  cfg.sensors.seed = 1;
+  const EstimatedRunResult f1 = runEstimatedLoop(sc, cfg, ref, false);
+  const EstimatedRunResult f1again = runEstimatedLoop(sc, cfg, ref, false);
+  cfg.sensors.seed = 2;
+  const EstimatedRunResult f2 = runEstimatedLoop(sc, cfg, ref, false);
+  expectSameRun(f1.run, f1again.run);
+  EXPECT_TRUE(sameBits(f1.fed_error_rms, f1again.fed_error_rms));
+  EXPECT_FALSE(sameBits(f1.run.metrics[AXIS_Y].ise, f2.run.metrics[AXIS_Y].ise));
+  EXPECT_FALSE(sameBits(f1.fed_error_rms, f2.fed_error_rms));
+}
+
+TEST(EstimatedRun, BadParametersAreRefusedNamingTheKey) {
+  const Scenario sc = line(OuterKind::kanayama, InnerKind::sliding_mode);
+  LineReference ref;
+  EstimatedRunConfig cfg;
+  cfg.sensors.fix.sigma = -1.0;
+  try {
+    runEstimatedLoop(sc, cfg, ref);
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("sensors/fix/sigma"), std::string::npos) << e.what();
+  }
+  cfg = EstimatedRunConfig();
+  TractionParams t;
+  t.mu_slide = 0.9;  // > mu_peak
+  cfg.traction = t;
+  EXPECT_THROW(runEstimatedLoop(sc, cfg, ref), std::invalid_argument);
+  Feedback f;
+  EXPECT_NE(parseFeedback("fusde", f).find("ground_truth, odometry, fused"), std::string::npos);
+  EXPECT_EQ(parseFeedback("odometry", f), "");
+  EXPECT_EQ(f, Feedback::odometry);
+}
+
+namespace {
+BenchScenario benchLine() {
+  BenchScenario b;
+  b.name = "line";
+  b.base.duration = 6.0;
+  b.base.disturbance.frequency = 3.0;
+  b.spec.settle_time = 3.0;
+  return b;
+}
+
+/// A 12 m row with an obstacle at x = 6 (the loader test's short field), from the row start.
+BenchScenario benchField() {
+  BenchScenario b;
+  b.name = "field";
+  b.track = TrackKind::field;
+  b.base.duration = 22.0;
+  b.base.start = {0.0, 3.0, 0.0};
+  b.field = FieldRunSetup().field;
+  b.field.rows = 1;
+  b.field.row_length = 12.0;
+  b.field.start_y = 3.0;
+  b.field.potential.beta = 4.0;
+  b.obstacles = {Obstacle{6.0, 3.0, 0.3}};
+  b.spec.start_dx = b.spec.start_dy = b.spec.start_dtheta = Uniform{0.0, 0.0};
+  b.spec.amplitude = Uniform{0.0, 0.0};
+  b.spec.cross_track_threshold = 10.0;
+  b.spec.settle_time = 2.0;
+  return b;
+}
+
+void expectSameRows(const std::vector<RunRow>& a, const std::vector<RunRow>& b) {
+  ASSERT_EQ(a.size(), b.size());
+  // The CSV carries every figure at full precision: equal lines, equal rows.
+  EXPECT_EQ(runsCsvLines("s", "c", a), runsCsvLines("s", "c", b));
+  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a[i].cross_track_series, b[i].cross_track_series) << i;
+}
+}  // namespace
+
+TEST(EstimatedBench, ATruthFedRowWithoutTractionIsTodaysRow) {
+  for (BenchScenario b : {benchLine(), benchField()}) {
+    SCOPED_TRACE(b.name);
+    const std::vector<RunRow> today = runBenchmark(b, 3, 2);
+    b.realism = EstimatedRunConfig();
+    const std::vector<RunRow> through = runBenchmark(b, 3, 2);
+    expectSameRows(through, today);
+    EXPECT_TRUE(through[0].realism);
+    EXPECT_FALSE(today[0].realism);
+    // The realism columns only when asked; today's columns byte for byte otherwise.
+    EXPECT_EQ(runsCsvHeader().find("sensor_seed"), std::string::npos);
+    EXPECT_NE(runsCsvHeader(true).find(",sensor_seed,max_slip,"), std::string::npos);
+  }
+}
+
+TEST(EstimatedBench, TheSensorSeedIsANewDrawThatLeavesTheOthersAlone) {
+  const BenchScenario b = benchLine();
+  const RunDraw d0 = drawRun(b.spec, b.base, 0), d1 = drawRun(b.spec, b.base, 1);
+  EXPECT_NE(d0.sensor_seed, d1.sensor_seed);
+  EXPECT_LE(d0.sensor_seed, 2147483647u);
+  EXPECT_NE(d0.sensor_seed, d0.noise_seed);
+  // Fused runs repeat alone from their draws, on one or two threads.
+  BenchScenario f = benchLine();
+  EstimatedRunConfig cfg;
+  cfg.feedback = Feedback::fused;
+  f.realism = cfg;
+  f.requires_models = {"estimated_pose"};
+  const std::vector<RunRow> one = runBenchmark(f, 3, 1), two = runBenchmark(f, 3, 2);
+  expectSameRows(one, two);
+  EXPECT_EQ(estimatedBenchRow(f, 2).fed_error_rms, one[2].fed_error_rms);
+  // Run 2's sensors are seeded by its draw 8: the same run alone with that seed, not with the table's seed 1.
+  const RunDraw d2 = drawRun(f.spec, f.base, 2);
+  EstimatedRunConfig alone = cfg;
+  alone.sensors.seed = d2.sensor_seed;
+  LineReference ref(f.line_v_r, f.line_y, f.line_x0);
+  EXPECT_EQ(runEstimatedLoop(applyDraw(f.base, f.spec, d2), alone, ref, false).fed_error_rms, one[2].fed_error_rms);
+  alone.sensors.seed = 1;
+  EXPECT_NE(runEstimatedLoop(applyDraw(f.base, f.spec, d2), alone, ref, false).fed_error_rms, one[2].fed_error_rms);
+  EXPECT_GT(one[0].fed_error_rms, 0.0);
+  EXPECT_NE(runsCsvLines("s", "c", one, true).find("," + std::to_string(d0.sensor_seed) + ","), std::string::npos);
+}
+
+TEST(EstimatedBench, RequiredModelsMustBeSwitchedOn) {
+  BenchScenario b = benchLine();
+  b.requires_models = {"wet_soil"};
+  EXPECT_NE(b.validate().find("traction is not enabled"), std::string::npos) << b.validate();
+  b.requires_models = {"estimated_pose"};
+  EXPECT_NE(b.validate().find("feedback is ground_truth"), std::string::npos) << b.validate();
+  b.realism = EstimatedRunConfig();
+  b.realism->feedback = Feedback::fused;
+  EXPECT_EQ(b.validate(), "");
+  b.requires_models = {"dry_soil"};
+  EXPECT_NE(b.validate().find("dry_soil"), std::string::npos);
+}
+
+TEST(EstimatedBench, ARobotThatStallsOnThePatchIsNotFinished) {
+  BenchScenario b = benchField();
+  b.obstacles.clear();
+  EstimatedRunConfig cfg;
+  TractionParams t;
+  t.enabled = true;
+  t.draft_force = 60.0;  // a furrow opener in heavy soil
+  cfg.traction = t;
+  const std::vector<RunRow> dry = runBenchmark(b, 1, 1);
+  b.realism = cfg;
+  const std::vector<RunRow> grip = runBenchmark(b, 1, 1);
+  EXPECT_TRUE(grip[0].success) << grip[0].failure;  // on loose moist soil the draft is pulled
+  // Ice over the second half of the row: the wheels spin, the robot stops short of the end.
+  SoilPatch ice;
+  ice.polygon = {{6.0, 0.0}, {20.0, 0.0}, {20.0, 6.0}, {6.0, 6.0}};
+  ice.mu_peak = 0.05;
+  ice.mu_slide = 0.04;
+  b.realism->patches = {ice};
+  const std::vector<RunRow> stall = runBenchmark(b, 1, 1);
+  EXPECT_TRUE(dry[0].success) << dry[0].failure;
+  EXPECT_FALSE(stall[0].success);
+  EXPECT_EQ(stall[0].failure, "not finished");
+  EXPECT_GT(stall[0].end_distance, 1.0);
+  EXPECT_GT(stall[0].max_slip, 0.5);
+  EXPECT_GT(stall[0].tool_down_time, 0.0);
+}
