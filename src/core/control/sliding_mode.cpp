@@ -5,7 +5,6 @@
 #include <stdexcept>
 
 #include "sowing_robot/core/common/validation.h"
-#include "sowing_robot/core/numerics/cube_root.h"
 
 namespace sowing_robot {
 namespace core {
@@ -21,7 +20,7 @@ double powerOfRoot(double root, int num, bool negative) {
 
 double realPower(double x, int num, int den) {
   // the thesis's 5/3 and 2/3: a cube root and integer multiplications beat pow ~4x
-  if (den == 3) return powerOfRoot(cubeRoot(std::fabs(x)), num, x < 0.0);
+  if (den == 3) return powerOfRoot(std::cbrt(std::fabs(x)), num, x < 0.0);
   const double mag = std::pow(std::fabs(x), static_cast<double>(num) / den);
   return (num % 2 == 0 || x >= 0.0) ? mag : -mag;
 }
@@ -134,7 +133,7 @@ inline void SlidingModeController::surface(Channel& c, double e, double xd_dot, 
   // singularity); only its own derivative would be unbounded there, and that never enters the law.
   double power_p, power_p_minus_q;  // (int e)^(p/q) and (int e)^((p-q)/q)
   if (params_.q == 3) {             // one cube root serves both powers (same values as realPower)
-    const double root = cubeRoot(std::fabs(c.integral));
+    const double root = std::cbrt(std::fabs(c.integral));
     // powerOfRoot's products, shared: root^p is root^(p-q) times root, q more times, in that order.
     const int p_minus_q = params_.p - params_.q;
     double mag = 1.0;

@@ -54,38 +54,13 @@ RunRow measure(const Scenario& sc, ReferenceSource& reference, const MonteCarloS
   return row;
 }
 
-/// measure() of two runs at once (runClosedLoopPair): the same two rows. Runs whose meters need every
-/// period (a body, a last reference) are measured one after the other.
-void measurePair(const Scenario& sa, ReferenceSource& ra, const RunDraw& da, RunRow& row_a, const Scenario& sb,
-                 ReferenceSource& rb, const RunDraw& db, RunRow& row_b, const MonteCarloSpec& spec,
-                 const RunExtras& extras) {
-  if (extras.contacts != nullptr || extras.last_reference != nullptr) {
-    row_a = measure(sa, ra, spec, da, extras);
-    row_b = measure(sb, rb, spec, db, extras);
-    return;
-  }
-  row_a.draw = da;
-  row_b.draw = db;
-  RowMeter meter_a(row_a, sa, spec, extras), meter_b(row_b, sb, spec, extras);
-  const std::array<RunResult, 2> r = runClosedLoopPair(sa, ra, meter_a.tally(), sb, rb, meter_b.tally(), true);
-  meter_a.finish(r[0]);
-  meter_b.finish(r[1]);
-}
-
-/// A parallelRows worker for seeded runs of `base`: runs i and i + 1 of a batch in lockstep (measurePair),
-/// each on its own clone of `reference`; a batch of one run alone (measure). Either way a row is its run's.
-auto pairedRuns(const Scenario& base, const MonteCarloSpec& spec, const ReferenceSource& reference,
+/// A parallelRows worker for seeded runs of `base` on its own clone of `reference`: run i -> its row.
+auto seededRuns(const Scenario& base, const MonteCarloSpec& spec, const ReferenceSource& reference,
                 const RunExtras& extras) {
-  std::shared_ptr<ReferenceSource> ref_a = reference.clone(), ref_b = reference.clone();
-  return [&base, &spec, ref_a, ref_b, extras](std::int64_t i, int count, RunRow* rows) {
-    const RunDraw draw_a = drawRun(spec, base, i);
-    if (count == 1) {
-      rows[0] = measure(applyDraw(base, spec, draw_a), *ref_a, spec, draw_a, extras);
-      return;
-    }
-    const RunDraw draw_b = drawRun(spec, base, i + 1);
-    measurePair(applyDraw(base, spec, draw_a), *ref_a, draw_a, rows[0], applyDraw(base, spec, draw_b), *ref_b, draw_b,
-                rows[1], spec, extras);
+  std::shared_ptr<ReferenceSource> ref = reference.clone();
+  return [&base, &spec, ref, extras](std::int64_t i) {
+    const RunDraw draw = drawRun(spec, base, i);
+    return measure(applyDraw(base, spec, draw), *ref, spec, draw, extras);
   };
 }
 
@@ -106,16 +81,15 @@ double threadCpuSeconds() {
   return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
-/// Runs 0..runs-1 on `threads` threads, two at a time: make() is called once per thread and returns that
-/// thread's run(i, count, rows), which writes runs i .. i + count - 1 (count 1 or 2) into rows[0 .. count-1]
-/// with its own references and state. Row i lands at index i whatever thread ran it (and whichever run it
-/// was paired with: a pair's rows are those of the two runs alone). loads (optional): each thread's runs
-/// and CPU time, thread t's in (*loads)[t].
+/// Runs 0..runs-1 on `threads` threads: make() is called once per thread and returns that thread's
+/// run(i) -> RunRow, with its own references and state. The threads take the next run as they free up; row
+/// i lands at index i whatever thread ran it. loads (optional): each thread's runs and CPU time, thread t's
+/// in (*loads)[t].
 template <typename MakeWorker>
 std::vector<RunRow> parallelRows(std::int64_t runs, int threads, const std::function<void(std::int64_t)>& progress,
                                  const MakeWorker& make, std::vector<WorkerLoad>* loads = nullptr) {
   if (threads <= 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  threads = static_cast<int>(std::min<std::int64_t>(threads, (runs + 1) / 2));
+  threads = static_cast<int>(std::min<std::int64_t>(threads, runs));
   std::vector<WorkerLoad> load(static_cast<std::size_t>(threads));
   std::vector<RunRow> rows(static_cast<std::size_t>(runs));
   std::atomic<std::int64_t> next{0};
@@ -127,13 +101,12 @@ std::vector<RunRow> parallelRows(std::int64_t runs, int threads, const std::func
     const double cpu0 = threadCpuSeconds();
     try {
       auto run = make();
-      for (std::int64_t i = next.fetch_add(2); i < runs; i = next.fetch_add(2)) {
-        const int count = static_cast<int>(std::min<std::int64_t>(2, runs - i));
-        run(i, count, &rows[static_cast<std::size_t>(i)]);
-        mine.runs += count;
+      for (std::int64_t i = next++; i < runs; i = next++) {
+        rows[static_cast<std::size_t>(i)] = run(i);
+        ++mine.runs;
         if (progress) {
           std::lock_guard<std::mutex> lock(progress_mutex);
-          for (int j = 0; j < count; ++j) progress(++done);
+          progress(++done);
         }
       }
     } catch (...) {
@@ -153,14 +126,6 @@ std::vector<RunRow> parallelRows(std::int64_t runs, int threads, const std::func
   if (failure) std::rethrow_exception(failure);
   if (loads != nullptr) *loads = load;
   return rows;
-}
-
-/// A parallelRows worker from a one-run function run(i) -> RunRow: the runs of a batch one by one.
-template <typename RunOne>
-auto oneByOne(RunOne run) {
-  return [run](std::int64_t i, int count, RunRow* rows) {
-    for (int j = 0; j < count; ++j) rows[j] = run(i + j);
-  };
 }
 
 /// Nearest-rank quantile of sorted values.
@@ -232,7 +197,7 @@ std::vector<RunRow> runMonteCarlo(const Scenario& base, const ReferenceSource& r
   const std::string e = firstError({spec.validate(), base.validate()});
   if (!e.empty()) throw std::invalid_argument(e);
   refuseBadDraws(base, spec, runs);
-  return parallelRows(runs, threads, progress, [&]() { return pairedRuns(base, spec, reference, RunExtras{}); });
+  return parallelRows(runs, threads, progress, [&]() { return seededRuns(base, spec, reference, RunExtras{}); });
 }
 
 std::string BenchScenario::validate() const {
@@ -269,8 +234,8 @@ std::vector<RunRow> runBenchmark(const BenchScenario& bench, std::int64_t runs, 
   refuseBadDraws(base, spec, runs);
   if (bench.realism)  // sensors, traction or an estimate in the loop (issue 16): estimated_bench.h
     return parallelRows(
-        runs, threads, progress,
-        [&]() { return oneByOne([&bench](std::int64_t i) { return estimatedBenchRow(bench, i); }); }, loads);
+        runs, threads, progress, [&]() { return [&bench](std::int64_t i) { return estimatedBenchRow(bench, i); }; },
+        loads);
   RunExtras extras;
   extras.series_every = seriesEvery(bench);
   if (bench.track != TrackKind::field) {
@@ -279,22 +244,21 @@ std::vector<RunRow> runBenchmark(const BenchScenario& bench, std::int64_t runs, 
       proto = std::make_unique<LineReference>(bench.line_v_r, bench.line_y, bench.line_x0);
     else
       proto = std::make_unique<SineReference>(bench.sine);
-    // Two runs at a time in lockstep (measurePair), each with its own reference.
     return parallelRows(
-        runs, threads, progress, [&]() { return pairedRuns(base, spec, *proto, extras); }, loads);
+        runs, threads, progress, [&]() { return seededRuns(base, spec, *proto, extras); }, loads);
   }
   // Field: the path starts at the drawn start (the approach), so each run builds its own reference, and its
   // duration grows by the approach's extra time, as run_scenario --field does.
   return parallelRows(
       runs, threads, progress,
       [&]() {
-        return oneByOne([&bench, &base, &spec, &extras](std::int64_t i) {
+        return [&bench, &base, &spec, &extras](std::int64_t i) {
           const RunDraw draw = drawRun(spec, base, i);
           return fieldRow(bench, applyDraw(base, spec, draw), extras,
                           [&spec, &draw](const Scenario& sc, ReferenceSource& reference, const RunExtras& e) {
                             return measure(sc, reference, spec, draw, e);
                           });
-        });
+        };
       },
       loads);
 }

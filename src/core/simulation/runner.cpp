@@ -33,8 +33,7 @@ namespace {
 // One run's state through the loop, over concrete controller types (no virtual call when they are final or
 // plain classes): Outer::compute(ref, pose, v, omega) -> VelocityCommand; Inner::update(cmd, v, omega, dt)
 // -> InnerOutput, m0Hat(), i0Hat(). Trace: the public API's std::function (may be empty), or a RunTally
-// (its add() inlined here, and what it does not read of the LoopSample never built). The one-run loop and
-// the two-run loop (runPair) step it the same way: control(k), then the plant, period after period.
+// (its add() inlined here, and what it does not read of the LoopSample never built).
 template <typename Outer, typename Inner, typename Trace>
 struct LoopRun {
   static constexpr bool kanayama = std::is_same_v<Outer, Kanayama>;
@@ -72,30 +71,6 @@ struct LoopRun {
     pose = Pose2D{s[X], s[Y], yawThroughQuaternion(s[THETA])};
     if constexpr (kanayama) sinCos(pose.theta, sin_yaw, cos_yaw);
     return true;
-  }
-
-  /// observe() of two runs, their sin/cos in two lanes (each lane the scalar's bits) when both are finite.
-  static void observePair(LoopRun& a, LoopRun& b, bool& seen_a, bool& seen_b) {
-    if constexpr (kHaveLanes2) {
-      const State &sa = a.plant.state(), &sb = b.plant.state();
-      if (finiteSum(sa) && finiteSum(sb)) {
-        a.pose = Pose2D{sa[X], sa[Y], 0.0};
-        b.pose = Pose2D{sb[X], sb[Y], 0.0};
-        yawsThroughQuaternion(sa[THETA], sb[THETA], a.pose.theta, b.pose.theta);
-        if constexpr (kanayama) {
-          Lanes2 s, c;
-          sinCos(Lanes2(a.pose.theta, b.pose.theta), s, c);
-          a.sin_yaw = s.first();
-          a.cos_yaw = c.first();
-          b.sin_yaw = s.second();
-          b.cos_yaw = c.second();
-        }
-        seen_a = seen_b = true;
-        return;
-      }
-    }
-    seen_a = a.observe();
-    seen_b = b.observe();
   }
 
   /// control(k) after observe().
@@ -138,14 +113,6 @@ struct LoopRun {
     else
       plant.step(tau_right, tau_left, dt);
   }
-  /// The same, as Plant::stepPair's input (a heading that matches no state without Kanayama's cos/sin).
-  Plant::HeadingStep headingStep() const {
-    if constexpr (kanayama)
-      return {tau_right, tau_left, pose.theta, cos_yaw, sin_yaw};
-    else
-      return {tau_right, tau_left, std::numeric_limits<double>::quiet_NaN(), 0.0, 0.0};
-  }
-
   /// Periods from `from` to the end (or to an earlier end of the run).
   void runFrom(std::int64_t from) {
     for (std::int64_t k = from; k <= n; ++k) {
@@ -183,29 +150,6 @@ RunResult loop(const Scenario& sc, ReferenceSource& reference, Outer& outer, Inn
   return run.finish();
 }
 
-// Two runs of the same length and period in lockstep: each period's control for one, then the other, then
-// both plants in one Plant::stepPair. When one run ends early (diverged), the other goes on alone. Each
-// result is the one-run loop's to the bit: the same calls in the same order for each run.
-template <typename Outer, typename Inner>
-std::array<RunResult, 2> loopPair(LoopRun<Outer, Inner, RunTally>& a, LoopRun<Outer, Inner, RunTally>& b) {
-  const std::int64_t n = a.n;
-  for (std::int64_t k = 0; k <= n; ++k) {
-    bool seen_a, seen_b;
-    LoopRun<Outer, Inner, RunTally>::observePair(a, b, seen_a, seen_b);
-    const bool go_a = seen_a && a.controlObserved(k), go_b = seen_b && b.controlObserved(k);
-    if (!(go_a && go_b)) {
-      for (auto* run : {&a, &b}) {
-        if (!(run == &a ? go_a : go_b)) continue;
-        if (k < n) run->stepPlant();
-        run->runFrom(k + 1);
-      }
-      break;
-    }
-    if (k < n) Plant::stepPair(a.plant, a.headingStep(), b.plant, b.headingStep(), a.dt);
-  }
-  return {a.finish(), b.finish()};
-}
-
 template <typename Outer, typename Trace>
 RunResult withInner(const Scenario& sc, ReferenceSource& reference, Outer& outer, bool keep_samples, Trace& trace,
                     const RunStop& stop) {
@@ -228,28 +172,6 @@ RunResult withOuter(const Scenario& sc, ReferenceSource& reference, bool keep_sa
   return withInner(sc, reference, pursuit, keep_samples, trace, stop);
 }
 
-template <typename Outer, typename Inner>
-std::array<RunResult, 2> pairOf(const Scenario& sa, ReferenceSource& ra, RunTally& ta, Outer& oa, Inner& ia,
-                                const Scenario& sb, ReferenceSource& rb, RunTally& tb, Outer& ob, Inner& ib,
-                                bool keep_samples) {
-  const RunStop none;
-  LoopRun<Outer, Inner, RunTally> a(sa, ra, oa, ia, keep_samples, ta, none);
-  LoopRun<Outer, Inner, RunTally> b(sb, rb, ob, ib, keep_samples, tb, none);
-  return loopPair(a, b);
-}
-
-template <typename Outer>
-std::array<RunResult, 2> pairWithInner(const Scenario& sa, ReferenceSource& ra, RunTally& ta, Outer& oa,
-                                       const Scenario& sb, ReferenceSource& rb, RunTally& tb, Outer& ob,
-                                       bool keep_samples) {
-  if (sa.inner == InnerKind::pid) {
-    InnerAdapter<WheelPid> pa{WheelPid(sa.pid, sa.robot)}, pb{WheelPid(sb.pid, sb.robot)};
-    return pairOf(sa, ra, ta, oa, pa, sb, rb, tb, ob, pb, keep_samples);
-  }
-  SlidingModeController ca(sa.sliding, sa.robot), cb(sb.sliding, sb.robot);
-  return pairOf(sa, ra, ta, oa, ca, sb, rb, tb, ob, cb, keep_samples);
-}
-
 }  // namespace
 
 RunResult runClosedLoop(const Scenario& sc, ReferenceSource& reference, bool keep_samples,
@@ -259,21 +181,6 @@ RunResult runClosedLoop(const Scenario& sc, ReferenceSource& reference, bool kee
 
 RunResult runClosedLoop(const Scenario& sc, ReferenceSource& reference, bool keep_samples, RunTally& tally) {
   return withOuter(sc, reference, keep_samples, tally, RunStop{});
-}
-
-std::array<RunResult, 2> runClosedLoopPair(const Scenario& a, ReferenceSource& reference_a, RunTally& tally_a,
-                                           const Scenario& b, ReferenceSource& reference_b, RunTally& tally_b,
-                                           bool keep_samples) {
-  // In lockstep only runs of one shape: the same controller types, period and number of periods.
-  if (!(a.outer == b.outer && a.inner == b.inner && a.control_period_ns == b.control_period_ns &&
-        a.steps() == b.steps()))
-    return {runClosedLoop(a, reference_a, keep_samples, tally_a), runClosedLoop(b, reference_b, keep_samples, tally_b)};
-  if (a.outer == OuterKind::kanayama) {
-    Kanayama ka(a.kanayama), kb(b.kanayama);
-    return pairWithInner(a, reference_a, tally_a, ka, b, reference_b, tally_b, kb, keep_samples);
-  }
-  PurePursuit pa(a.pure_pursuit, a.outer == OuterKind::rpp), pb(b.pure_pursuit, b.outer == OuterKind::rpp);
-  return pairWithInner(a, reference_a, tally_a, pa, b, reference_b, tally_b, pb, keep_samples);
 }
 
 RunResult runClosedLoop(const Scenario& sc, ReferenceSource& reference, OuterController& outer, InnerController& inner,

@@ -270,13 +270,13 @@ TEST(Benchmark, WorkerLoadsCountEveryRunOnceAndLeaveTheRowsAlone) {
   b.spec = shortSpec();
   ASSERT_EQ(b.validate(), "");
   const std::vector<RunRow> plain = runBenchmark(b, 7, 2);
-  // 7 runs in batches of 2: at most 4 batches, so 5 threads are cut to 4 workers.
-  for (const int threads : {1, 2, 5}) {
+  // 7 runs: 8 threads are cut to 7 workers.
+  for (const int threads : {1, 2, 5, 8}) {
     SCOPED_TRACE(threads);
     std::vector<WorkerLoad> loads{{99, -1.0}};  // overwritten, not appended to
     const std::vector<RunRow> rows = runBenchmark(b, 7, threads, {}, &loads);
     expectSameRows(plain, rows);
-    ASSERT_EQ(loads.size(), static_cast<std::size_t>(std::min(threads, 4)));
+    ASSERT_EQ(loads.size(), static_cast<std::size_t>(std::min(threads, 7)));
     std::int64_t runs = 0;
     for (const WorkerLoad& w : loads) {
       runs += w.runs;

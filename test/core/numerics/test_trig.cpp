@@ -79,27 +79,6 @@ TEST(Trig, SinAndCosAloneGiveSinCosBits) {
 }
 
 #if defined(__SSE2__)
-// Plant::stepPair and the two-run loop take two sinCos at once: each lane must be the scalar's bits,
-// whichever value shares the register (neighbours in arguments() mix ranges, tiny, huge and near-pi/2).
-TEST(Trig, TwoLanesGiveEachLaneTheScalarBits) {
-  std::vector<double> xs = arguments();
-  for (const double odd :
-       {0.0, -0.0, 1e-30, 1e6, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()})
-    xs.insert(xs.begin() + 1001, odd);
-  std::mt19937_64 rng(11);
-  std::uniform_int_distribution<std::size_t> pick(0, xs.size() - 1);
-  for (std::size_t i = 0; i + 1 < 2 * xs.size(); ++i) {
-    // every argument with its neighbour, then with a random one
-    const double a = xs[i % xs.size()], b = i < xs.size() ? xs[(i + 1) % xs.size()] : xs[pick(rng)];
-    Lanes2 s, c;
-    sinCos(Lanes2(a, b), s, c);
-    double sa, ca, sb, cb;
-    sinCos(a, sa, ca);
-    sinCos(b, sb, cb);
-    ASSERT_TRUE(sameBits(s.first(), sa) && sameBits(c.first(), ca)) << a << " beside " << b;
-    ASSERT_TRUE(sameBits(s.second(), sb) && sameBits(c.second(), cb)) << b << " beside " << a;
-  }
-}
 #endif
 
 // Kanayama::compute reuses cos/sin of the robot's heading for theta_e = -theta (reference heading 0):

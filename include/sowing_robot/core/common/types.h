@@ -55,17 +55,6 @@ inline double yawThroughQuaternion(double theta) {
   return std::atan2(2.0 * w * z, 1.0 - 2.0 * z * z);
 }
 
-#if defined(__SSE2__)
-/// yawThroughQuaternion of two headings, the sin/cos and products in two lanes: each the scalar's bits.
-inline void yawsThroughQuaternion(double theta_a, double theta_b, double& yaw_a, double& yaw_b) {
-  Lanes2 z, w;
-  sinCos(Lanes2(0.5 * theta_a, 0.5 * theta_b), z, w);
-  const Lanes2 y = Lanes2(2.0) * w * z, x = Lanes2(1.0) - Lanes2(2.0) * z * z;
-  yaw_a = std::atan2(y.first(), x.first());
-  yaw_b = std::atan2(y.second(), x.second());
-}
-#endif
-
 /// True when every argument is a finite number.
 template <typename... T>
 bool allFinite(T... v) {

@@ -55,17 +55,6 @@ class Plant {
   /// `theta` is bit-identical to the state's heading, else computed. The same numbers as step().
   bool step(double tau_right, double tau_left, double dt, double theta, double cos_theta, double sin_theta);
 
-  /// One step's input for stepPair: the commanded torques and, as for step() with a heading, some
-  /// heading with its cos/sin (used when it is the state's heading to the bit).
-  struct HeadingStep {
-    double tau_right, tau_left, theta, cos_theta, sin_theta;
-  };
-  /// a.step(in_a..., dt, ...) and b.step(in_b..., dt, ...) in one go, the same numbers for each: the RK4
-  /// arithmetic of both plants in two-lane SSE2 instructions (lanes2.h; the benchmark steps two seeds in
-  /// lockstep), the noise, disturbance and any library call lane by lane. Falls back to the two steps
-  /// without SSE2, when the plants' R or L differ, or when an input is refused (which step() refuses).
-  static void stepPair(Plant& a, const HeadingStep& in_a, Plant& b, const HeadingStep& in_b, double dt);
-
   /// Time derivative of the state for the *applied* torques (commands + disturbance already added).
   State derivative(const State& s, double applied_right, double applied_left) const;
 
@@ -87,9 +76,6 @@ class Plant {
   State derivativeWithHeading(const State& s, double cos_th, double sin_th, double applied_right,
                               double applied_left) const;
   void disturbanceAt(double t, double& right, double& left);  // sinusoidalDisturbance, memoised
-  // disturbanceAt of two plants, their two sinCos in one when both are due (stepPair)
-  static void disturbancePairAt(Plant& a, double ta, Plant& b, double tb, double& right_a, double& left_a,
-                                double& right_b, double& left_b);
   bool stepWithHeading(double tau_right, double tau_left, double dt, double cos0, double sin0);
   void drawNoise(double& right, double& left);  // the step's torque noise (0, 0 when off)
   void addIncrement(double x, double y, double theta, double v, double omega, double phi_r, double phi_l, double dt);

@@ -9,16 +9,14 @@ namespace sowing_robot {
 namespace core {
 
 // cos and sin of (theta + delta) from cos0 = cos(theta), sin0 = sin(theta) by the angle-sum identity and
-// the Taylor series of cos(delta), sin(delta), for |delta| <= 0.05 (rotateHeading's case). A template over
-// the number type: double, or two lanes of doubles at once (Plant::stepPair), with the same operations.
-template <typename N>
-inline void rotateBySeries(N cos0, N sin0, N delta, N& cos_out, N& sin_out) {
-  const N d2 = delta * delta;
-  const N one(1.0), half(0.5);
-  const N k6(1.0 / 6.0), k20(1.0 / 20.0), k42(1.0 / 42.0);    // 3!, 5!/3!, 7!/5!
-  const N k12(1.0 / 12.0), k30(1.0 / 30.0), k56(1.0 / 56.0);  // 4!/2!, 6!/4!, 8!/6!
-  const N sd = delta * (one - d2 * k6 * (one - d2 * k20 * (one - d2 * k42)));
-  const N cd = one - half * d2 * (one - d2 * k12 * (one - d2 * k30 * (one - d2 * k56)));
+// the Taylor series of cos(delta), sin(delta), for |delta| <= 0.05 (rotateHeading's case).
+inline void rotateBySeries(double cos0, double sin0, double delta, double& cos_out, double& sin_out) {
+  const double d2 = delta * delta;
+  const double one = 1.0, half = 0.5;
+  const double k6 = 1.0 / 6.0, k20 = 1.0 / 20.0, k42 = 1.0 / 42.0;    // 3!, 5!/3!, 7!/5!
+  const double k12 = 1.0 / 12.0, k30 = 1.0 / 30.0, k56 = 1.0 / 56.0;  // 4!/2!, 6!/4!, 8!/6!
+  const double sd = delta * (one - d2 * k6 * (one - d2 * k20 * (one - d2 * k42)));
+  const double cd = one - half * d2 * (one - d2 * k12 * (one - d2 * k30 * (one - d2 * k56)));
   cos_out = cos0 * cd - sin0 * sd;
   sin_out = sin0 * cd + cos0 * sd;
 }

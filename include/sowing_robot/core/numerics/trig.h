@@ -29,8 +29,6 @@
 
 #include <Eigen/Core>
 
-#include "sowing_robot/core/numerics/lanes2.h"
-
 namespace sowing_robot {
 namespace core {
 namespace trig_detail {
@@ -50,8 +48,7 @@ constexpr double S1 = -1.66666666666666324348e-01, S2 = 8.33333333332248946124e-
 constexpr double C1 = 4.16666666666666019037e-02, C2 = -1.38888888888741095749e-03, C3 = 2.48015872894767294178e-05,
                  C4 = -2.75573143513906633035e-07, C5 = 2.08757232129817482790e-09, C6 = -1.13596475577881948265e-11;
 
-/// sin(y0 + y1) for |y0 + y1| <= pi/4 (fdlibm's __kernel_sin with the tail). N: double, or Lanes2 for
-/// two at once (each lane the double's bits: the same operations, nothing fused).
+/// sin(y0 + y1) for |y0 + y1| <= pi/4 (fdlibm's __kernel_sin with the tail).
 template <typename N>
 inline N kernelSin(N y0, N y1) {
   const N z = y0 * y0, w = z * z, r = N(S2) + z * (N(S3) + z * N(S4)) + z * w * (N(S5) + z * N(S6)), v = z * y0;
@@ -161,54 +158,6 @@ inline double cosOf(double x) {
   const double v = (n & 1) ? kernelSin(y0, y1) : kernelCos(y0, y1);
   return ((n + 1) & 2) ? -v : v;
 }
-
-#if defined(__SSE2__)
-/// sinCos of both lanes: each lane the bits of the scalar sinCos of its value (the same operations; the
-/// quadrant taken from the rounded multiple's low mantissa bits instead of an int, the same n mod 4).
-/// A lane outside the reduction's range, or near a multiple of pi/2 (the third round), sends both lanes
-/// to the scalar path.
-inline void sinCos(Lanes2 x, Lanes2& sin_x, Lanes2& cos_x) {
-  using namespace trig_detail;
-  const auto scalar = [&] {
-    double sa, ca, sb, cb;
-    sinCos(x.first(), sa, ca);
-    sinCos(x.second(), sb, cb);
-    sin_x = Lanes2(sa, sb);
-    cos_x = Lanes2(ca, cb);
-  };
-  const __m128d ax = _mm_andnot_pd(_mm_set1_pd(-0.0), x.v);
-  const __m128d in_range =
-      _mm_and_pd(_mm_cmpge_pd(ax, _mm_set1_pd(kTiny)), _mm_cmplt_pd(ax, _mm_set1_pd(kMedium)));  // NaN: false
-  if (_mm_movemask_pd(in_range) != 3) return scalar();
-  const Lanes2 shifted = x * Lanes2(kInvPio2) + Lanes2(kToInt);
-  const Lanes2 fn = shifted - Lanes2(kToInt);
-  const Lanes2 t = x - fn * Lanes2(kPio2_1);
-  Lanes2 w = fn * Lanes2(kPio2_2);
-  const Lanes2 r = t - w;
-  w = fn * Lanes2(kPio2_2t) - ((t - r) - w);
-  const Lanes2 y0 = r - w;
-  // reduce()'s test for the third round, on both lanes' exponent fields (the high words hold them).
-  const __m128i exponent_mask = _mm_set1_epi64x(0x7ff);
-  const __m128i ex = _mm_and_si128(_mm_srli_epi64(_mm_castpd_si128(x.v), 52), exponent_mask);
-  const __m128i ey = _mm_and_si128(_mm_srli_epi64(_mm_castpd_si128(y0.v), 52), exponent_mask);
-  const __m128i cancelled = _mm_cmpgt_epi32(_mm_sub_epi32(ex, ey), _mm_set1_epi32(49));
-  if ((_mm_movemask_epi8(cancelled) & 0x0101) != 0) return scalar();  // the low 32 bits of each lane
-  const Lanes2 y1 = (r - y0) - w;
-  const Lanes2 s = kernelSin(y0, y1), c = kernelCos(y0, y1);
-  // shifted = 1.5 * 2^52 + n exactly, so its mantissa's low bits are n's (two's complement, mod 4).
-  const __m128i q = _mm_castpd_si128(shifted.v);
-  const __m128i odd = _mm_sub_epi64(_mm_setzero_si128(), _mm_and_si128(q, _mm_set1_epi64x(1)));  // all ones
-  const __m128d swap = _mm_castsi128_pd(odd);
-  const __m128d sin_v = _mm_or_pd(_mm_and_pd(swap, c.v), _mm_andnot_pd(swap, s.v));
-  const __m128d cos_v = _mm_or_pd(_mm_and_pd(swap, s.v), _mm_andnot_pd(swap, c.v));
-  // The sign flips of the scalar switch: sin negated when n & 2, cos when (n + 1) & 2.
-  const __m128i two = _mm_set1_epi64x(2);
-  const __m128i sin_sign = _mm_slli_epi64(_mm_and_si128(q, two), 62);
-  const __m128i cos_sign = _mm_slli_epi64(_mm_and_si128(_mm_add_epi64(q, _mm_set1_epi64x(1)), two), 62);
-  sin_x = Lanes2(_mm_xor_pd(sin_v, _mm_castsi128_pd(sin_sign)));
-  cos_x = Lanes2(_mm_xor_pd(cos_v, _mm_castsi128_pd(cos_sign)));
-}
-#endif
 
 }  // namespace core
 }  // namespace sowing_robot

@@ -176,14 +176,6 @@ RunResult runClosedLoop(const Scenario& scenario, ReferenceSource& reference, bo
 /// callback calling tally.add()).
 RunResult runClosedLoop(const Scenario& scenario, ReferenceSource& reference, bool keep_samples, RunTally& tally);
 
-/// Two runs in lockstep (the benchmark's Monte-Carlo rows, docs/performance.md): each result, tally and
-/// reference the same to the bit as runClosedLoop(scenario, reference, keep_samples, tally) of that run
-/// alone; both plants step in one Plant::stepPair. Runs of another shape (controller types, period or
-/// length differ) run one after the other. The references must be two objects.
-std::array<RunResult, 2> runClosedLoopPair(const Scenario& a, ReferenceSource& reference_a, RunTally& tally_a,
-                                           const Scenario& b, ReferenceSource& reference_b, RunTally& tally_b,
-                                           bool keep_samples);
-
 /// The same loop with caller-built controllers behind the run-time interfaces (virtual calls; the
 /// Scenario's outer/inner choice and gains are then ignored, its plant, timing and start are used).
 RunResult runClosedLoop(const Scenario& scenario, ReferenceSource& reference, OuterController& outer,
