@@ -6,7 +6,6 @@
 #include <cmath>
 #include <cstdio>
 
-#include "sowing_robot/core/numerics/trig.h"
 #include "sowing_robot/ros/common/component_params.h"
 #include "sowing_robot/ros/common/msg_checks.h"
 #include "sowing_robot/ros/common/urdf_params.h"
@@ -97,7 +96,8 @@ void SeedDrillNode::referenceCallback(const ReferenceState::ConstPtr& msg) {
 void SeedDrillNode::update(const nav_msgs::Odometry& odom, bool tool_down) {
   const core::Pose2D pose = poseOf(odom);
   double s, c;
-  core::sinCos(pose.theta, s, c);
+  s = std::sin(pose.theta);
+  c = std::cos(pose.theta);
   const Eigen::Vector2d tool(pose.x + c * tool_x_ - s * tool_y_, pose.y + s * tool_x_ + c * tool_y_);
   Eigen::Vector2d seed;
   if (!drill_->update(tool, tool_down, seed)) return;

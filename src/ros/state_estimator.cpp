@@ -4,7 +4,6 @@
 
 #include "sowing_robot/core/common/types.h"
 #include "sowing_robot/core/common/validation.h"
-#include "sowing_robot/core/numerics/trig.h"
 #include "sowing_robot/core/settings/node_settings.h"
 #include "sowing_robot/ros/common/component_params.h"
 #include "sowing_robot/ros/common/msg_checks.h"
@@ -178,7 +177,8 @@ void StateEstimator::step(const nav_msgs::Odometry& odom, const sensor_msgs::Imu
     in.dtheta = core::wrapAngle(b.theta - a.theta);
     const double mid = a.theta + 0.5 * in.dtheta;
     double s, c;
-    core::sinCos(mid, s, c);
+    s = std::sin(mid);
+    c = std::cos(mid);
     in.distance = (b.x - a.x) * c + (b.y - a.y) * s;
     in.covariance = increment_covariance_;  // the quantisation of the two encoders (core/estimation/ekf.h says why)
     in.has_rate = imu.angular_velocity_covariance[0] >= 0.0;  // -1: no rate in this message

@@ -5,7 +5,6 @@
 #include <stdexcept>
 
 #include "sowing_robot/core/common/validation.h"
-#include "sowing_robot/core/numerics/trig.h"
 
 namespace sowing_robot {
 namespace core {
@@ -32,46 +31,19 @@ void Kanayama::setGains(const KanayamaGains& g) {
   gains_ = g;
 }
 
-namespace {
-
-// eq 4.1 with c = cos(a.theta), s = sin(a.theta).
-inline PostureError postureErrorWith(const Pose2D& r, const Pose2D& a, double c, double s) {
+PostureError Kanayama::postureError(const Pose2D& r, const Pose2D& a) {
+  // eq 4.1
+  const double c = std::cos(a.theta), s = std::sin(a.theta);
   const double dx = r.x - a.x, dy = r.y - a.y;
   return {c * dx + s * dy, -s * dx + c * dy, wrapAngle(r.theta - a.theta)};
 }
 
-bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
-
-}  // namespace
-
-PostureError Kanayama::postureError(const Pose2D& r, const Pose2D& a) {
-  double s, c;
-  sinCos(a.theta, s, c);
-  return postureErrorWith(r, a, c, s);
-}
-
 VelocityCommand Kanayama::compute(const Reference& ref, const Pose2D& actual, double v, double omega) const {
-  double s, c;
-  sinCos(actual.theta, s, c);
-  return compute(ref, actual, c, s, v, omega);
-}
-
-VelocityCommand Kanayama::compute(const Reference& ref, const Pose2D& actual, double cos_theta, double sin_theta,
-                                  double v, double omega) const {
   if (!allFinite(ref.pose.x, ref.pose.y, ref.pose.theta, ref.v, ref.omega, ref.v_dot, ref.omega_dot, actual.x, actual.y,
                  actual.theta, v, omega))
     return VelocityCommand{};
-  const PostureError e = postureErrorWith(ref.pose, actual, cos_theta, sin_theta);
-  // Along a reference heading of 0 (the thesis line, rows along x) theta_e is exactly -theta, and cos is
-  // even and sin odd to the bit (core/numerics/trig.h; test_trig's CosIsEvenAndSinOddToTheBit holds it to that):
-  // the robot's heading's cos/sin serve, without a second sincos.
-  double c, s;
-  if (sameBits(e.thetae, -actual.theta)) {
-    c = cos_theta;
-    s = -sin_theta;
-  } else {
-    sinCos(e.thetae, s, c);
-  }
+  const PostureError e = postureError(ref.pose, actual);
+  const double c = std::cos(e.thetae), s = std::sin(e.thetae);
   VelocityCommand out;
   out.v = ref.v * c + gains_.kx * e.xe;
   out.omega = ref.omega + ref.v * (gains_.ky * e.ye + gains_.ktheta * s);
@@ -86,7 +58,7 @@ VelocityCommand Kanayama::compute(const Reference& ref, const Pose2D& actual, do
 }
 
 double Kanayama::lyapunov(const PostureError& e) const {
-  return 0.5 * (e.xe * e.xe + e.ye * e.ye) + (1.0 - cosOf(e.thetae)) / gains_.ky;
+  return 0.5 * (e.xe * e.xe + e.ye * e.ye) + (1.0 - std::cos(e.thetae)) / gains_.ky;
 }
 
 }  // namespace core

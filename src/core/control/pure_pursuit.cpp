@@ -6,7 +6,6 @@
 
 #include "sowing_robot/core/common/validation.h"
 #include "sowing_robot/core/control/kanayama.h"
-#include "sowing_robot/core/numerics/trig.h"
 
 namespace sowing_robot {
 namespace core {
@@ -64,13 +63,16 @@ Pose2D PurePursuit::carrot(const Reference& ref, double L) {
   Pose2D c;
   if (std::fabs(dth) < 1e-9) {
     double sn, cs;
-    sinCos(th, sn, cs);
+    sn = std::sin(th);
+    cs = std::cos(th);
     c.x = ref.pose.x + s * cs;
     c.y = ref.pose.y + s * sn;
   } else {
     double s0, c0, s1, c1;
-    sinCos(th, s0, c0);
-    sinCos(th + dth, s1, c1);
+    s0 = std::sin(th);
+    c0 = std::cos(th);
+    s1 = std::sin(th + dth);
+    c1 = std::cos(th + dth);
     c.x = ref.pose.x + (s1 - s0) / kappa_r;
     c.y = ref.pose.y - (c1 - c0) / kappa_r;
   }
@@ -87,7 +89,8 @@ VelocityCommand PurePursuit::compute(const Reference& ref, const Pose2D& actual,
   const PostureError pc = Kanayama::postureError(c, actual);
   const double xl = pc.xe, yl = pc.ye;
   double sin_e, cos_e;
-  sinCos(pc.thetae, sin_e, cos_e);
+  sin_e = std::sin(pc.thetae);
+  cos_e = std::cos(pc.thetae);
   const double xl_dot = ref.v * cos_e - v + omega * yl;
   const double yl_dot = ref.v * sin_e - omega * xl;
   const double d2 = xl * xl + yl * yl;
@@ -98,7 +101,7 @@ VelocityCommand PurePursuit::compute(const Reference& ref, const Pose2D& actual,
   }
   // Desired speed: v_r (+ along-track feedback on the reference point's error, Kanayama's xe).
   const PostureError e = Kanayama::postureError(ref.pose, actual);
-  const double xe_dot = omega * e.ye - v + ref.v * cosOf(e.thetae);
+  const double xe_dot = omega * e.ye - v + ref.v * std::cos(e.thetae);
   double speed = ref.v + params_.k_along * e.xe;
   double speed_dot = ref.v_dot + params_.k_along * xe_dot;
   if (regulated_ && speed > 0.0) {

@@ -1,5 +1,4 @@
 #include "sowing_robot/core/estimation/ekf.h"
-#include "sowing_robot/core/numerics/trig.h"
 
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
@@ -115,7 +114,8 @@ Ekf::Vector Ekf::motion(const Vector6& a) {
   const double mid = a(THETA) + 0.5 * a(4), u = a(5);
   Vector s;
   double sn, c;
-  sinCos(mid, sn, c);
+  sn = std::sin(mid);
+  c = std::cos(mid);
   s << a(X) + u * c, a(Y) + u * sn, wrapAngle(a(THETA) + a(4)), a(BIAS);
   return s;
 }
@@ -123,7 +123,8 @@ Ekf::Vector Ekf::motion(const Vector6& a) {
 Eigen::Matrix<double, 4, 6> Ekf::motionJacobian(const Vector6& a) {
   const double mid = a(THETA) + 0.5 * a(4), u = a(5);
   double s, c;
-  sinCos(mid, s, c);
+  s = std::sin(mid);
+  c = std::cos(mid);
   Eigen::Matrix<double, 4, 6> f = Eigen::Matrix<double, 4, 6>::Zero();
   f(X, X) = 1.0;
   f(X, THETA) = -u * s;

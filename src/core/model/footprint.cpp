@@ -1,5 +1,4 @@
 #include "sowing_robot/core/model/footprint.h"
-#include "sowing_robot/core/numerics/trig.h"
 
 #include <algorithm>
 #include <cmath>
@@ -88,7 +87,8 @@ double Footprint::signedDistance(const Eigen::Vector2d& q) const {
 double Footprint::distanceToCircle(const Pose2D& pose, const Eigen::Vector2d& centre, double radius) const {
   // The centre in base_link: rotate the offset by -theta.
   double s, c;
-  sinCos(pose.theta, s, c);
+  s = std::sin(pose.theta);
+  c = std::cos(pose.theta);
   const Eigen::Vector2d w = centre - Eigen::Vector2d(pose.x, pose.y);
   const Eigen::Vector2d q(c * w.x() + s * w.y(), -s * w.x() + c * w.y());
   return signedDistance(q) - radius;
@@ -96,7 +96,8 @@ double Footprint::distanceToCircle(const Pose2D& pose, const Eigen::Vector2d& ce
 
 std::vector<Eigen::Vector2d> Footprint::placed(const Pose2D& pose) const {
   double s, c;
-  sinCos(pose.theta, s, c);
+  s = std::sin(pose.theta);
+  c = std::cos(pose.theta);
   std::vector<Eigen::Vector2d> out;
   out.reserve(vertices_.size());
   for (const auto& v : vertices_) out.emplace_back(pose.x + c * v.x() - s * v.y(), pose.y + s * v.x() + c * v.y());

@@ -8,7 +8,6 @@
 #include "sowing_robot/core/common/types.h"
 #include "sowing_robot/core/common/validation.h"
 #include "sowing_robot/core/numerics/rotation.h"
-#include "sowing_robot/core/numerics/trig.h"
 
 namespace sowing_robot {
 namespace core {
@@ -67,7 +66,8 @@ inline void sinusoid(const PlantDisturbance& d, double t, double& right, double&
   }
   const double angle = d.frequency * t, amplitude = d.amplitude;
   double s, c;
-  sinCos(angle, s, c);
+  s = std::sin(angle);
+  c = std::cos(angle);
   right = amplitude * s;
   left = amplitude * c;
 }
@@ -80,7 +80,8 @@ void Plant::sinusoidalDisturbance(double t, double& right, double& left) const {
 
 State Plant::derivative(const State& s, double applied_right, double applied_left) const {
   double c, sn;
-  sinCos(s[THETA], sn, c);
+  sn = std::sin(s[THETA]);
+  c = std::cos(s[THETA]);
   return derivativeWithHeading(s, c, sn, applied_right, applied_left);
 }
 
@@ -116,15 +117,9 @@ inline void Plant::disturbanceAt(double t, double& right, double& left) {
 
 bool Plant::step(double tau_right, double tau_left, double dt) {
   double c, s;
-  sinCos(state_[THETA], s, c);
+  s = std::sin(state_[THETA]);
+  c = std::cos(state_[THETA]);
   return stepWithHeading(tau_right, tau_left, dt, c, s);
-}
-
-bool Plant::step(double tau_right, double tau_left, double dt, double theta, double cos_theta, double sin_theta) {
-  // Bit pattern, not ==: -0.0 == 0.0, but their sines differ in sign.
-  if (std::memcmp(&theta, &state_[THETA], sizeof theta) == 0)
-    return stepWithHeading(tau_right, tau_left, dt, cos_theta, sin_theta);
-  return step(tau_right, tau_left, dt);
 }
 
 namespace {

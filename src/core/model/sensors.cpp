@@ -4,7 +4,6 @@
 #include <stdexcept>
 
 #include "sowing_robot/core/common/validation.h"
-#include "sowing_robot/core/numerics/trig.h"
 
 namespace sowing_robot {
 namespace core {
@@ -130,7 +129,8 @@ Odometry2D EncoderOdometry::update(double phi_r, double phi_l, double dt) {
   Pose2D& p = out_.pose;
   const double mid = p.theta + 0.5 * dth;
   double s, c;
-  sinCos(mid, s, c);
+  s = std::sin(mid);
+  c = std::cos(mid);
   // Jacobians at the pose before the update: F in (x, y, theta), G in (Δs_R, Δs_L).
   Eigen::Matrix3d F = Eigen::Matrix3d::Identity();
   F(0, 2) = -ds * s;

@@ -8,7 +8,6 @@
 #include "sowing_robot/core/common/types.h"
 #include "sowing_robot/core/common/validation.h"
 #include "sowing_robot/core/numerics/rotation.h"
-#include "sowing_robot/core/numerics/trig.h"
 
 namespace sowing_robot {
 namespace core {
@@ -138,7 +137,8 @@ void TractionPlant::setSoil(const SoilMap& soil) {
 void TractionPlant::locateContacts() {
   if (soil_.empty()) return;
   double s, c;
-  sinCos(state_[THETA], s, c);
+  s = std::sin(state_[THETA]);
+  c = std::cos(state_[THETA]);
   const double L = nominal_.L;
   const Eigen::Vector2d axle(state_[X], state_[Y]), left(-s * L, c * L);
   ground_[RIGHT] = 1 + soil_.patchAt(axle - left);
@@ -167,16 +167,9 @@ double TractionPlant::kineticEnergy() const {
 
 bool TractionPlant::step(double tau_right, double tau_left, double dt) {
   double c, s;
-  sinCos(state_[THETA], s, c);
+  s = std::sin(state_[THETA]);
+  c = std::cos(state_[THETA]);
   return stepWithHeading(tau_right, tau_left, dt, c, s);
-}
-
-bool TractionPlant::step(double tau_right, double tau_left, double dt, double theta, double cos_theta,
-                         double sin_theta) {
-  // Bit pattern, not ==: -0.0 == 0.0, but their sines differ in sign.
-  if (std::memcmp(&theta, &state_[THETA], sizeof theta) == 0)
-    return stepWithHeading(tau_right, tau_left, dt, cos_theta, sin_theta);
-  return step(tau_right, tau_left, dt);
 }
 
 // cos_th, sin_th: cos and sin of state_[THETA].
@@ -194,7 +187,8 @@ bool TractionPlant::stepWithHeading(double tau_right, double tau_left, double dt
   const double dist_step = disturbance_.frequency * h;
   if (disturbance_.sinusoidal) {
     const double angle = disturbance_.frequency * (time_ + 0.5 * h);
-    sinCos(angle, dist_s, dist_c);
+    dist_s = std::sin(angle);
+    dist_c = std::cos(angle);
   }
   const double amplitude = disturbance_.sinusoidal ? disturbance_.amplitude : 0.0;
   locateContacts();

@@ -1,5 +1,4 @@
 #include "sowing_robot/core/planning/approach.h"
-#include "sowing_robot/core/numerics/trig.h"
 
 #include <algorithm>
 #include <cmath>

@@ -6,7 +6,6 @@
 #include <limits>
 
 #include "sowing_robot/core/common/validation.h"
-#include "sowing_robot/core/numerics/trig.h"
 
 namespace sowing_robot {
 namespace core {
@@ -32,7 +31,8 @@ std::string indexList(const std::vector<std::size_t>& v) {
 void cycloid(double tau, double& f, double& f1, double& f2, double& f3) {
   const double w = 2.0 * M_PI;
   double s, c;
-  sinCos(w * tau, s, c);
+  s = std::sin(w * tau);
+  c = std::cos(w * tau);
   f = tau - s / w;
   f1 = 1.0 - c;
   f2 = w * s;

@@ -6,7 +6,6 @@
 #include <stdexcept>
 
 #include "sowing_robot/core/common/validation.h"
-#include "sowing_robot/core/numerics/trig.h"
 
 namespace sowing_robot {
 namespace core {
@@ -113,7 +112,8 @@ void HeadlandTurn::segmentState(const Segment& g, double tau, double& theta, dou
   }
   const double dk = g.k1 - g.k0, w = M_PI / g.length;
   double s, c;
-  sinCos(w * tau, s, c);
+  s = std::sin(w * tau);
+  c = std::cos(w * tau);
   kappa = g.k0 + 0.5 * dk * (1.0 - c);
   theta = g.theta0 + g.k0 * tau + 0.5 * dk * (tau - s / w);
   dkappa = 0.5 * dk * w * s;
@@ -429,7 +429,8 @@ void FieldPath::arcLength(double t, double& s, double& sd, double& sdd, double& 
   }
   const double dv = ph.v1 - ph.v0, w = M_PI / ph.duration;
   double sn, c;
-  sinCos(w * tau, sn, c);
+  sn = std::sin(w * tau);
+  c = std::cos(w * tau);
   s = ph.s0 + ph.v0 * tau + 0.5 * dv * (tau - sn / w);
   sd = ph.v0 + 0.5 * dv * (1.0 - c);
   sdd = 0.5 * dv * w * sn;
@@ -454,7 +455,8 @@ TargetState FieldPath::at(double t) const {
     double th_l, k_l, dk_l;
     turn_.evaluate(sigma, local, th_l, k_l, dk_l);
     double sn, c;
-    sinCos(el.heading, sn, c);
+    sn = std::sin(el.heading);
+    c = std::cos(el.heading);
     const double ly = el.side * local.y();
     p = el.p0 + Eigen::Vector2d(c * local.x() - sn * ly, sn * local.x() + c * ly);
     theta = el.heading + el.side * th_l;

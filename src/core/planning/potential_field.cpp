@@ -6,7 +6,6 @@
 #include <utility>
 
 #include "sowing_robot/core/common/validation.h"
-#include "sowing_robot/core/numerics/trig.h"
 
 namespace sowing_robot {
 namespace core {

@@ -7,7 +7,6 @@
 #include <stdexcept>
 
 #include "sowing_robot/core/common/validation.h"
-#include "sowing_robot/core/numerics/trig.h"
 #include "sowing_robot/core/planning/tool_engagement.h"
 
 namespace sowing_robot {
@@ -149,7 +148,8 @@ EstimatedRunResult loop(const Scenario& sc, const EstimatedRunConfig& cfg, P& pl
         in.dtheta = wrapAngle(odom_pose.theta - last_odom.theta);
         const double mid = last_odom.theta + 0.5 * in.dtheta;
         double s_mid, c_mid;
-        sinCos(mid, s_mid, c_mid);
+        s_mid = std::sin(mid);
+        c_mid = std::cos(mid);
         in.distance = (odom_pose.x - last_odom.x) * c_mid + (odom_pose.y - last_odom.y) * s_mid;
         in.covariance = increment_covariance;
         in.has_rate = true;
@@ -181,7 +181,8 @@ EstimatedRunResult loop(const Scenario& sc, const EstimatedRunConfig& cfg, P& pl
     bool tool_down = false;
     if (draft && k < n) {
       double sn, c;
-      sinCos(s[THETA], sn, c);
+      sn = std::sin(s[THETA]);
+      c = std::cos(s[THETA]);
       const Eigen::Vector2d p(s[X] + c * cfg.tool.x() - sn * cfg.tool.y(), s[Y] + sn * cfg.tool.x() + c * cfg.tool.y());
       tool_down = tool_rule.update(p);
       traction->setToolDown(tool_down);

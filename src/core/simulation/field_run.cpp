@@ -5,7 +5,6 @@
 #include <cstdio>
 #include <stdexcept>
 
-#include "sowing_robot/core/numerics/trig.h"
 #include "sowing_robot/core/planning/tool_engagement.h"
 #include "sowing_robot/core/simulation/traction_run.h"
 
@@ -50,7 +49,8 @@ FieldRunReport runField(const FieldRunSetup& setup) {
     const Pose2D pose{x[X], x[Y], x[THETA]};
     contacts.update(s.t, pose);
     double sn, c;
-    sinCos(x[THETA], sn, c);
+    sn = std::sin(x[THETA]);
+    c = std::cos(x[THETA]);
     const Eigen::Vector2d tool(x[X] + c * setup.tool.x() - sn * setup.tool.y(),
                                x[Y] + sn * setup.tool.x() + c * setup.tool.y());
     Eigen::Vector2d seed;

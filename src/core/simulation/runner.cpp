@@ -5,7 +5,6 @@
 #include <type_traits>
 
 #include "sowing_robot/core/common/validation.h"
-#include "sowing_robot/core/numerics/trig.h"
 
 namespace sowing_robot {
 namespace core {
@@ -36,8 +35,6 @@ namespace {
 // (its add() inlined here, and what it does not read of the LoopSample never built).
 template <typename Outer, typename Inner, typename Trace>
 struct LoopRun {
-  static constexpr bool kanayama = std::is_same_v<Outer, Kanayama>;
-
   LoopRun(const Scenario& scenario, ReferenceSource& ref, Outer& o, Inner& i, bool keep_samples, Trace& tr,
           const RunStop& st)
       : sc(scenario),
@@ -59,9 +56,7 @@ struct LoopRun {
   /// diverged, or stop() said so) and the plant must not step.
   bool control(std::int64_t k) { return observe() && controlObserved(k); }
 
-  /// The state as the controllers receive it in nav_msgs/Odometry (pose, and with Kanayama cos/sin of its
-  /// yaw, which Kanayama needs, and so does the plant's step when the quaternion round trip gave the
-  /// heading back to the bit, about two steps in three: computed once). False: the state diverged.
+  /// The state as the controllers receive it in nav_msgs/Odometry. False: the state diverged.
   bool observe() {
     const State& s = plant.state();
     if (!finiteSum(s)) {
@@ -69,7 +64,6 @@ struct LoopRun {
       return false;
     }
     pose = Pose2D{s[X], s[Y], yawThroughQuaternion(s[THETA])};
-    if constexpr (kanayama) sinCos(pose.theta, sin_yaw, cos_yaw);
     return true;
   }
 
@@ -82,12 +76,7 @@ struct LoopRun {
     worldErrors(ref, pose, ex, ey, eth);
     metrics.add(t, ex, ey, eth);
     // Initialised from the call (not assigned): the controller writes the command in place.
-    const VelocityCommand cmd = [&] {
-      if constexpr (kanayama)
-        return outer.compute(ref, pose, cos_yaw, sin_yaw, s[V], s[OMEGA]);
-      else
-        return outer.compute(ref, pose, s[V], s[OMEGA]);
-    }();
+    const VelocityCommand cmd = outer.compute(ref, pose, s[V], s[OMEGA]);
     // A local, not a member: assigned to one, the result would be copied 16 bytes at a time out of
     // fields just stored 8 bytes at a time (store-forwarding stalls); the torques are taken field by field.
     const InnerOutput u = inner.update(cmd, s[V], s[OMEGA], dt);
@@ -107,12 +96,7 @@ struct LoopRun {
   }
 
   /// The plant's step with this period's torques.
-  void stepPlant() {
-    if constexpr (kanayama)
-      plant.step(tau_right, tau_left, dt, pose.theta, cos_yaw, sin_yaw);
-    else
-      plant.step(tau_right, tau_left, dt);
-  }
+  void stepPlant() { plant.step(tau_right, tau_left, dt); }
   /// Periods from `from` to the end (or to an earlier end of the run).
   void runFrom(std::int64_t from) {
     for (std::int64_t k = from; k <= n; ++k) {
@@ -138,7 +122,6 @@ struct LoopRun {
   MetricsAccumulator metrics;
   RunResult result;
   Pose2D pose;
-  double cos_yaw = 0.0, sin_yaw = 0.0;
   double tau_right = 0.0, tau_left = 0.0;
 };
 

@@ -1,5 +1,4 @@
 #include "sowing_robot/core/simulation/traction_run.h"
-#include "sowing_robot/core/numerics/trig.h"
 
 #include <algorithm>
 #include <cmath>
@@ -32,21 +31,17 @@ TractionRunResult runTractionClosedLoop(const Scenario& sc, const TractionParams
       break;
     }
     const Pose2D pose{s[X], s[Y], yawThroughQuaternion(s[THETA])};
-    // cos/sin of the controllers' yaw, for Kanayama and (when the quaternion gave the heading back to the
-    // bit) the plant's step: one sincos for both, as in runClosedLoop.
-    double sin_yaw, cos_yaw;
-    sinCos(pose.theta, sin_yaw, cos_yaw);
     const Reference ref = reference.next(t);
     double ex, ey, eth;
     worldErrors(ref, pose, ex, ey, eth);
     metrics.add(t, ex, ey, eth);
-    const VelocityCommand cmd = kanayama.compute(ref, pose, cos_yaw, sin_yaw, s[V], s[OMEGA]);
+    const VelocityCommand cmd = kanayama.compute(ref, pose, s[V], s[OMEGA]);
     const SlidingModeOutput u = smc.update(cmd, s[V], s[OMEGA], dt);
     if (u.saturated) ++result.saturated_steps;
     if (trace) trace({t, &s, &ref, &cmd, &u, smc.m0Hat(), smc.i0Hat(), ex, ey, eth});
     result.periods = k;
     if (k < n) {
-      plant.step(u.torques.right, u.torques.left, dt, pose.theta, cos_yaw, sin_yaw);
+      plant.step(u.torques.right, u.torques.left, dt);
       out.max_abs_slip =
           std::max({out.max_abs_slip, std::fabs(plant.slipRatio(RIGHT)), std::fabs(plant.slipRatio(LEFT))});
     }

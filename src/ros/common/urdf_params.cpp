@@ -1,7 +1,6 @@
 #include "sowing_robot/ros/common/urdf_params.h"
 
 #include "sowing_robot/core/common/validation.h"
-#include "sowing_robot/core/numerics/trig.h"
 
 #include <urdf_parser/urdf_parser.h>
 
@@ -289,7 +288,8 @@ std::string projectGeometry(const urdf::Geometry& g, const Eigen::Isometry3d& t,
     for (int k = 0; k < kCircle; ++k) {
       const double a = 2.0 * M_PI * k / kCircle;
       double s, c;
-      core::sinCos(a, s, c);
+      s = std::sin(a);
+      c = std::cos(a);
       add(centre + r * (c * e1 + s * e2));
     }
   };

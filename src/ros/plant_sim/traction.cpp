@@ -7,7 +7,6 @@
 #include <cmath>
 #include <cstdio>
 
-#include "sowing_robot/core/numerics/trig.h"
 #include "sowing_robot/ros/common/component_params.h"
 
 namespace sowing_robot {
@@ -97,7 +96,8 @@ void TractionModel::step(double tau_right, double tau_left, double dt) {
     // The tool point of the state the torque answers (t_k): the same rows and pose in every run.
     const core::State& s = plant_.state();
     double sn, c;
-    core::sinCos(s[core::THETA], sn, c);
+    sn = std::sin(s[core::THETA]);
+    c = std::cos(s[core::THETA]);
     const Eigen::Vector2d p(s[core::X] + c * cfg_.tool.x() - sn * cfg_.tool.y(),
                             s[core::Y] + sn * cfg_.tool.x() + c * cfg_.tool.y());
     std::lock_guard<std::mutex> lock(mutex_);

@@ -3,7 +3,8 @@
 
 #include <cmath>
 #include <cstdint>
-#include "sowing_robot/core/numerics/trig.h"
+
+#include <Eigen/Core>
 
 namespace sowing_robot {
 namespace core {
@@ -51,9 +52,13 @@ inline double secondsFromNanos(std::int64_t ns) {
 /// back, so that the runner sees what the nodes see in nav_msgs/Odometry.
 inline double yawThroughQuaternion(double theta) {
   double z, w;
-  sinCos(0.5 * theta, z, w);
+  z = std::sin(0.5 * theta);
+  w = std::cos(0.5 * theta);
   return std::atan2(2.0 * w * z, 1.0 - 2.0 * z * z);
 }
+
+/// (cos h, sin h): the unit vector of heading h.
+inline Eigen::Vector2d unitVector(double heading) { return {std::cos(heading), std::sin(heading)}; }
 
 /// True when every argument is a finite number.
 template <typename... T>

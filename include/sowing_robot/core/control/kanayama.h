@@ -5,7 +5,6 @@
 
 #include "sowing_robot/core/common/param_table.h"
 #include "sowing_robot/core/common/types.h"
-#include "sowing_robot/core/numerics/trig.h"
 
 namespace sowing_robot {
 namespace core {
@@ -38,10 +37,6 @@ class Kanayama {
   /// differentiation (and no filter lag) enters the inner loop. A non-finite input gives the stop
   /// command (all zero), never a NaN: the safe output of a stateless controller.
   VelocityCommand compute(const Reference& ref, const Pose2D& actual, double v, double omega) const;
-  /// compute() with cos_theta, sin_theta = sinCos(actual.theta) supplied by a
-  /// caller that needs them too (runClosedLoop shares them with the plant's step): the same numbers.
-  VelocityCommand compute(const Reference& ref, const Pose2D& actual, double cos_theta, double sin_theta, double v,
-                          double omega) const;
 
   /// eq 4.14: L0 = (xe^2 + ye^2)/2 + (1 - cos thetae)/ky.
   double lyapunov(const PostureError& e) const;

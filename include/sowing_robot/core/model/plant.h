@@ -50,10 +50,6 @@ class Plant {
   /// false, leaving the state, the time and the noise generator untouched, when a torque is not finite
   /// or dt is not a finite positive number: bad input never reaches the integrator.
   bool step(double tau_right, double tau_left, double dt);
-  /// step() for a caller that already has cos/sin of some heading (runClosedLoop: of the yaw the
-  /// controllers see, which is the plant's own heading to the bit about two steps in three): used when
-  /// `theta` is bit-identical to the state's heading, else computed. The same numbers as step().
-  bool step(double tau_right, double tau_left, double dt, double theta, double cos_theta, double sin_theta);
 
   /// Time derivative of the state for the *applied* torques (commands + disturbance already added).
   State derivative(const State& s, double applied_right, double applied_left) const;

@@ -158,9 +158,6 @@ class TractionPlant {
   /// Advance by dt [s] with the commanded wheel torques [N·m] held over the step (plus the disturbance,
   /// as in Plant). Returns false, changing nothing, for a non-finite torque or dt <= 0.
   bool step(double tau_right, double tau_left, double dt);
-  /// The same step, given cos/sin of `theta` (the caller has them already): used when theta is the
-  /// plant's heading to the bit, otherwise computed again, so the result is step()'s either way.
-  bool step(double tau_right, double tau_left, double dt, double theta, double cos_theta, double sin_theta);
 
   const State& state() const { return state_; }
   double time() const { return time_; }

@@ -3,7 +3,6 @@
 #pragma once
 
 #include <cmath>
-#include "sowing_robot/core/numerics/trig.h"
 
 namespace sowing_robot {
 namespace core {
@@ -31,7 +30,8 @@ inline void rotateHeading(double cos0, double sin0, double delta, double& cos_ou
     return;
   }
   double sd, cd;
-  sinCos(delta, sd, cd);
+  sd = std::sin(delta);
+  cd = std::cos(delta);
   cos_out = cos0 * cd - sin0 * sd;
   sin_out = sin0 * cd + cos0 * sd;
 }

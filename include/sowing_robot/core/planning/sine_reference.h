@@ -9,7 +9,6 @@
 #include <string>
 
 #include "sowing_robot/core/common/reference.h"
-#include "sowing_robot/core/numerics/trig.h"
 
 namespace sowing_robot {
 namespace core {
@@ -45,7 +44,8 @@ class SineReference : public ReferenceSource {
     const double k = 2.0 * M_PI / p_.wavelength, u = p_.speed_x, a = p_.amplitude;
     const double phi = k * u * t;
     double s, c;
-    sinCos(phi, s, c);
+    s = std::sin(phi);
+    c = std::cos(phi);
     // Derivatives of (x, y) in t: x' = u, x'' = 0; y' = u A k cos, y'' = -u^2 A k^2 sin, y''' = -u^3 A k^3 cos.
     const double yd = u * a * k * c, ydd = -u * u * a * k * k * s, yddd = -u * u * u * a * k * k * k * c;
     const double v2 = u * u + yd * yd, v = std::sqrt(v2);

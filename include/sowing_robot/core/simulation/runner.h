@@ -20,7 +20,6 @@
 #include "sowing_robot/core/control/kanayama.h"
 #include "sowing_robot/core/control/sliding_mode.h"
 #include "sowing_robot/core/model/plant.h"
-#include "sowing_robot/core/numerics/trig.h"
 #include "sowing_robot/core/simulation/metrics.h"
 
 namespace sowing_robot {
@@ -67,7 +66,8 @@ inline double crossTrack(const LoopSample& s) {
   // sin(+-0) = +-0 and cos(+-0) = 1 exactly: a line or a row along x needs no sincos every period.
   double sn = th, c = 1.0;
   if (th != 0.0) {
-    sinCos(th, sn, c);
+    sn = std::sin(th);
+    c = std::cos(th);
   }
   return -sn * s.ex + c * s.ey;
 }

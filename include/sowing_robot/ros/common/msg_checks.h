@@ -8,7 +8,6 @@
 #include <cstdint>
 
 #include "sowing_robot/core/common/types.h"
-#include "sowing_robot/core/numerics/trig.h"
 
 namespace sowing_robot {
 
@@ -22,7 +21,8 @@ inline core::Pose2D poseOf(const nav_msgs::Odometry& o) {
 /// The quaternion of a yaw about z, as core::yawThroughQuaternion builds it (poseOf inverts it).
 inline geometry_msgs::Quaternion yawQuaternion(double theta) {
   geometry_msgs::Quaternion q;
-  core::sinCos(0.5 * theta, q.z, q.w);
+  q.z = std::sin(0.5 * theta);
+  q.w = std::cos(0.5 * theta);
   return q;
 }
 
