@@ -19,8 +19,8 @@
 #include "sowing_robot/core/evaluation/pso.h"
 #include "sowing_robot/core/evaluation/tuning.h"
 #include "sowing_robot/core/model/plant.h"
+#include "sowing_robot/core/simulation/closed_loop.h"
 #include "sowing_robot/core/simulation/runner.h"
-#include "sowing_robot/core/simulation/traction_run.h"
 #include "thesis_scenario.h"
 
 using namespace sowing_robot;
@@ -133,10 +133,15 @@ void BM_ThesisRun25sTraction(benchmark::State& state) {
   const Scenario sc = bench::thesisScenario();
   LineReference ref = bench::thesisLine();
   const TractionParams traction;
+  const std::function<void(const LoopSample&)> no_trace;
   volatile double itae = 0.0;
   for (auto _ : state) {
-    const TractionRunResult r = runTractionClosedLoop(sc, traction, ref, false);
-    itae = r.run.metrics[AXIS_Y].itae;
+    // The one loop on the traction plant, fed its own state (no sensors), as runClosedLoop feeds the Plant.
+    SlipPlant plant{TractionPlant(sc.robot, sc.disturbance, traction)};
+    StateFeed feed;
+    Kanayama outer(sc.kanayama);
+    SlidingModeController inner(sc.sliding, sc.robot);
+    itae = closedLoop(sc, plant, feed, outer, inner, ref, false, no_trace, RunStop{}).run.metrics[AXIS_Y].itae;
   }
   state.SetItemsProcessed(state.iterations() * sc.steps());
   state.counters["itae_y"] = benchmark::Counter(itae, benchmark::Counter::kDefaults);

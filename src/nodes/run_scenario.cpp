@@ -26,9 +26,9 @@
 #include <vector>
 
 #include "sowing_robot/core/common/validation.h"
+#include "sowing_robot/core/simulation/estimated_run.h"
 #include "sowing_robot/core/simulation/field_run.h"
 #include "sowing_robot/core/simulation/runner.h"
-#include "sowing_robot/core/simulation/traction_run.h"
 
 using namespace sowing_robot::core;
 
@@ -200,9 +200,11 @@ int main(int argc, char** argv) {
     const auto t0 = std::chrono::steady_clock::now();
     for (int k = 0; k < repeat; ++k) {
       if (traction.enabled) {
-        const TractionRunResult tr = runTractionClosedLoop(sc, traction, ref);
-        r = tr.run;
-        max_slip = tr.max_abs_slip;
+        EstimatedRunConfig plant;  // the traction plant, fed the truth
+        plant.traction = traction;
+        const EstimatedRunResult er = runEstimatedLoop(sc, plant, ref);
+        r = er.run;
+        max_slip = er.max_abs_slip;
       } else {
         r = runClosedLoop(sc, ref);
       }

@@ -5,8 +5,7 @@
 #include <cstdio>
 #include <stdexcept>
 
-#include "sowing_robot/core/planning/tool_engagement.h"
-#include "sowing_robot/core/simulation/traction_run.h"
+#include "sowing_robot/core/simulation/estimated_run.h"
 
 namespace sowing_robot {
 namespace core {
@@ -41,10 +40,8 @@ FieldRunReport runField(const FieldRunSetup& setup) {
                   setup.scoring_obstacles.empty() ? setup.obstacles : setup.scoring_obstacles,
                   setup.field.potential.influence_distance);
   FieldRunReport rep;
-  TractionPlant* traction_plant = nullptr;  // with setup.traction: the plant of the run
-  ToolEngagement tool_rule(setup.seeding, rowsOf(setup.field));
-  const double dt = secondsFromNanos(setup.scenario.control_period_ns);
-  auto trace = [&](const LoopSample& s) {
+  auto trace = [&](const EstimatedSample& es) {
+    const LoopSample& s = *es.loop;
     const State& x = *s.state;
     const Pose2D pose{x[X], x[Y], x[THETA]};
     contacts.update(s.t, pose);
@@ -55,11 +52,6 @@ FieldRunReport runField(const FieldRunSetup& setup) {
                                x[Y] + sn * setup.tool.x() + c * setup.tool.y());
     Eigen::Vector2d seed;
     drill.update(tool, s.reference->tool_down, seed);
-    // The plant's own tool rule on the state the next step starts from (as plant_sim's TractionModel).
-    if (traction_plant && setup.traction->draft_force > 0.0) {
-      traction_plant->setToolDown(tool_rule.update(tool));
-      if (traction_plant->toolDown()) rep.tool_down_time += dt;
-    }
     const Reference& r = *s.reference;
     if (s.t >= setup.peaks_from) {
       rep.peak_yaw_rate = std::max(rep.peak_yaw_rate, std::fabs(x[OMEGA]));
@@ -71,20 +63,18 @@ FieldRunReport runField(const FieldRunSetup& setup) {
     rep.max_speed = std::max(rep.max_speed, std::fabs(x[V]));
     if (setup.on_step) setup.on_step(s.t, reference, contacts);
   };
-  RunResult run;
-  if (setup.traction) {
-    const SoilMap soil(setup.patches);
-    const TractionRunResult tr =
-        runTractionClosedLoop(setup.scenario, *setup.traction, reference, false, trace, [&](TractionPlant& p) {
-          p.setSoil(soil);
-          p.setToolPoint(setup.tool);
-          traction_plant = &p;
-        });
-    run = tr.run;
-    rep.max_slip = tr.max_abs_slip;
-  } else {
-    run = runClosedLoop(setup.scenario, reference, false, trace);
-  }
+  // The plant fed its own state; with setup.traction the wheel-soil plant, whose tool rule lowers the tool
+  // on the field's rows (as plant_sim's TractionModel).
+  EstimatedRunConfig plant;
+  plant.traction = setup.traction;
+  plant.patches = setup.patches;
+  plant.tool = setup.tool;
+  plant.tool_rows = rowsOf(setup.field);
+  plant.seeding = setup.seeding;
+  const EstimatedRunResult er = runEstimatedLoop(setup.scenario, plant, reference, false, trace);
+  const RunResult& run = er.run;
+  rep.max_slip = er.max_abs_slip;
+  rep.tool_down_time = er.tool_down_time;
   rep.saturated = static_cast<long>(run.saturated_steps);
   contacts.finish();
   rep.min_clearance = contacts.minClearance();

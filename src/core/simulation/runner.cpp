@@ -2,9 +2,8 @@
 
 #include <cmath>
 #include <limits>
-#include <type_traits>
-
 #include "sowing_robot/core/common/validation.h"
+#include "sowing_robot/core/simulation/closed_loop.h"
 
 namespace sowing_robot {
 namespace core {
@@ -29,110 +28,16 @@ std::int64_t Scenario::steps() const {
 
 namespace {
 
-// One run's state through the loop, over concrete controller types (no virtual call when they are final or
-// plain classes): Outer::compute(ref, pose, v, omega) -> VelocityCommand; Inner::update(cmd, v, omega, dt)
-// -> InnerOutput, m0Hat(), i0Hat(). Trace: the public API's std::function (may be empty), or a RunTally
-// (its add() inlined here, and what it does not read of the LoopSample never built).
-template <typename Outer, typename Inner, typename Trace>
-struct LoopRun {
-  LoopRun(const Scenario& scenario, ReferenceSource& ref, Outer& o, Inner& i, bool keep_samples, Trace& tr,
-          const RunStop& st)
-      : sc(scenario),
-        reference(ref),
-        outer(o),
-        inner(i),
-        trace(tr),
-        stop(st),
-        plant(scenario.robot, scenario.disturbance),
-        n(scenario.steps()),
-        dt(secondsFromNanos(scenario.control_period_ns)),
-        metrics(keep_samples) {
-    plant.reset(startState(sc), phaseStartTime(sc));
-    reference.reset();
-    metrics.reserve(static_cast<std::size_t>(n + 1));
-  }
-
-  /// Period k up to its torques (tau_right, tau_left, for stepPlant()). False: the run ends at k (the state
-  /// diverged, or stop() said so) and the plant must not step.
-  bool control(std::int64_t k) { return observe() && controlObserved(k); }
-
-  /// The state as the controllers receive it in nav_msgs/Odometry. False: the state diverged.
-  bool observe() {
-    const State& s = plant.state();
-    if (!finiteSum(s)) {
-      result.diverged = true;
-      return false;
-    }
-    pose = Pose2D{s[X], s[Y], yawThroughQuaternion(s[THETA])};
-    return true;
-  }
-
-  /// control(k) after observe().
-  bool controlObserved(std::int64_t k) {
-    const double t = secondsFromNanos(k * sc.control_period_ns);
-    const State& s = plant.state();
-    const Reference& ref = reference.next(t);  // the source's copy, valid until the next call
-    double ex, ey, eth;
-    worldErrors(ref, pose, ex, ey, eth);
-    metrics.add(t, ex, ey, eth);
-    // Initialised from the call (not assigned): the controller writes the command in place.
-    const VelocityCommand cmd = outer.compute(ref, pose, s[V], s[OMEGA]);
-    // A local, not a member: assigned to one, the result would be copied 16 bytes at a time out of
-    // fields just stored 8 bytes at a time (store-forwarding stalls); the torques are taken field by field.
-    const InnerOutput u = inner.update(cmd, s[V], s[OMEGA], dt);
-    if (u.saturated) ++result.saturated_steps;
-    if constexpr (std::is_same_v<Trace, RunTally>)
-      trace.add({t, &s, &ref, &cmd, &u, inner.m0Hat(), inner.i0Hat(), ex, ey, eth});
-    else if (trace)
-      trace({t, &s, &ref, &cmd, &u, inner.m0Hat(), inner.i0Hat(), ex, ey, eth});
-    result.periods = k;
-    if (stop && k % kStopCheckEvery == kStopCheckEvery - 1 && k < n && stop(metrics)) {
-      result.stopped = true;
-      return false;
-    }
-    tau_right = u.torques.right;
-    tau_left = u.torques.left;
-    return true;
-  }
-
-  /// The plant's step with this period's torques.
-  void stepPlant() { plant.step(tau_right, tau_left, dt); }
-  /// Periods from `from` to the end (or to an earlier end of the run).
-  void runFrom(std::int64_t from) {
-    for (std::int64_t k = from; k <= n; ++k) {
-      if (!control(k)) break;
-      if (k < n) stepPlant();
-    }
-  }
-
-  RunResult finish() {
-    closeRun(result, plant.state(), metrics);
-    return result;
-  }
-
-  const Scenario& sc;
-  ReferenceSource& reference;
-  Outer& outer;
-  Inner& inner;
-  Trace& trace;
-  const RunStop& stop;
-  Plant plant;
-  const std::int64_t n;
-  const double dt;
-  MetricsAccumulator metrics;
-  RunResult result;
-  Pose2D pose;
-  double tau_right = 0.0, tau_left = 0.0;
-};
-
+// runClosedLoop's runs: the no-slip plant fed its own state, through the one loop (closed_loop.h).
 template <typename Outer, typename Inner, typename Trace>
 RunResult loop(const Scenario& sc, ReferenceSource& reference, Outer& outer, Inner& inner, bool keep_samples,
                Trace& trace, const RunStop& stop) {
-  LoopRun<Outer, Inner, Trace> run(sc, reference, outer, inner, keep_samples, trace, stop);
-  run.runFrom(0);
-  return run.finish();
+  NoSlipPlant plant{Plant(sc.robot, sc.disturbance)};
+  StateFeed feed;
+  return closedLoop(sc, plant, feed, outer, inner, reference, keep_samples, trace, stop).run;
 }
 
+// The scenario's controllers as concrete types (direct calls in the loop).
 template <typename Outer, typename Trace>
 RunResult withInner(const Scenario& sc, ReferenceSource& reference, Outer& outer, bool keep_samples, Trace& trace,
                     const RunStop& stop) {

@@ -13,10 +13,26 @@
 
 #include "sowing_robot/core/model/plant.h"
 #include "sowing_robot/core/model/traction.h"
+#include "sowing_robot/core/simulation/closed_loop.h"
 #include "sowing_robot/core/simulation/runner.h"
-#include "sowing_robot/core/simulation/traction_run.h"
 
 using namespace sowing_robot::core;
+
+namespace {
+
+/// The one closed loop (closed_loop.h) on the traction plant, fed its own state, with Kanayama and the
+/// sliding mode; tool_down: the tool held down (its draft acting) the whole run.
+EstimatedRunResult tractionRun(const Scenario& sc, const TractionParams& t, ReferenceSource& ref,
+                               const std::function<void(const LoopSample&)>& trace = {}, bool tool_down = false) {
+  SlipPlant plant{TractionPlant(sc.robot, sc.disturbance, t)};
+  plant.plant.setToolDown(tool_down);
+  StateFeed feed;
+  Kanayama outer(sc.kanayama);
+  SlidingModeController inner(sc.sliding, sc.robot);
+  return closedLoop(sc, plant, feed, outer, inner, ref, false, trace, RunStop{});
+}
+
+}  // namespace
 
 namespace {
 constexpr double kDt = 1e-3;
@@ -142,7 +158,7 @@ TEST(Traction, ThesisLoopOnSoilAndIceStaysFiniteAndReportsSaturation) {
     TractionParams t;
     t.mu_peak = mu;
     t.mu_slide = 0.75 * mu;
-    const TractionRunResult r = runTractionClosedLoop(sc, t, line, false);
+    const EstimatedRunResult r = tractionRun(sc, t, line);
     EXPECT_FALSE(r.run.diverged) << mu;
     EXPECT_TRUE(r.run.final_state.allFinite()) << mu;
     EXPECT_EQ(r.run.periods, sc.steps()) << mu;
@@ -162,7 +178,7 @@ TEST(Traction, ThesisLoopTracksOnLooseSoilWithASoilSizedTorqueLimit) {
   sc.sliding.max_torque = 4.0;
   LineReference line;
   double late = 0.0;
-  const TractionRunResult r = runTractionClosedLoop(sc, TractionParams{}, line, false, [&](const LoopSample& s) {
+  const EstimatedRunResult r = tractionRun(sc, TractionParams{}, line, [&](const LoopSample& s) {
     if (s.t > 15.0) late = std::max(late, std::fabs(s.ey));
   });
   std::printf("max_torque 4: ISE y %.3f, max |ey| after 15 s %.4f m, saturated %lld periods\n",
@@ -234,7 +250,7 @@ TEST(Traction, ThesisLineMetricsApproachTodaysAsGripGrows) {
               today.metrics[AXIS_Y].itae, today.metrics[AXIS_THETA].ise);
   std::vector<double> rel;
   for (const Soil& s : soils) {
-    const TractionRunResult r = runTractionClosedLoop(sc, grip(s.mu, s.k), line, false);
+    const EstimatedRunResult r = tractionRun(sc, grip(s.mu, s.k), line);
     ASSERT_FALSE(r.run.diverged) << s.name;
     const double d = std::fabs(r.run.metrics[AXIS_Y].ise - today.metrics[AXIS_Y].ise) / today.metrics[AXIS_Y].ise;
     std::printf("| %s | %g | %g | %.6g | %.6g | %.6g | %.3g | %.2e |\n", s.name, s.mu, s.k, r.run.metrics[AXIS_Y].ise,
@@ -426,7 +442,7 @@ TEST(Traction, CostBesidePlant) {
     auto t0 = Clock::now();
     runClosedLoop(sc, line, false);
     auto t1 = Clock::now();
-    runTractionClosedLoop(sc, t, line, false);
+    tractionRun(sc, t, line);
     auto t2 = Clock::now();
     best_plant = std::min(best_plant, std::chrono::duration<double, std::milli>(t1 - t0).count());
     best_traction = std::min(best_traction, std::chrono::duration<double, std::milli>(t2 - t1).count());
@@ -540,8 +556,7 @@ TEST(TractionDraft, ClosedLoopAgainstAnInsurmountableDraftEndsAndReportsSaturati
   LineReference line;
   TractionParams t;
   t.draft_force = 300.0;
-  const TractionRunResult r =
-      runTractionClosedLoop(sc, t, line, false, {}, [](TractionPlant& p) { p.setToolDown(true); });
+  const EstimatedRunResult r = tractionRun(sc, t, line, {}, true);
   EXPECT_FALSE(r.run.diverged);
   EXPECT_TRUE(r.run.final_state.allFinite());
   EXPECT_EQ(r.run.periods, sc.steps());

@@ -1,6 +1,6 @@
 // The in-process loop with an estimate in it (core/simulation/estimated_run.h) and the benchmark rows built on it
-// (core/evaluation/estimated_bench.h): fed the truth it is runClosedLoop / runTractionClosedLoop bit for bit; fed
-// the EKF on the line its error stays bounded; fed the encoders it drifts under slip; the sensors' seed
+// (core/evaluation/estimated_bench.h): fed the truth it is runClosedLoop / the one loop with the plant's own state bit
+// for bit; fed the EKF on the line its error stays bounded; fed the encoders it drifts under slip; the sensors' seed
 // changes the sensor noise and nothing else; a benchmark row through it equals today's row; a robot that
 // stalls on the patch is counted as not finished.
 #include <gtest/gtest.h>
@@ -10,8 +10,8 @@
 
 #include "sowing_robot/core/evaluation/benchmark.h"
 #include "sowing_robot/core/evaluation/estimated_bench.h"
+#include "sowing_robot/core/simulation/closed_loop.h"
 #include "sowing_robot/core/simulation/estimated_run.h"
-#include "sowing_robot/core/simulation/traction_run.h"
 
 using namespace sowing_robot::core;
 
@@ -73,8 +73,8 @@ TEST(EstimatedRun, FedTheTruthItIsRunClosedLoopBitForBit) {
   }
 }
 
-TEST(EstimatedRun, FedTheTruthOnTheTractionPlantItIsRunTractionClosedLoopBitForBit) {
-  Scenario sc = line(OuterKind::kanayama, InnerKind::sliding_mode, true, 0.0);  // that loop has no phase
+TEST(EstimatedRun, FedTheTruthOnTheTractionPlantItIsTheLoopOnThePlantsOwnStateBitForBit) {
+  Scenario sc = line(OuterKind::kanayama, InnerKind::sliding_mode, true);
   TractionParams t;
   t.enabled = true;
   t.mu_peak = 0.35;
@@ -86,8 +86,14 @@ TEST(EstimatedRun, FedTheTruthOnTheTractionPlantItIsRunTractionClosedLoopBitForB
   wet.rolling_resistance =
       0.15;  // soft: the patch changes the run (within the curve's linear part grip alone would not)
   LineReference ref;
-  const TractionRunResult today =
-      runTractionClosedLoop(sc, t, ref, true, {}, [&](TractionPlant& p) { p.setSoil(SoilMap({wet})); });
+  // The sensors' feed fed the truth against the plant's own state (closed_loop.h's StateFeed, no sensors).
+  SlipPlant plant{TractionPlant(sc.robot, sc.disturbance, t)};
+  plant.plant.setSoil(SoilMap({wet}));
+  StateFeed state_feed;
+  Kanayama outer(sc.kanayama);
+  SlidingModeController inner(sc.sliding, sc.robot);
+  const std::function<void(const LoopSample&)> no_trace;
+  const EstimatedRunResult today = closedLoop(sc, plant, state_feed, outer, inner, ref, true, no_trace, RunStop{});
   EstimatedRunConfig cfg;
   cfg.traction = t;
   cfg.patches = {wet};

@@ -20,10 +20,7 @@
 //       update on the new state at t_{k+1} (encoders, yaw rate, fix sampling), as SimulatedPlant::step.
 // With feedback ground_truth the sensors still run (their output unused), so a run's numbers do not
 // depend on it; the controllers then see exactly what runClosedLoop's see (test_estimated_run: equal bit
-// for bit to runClosedLoop, and to runTractionClosedLoop with the traction plant at phase 0).
-//
-// One loop over both plants (a template in estimated_run.cpp) replaces neither runClosedLoop (its hot
-// path stays as it is) nor runTractionClosedLoop (kept for its callers); both are its special cases.
+// for bit to runClosedLoop). Both are the one loop of closed_loop.h, with another feedback source.
 #pragma once
 
 #include <Eigen/Core>

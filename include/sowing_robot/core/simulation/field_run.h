@@ -1,4 +1,4 @@
-// A field run in-process, measured on the body: the closed loop (runClosedLoop) on a FieldReference,
+// A field run in-process, measured on the body: the closed loop (closed_loop.h) on a FieldReference,
 // with the footprint checked against the obstacles (ContactMonitor), the seed drill scoring the tool
 // point, and the peaks of the robot's yaw rate and lateral acceleration v omega. Used by the avoidance
 // tests and by run_scenario --field (the figures of the README's field table).
@@ -42,8 +42,7 @@ struct FieldRunSetup {
   std::function<void(double t, FieldReference& reference, ContactMonitor& contacts)> on_step;
   /// Peaks are taken from this time on (e.g. after the approach from the start) [s].
   double peaks_from = 0.0;
-  /// Set: the traction plant (traction.h, runTractionClosedLoop: Kanayama + sliding mode, whatever
-  /// scenario.outer says) in place of the no-slip Plant, on these soil patches, with the tool's draft
+  /// Set: the traction plant (traction.h) in place of the no-slip Plant, on these soil patches, with the tool's draft
   /// (traction->draft_force) while the tool is down by the plant's own rule (tool_engagement.h, on the
   /// field's rows), as plant_sim does with traction:=true.
   std::optional<TractionParams> traction;

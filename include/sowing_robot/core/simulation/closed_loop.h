@@ -1,0 +1,168 @@
+// The one closed loop of the core: a plant, a feedback source, an outer and an inner controller and a
+// reference, stepped period by period in the order the node pipeline steps them in lockstep, so that
+// the in-process runs and the nodes give the same numbers. Every in-process run goes through it:
+// runClosedLoop (runner.h: the no-slip plant, fed its own state), runEstimatedLoop (estimated_run.h:
+// either plant, fed the state, the encoders or the EKF), and through them the benchmark, the tuner, the
+// field runs and the Python module.
+//
+// Period k, t_k = k * period (secondsFromNanos, as ros::Time::toSec):
+//   1. the state; a non-finite one ends the run as diverged;
+//   2. the feedback source gives the pose (through the quaternion round trip of nav_msgs/Odometry) and
+//      twist the controllers get;
+//   3. the reference at t_k; the errors against the TRUE pose go into the metrics;
+//   4. outer controller -> velocity command, inner controller -> wheel torques;
+//   5. with the traction plant and a draft: the tool rule on the true tool point lowers or lifts the tool;
+//   6. the trace sees the period; the caller's stop() may end the run here (every kStopCheckEvery);
+//   7. the plant steps (k < n), then the sensors see the new state at t_{k+1}.
+//
+// The parts are template parameters, so the per-period calls are direct:
+//   Plant: NoSlipPlant or SlipPlant (below); Feed: StateFeed (the plant's state, no sensors) or the
+//   sensors with the fed pose chosen at run time (estimated_run.cpp's SensorFeed); Outer/Inner: the concrete
+//   controllers or the run-time interfaces of controllers.h; Trace: an empty std::function, a std::function of
+//   LoopSample or EstimatedSample, or a RunTally (its add() inlined, and what it does not read never built).
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <type_traits>
+
+#include "sowing_robot/core/model/traction.h"
+#include "sowing_robot/core/planning/tool_engagement.h"
+#include "sowing_robot/core/simulation/estimated_run.h"
+#include "sowing_robot/core/simulation/runner.h"
+
+namespace sowing_robot {
+namespace core {
+
+/// The no-slip Plant behind the loop's plant interface.
+struct NoSlipPlant {
+  static constexpr bool kTraction = false;
+  Plant plant;
+  void reset(const State& x0, double t0) { plant.reset(x0, t0); }
+  void step(double r, double l, double dt) { plant.step(r, l, dt); }
+  const State& state() const { return plant.state(); }
+  double slip(Wheel) const { return 0.0; }
+  void setToolDown(bool) {}
+};
+
+/// The wheel–soil TractionPlant behind the same interface.
+struct SlipPlant {
+  static constexpr bool kTraction = true;
+  TractionPlant plant;
+  void reset(const State& x0, double t0) { plant.reset(x0, t0); }
+  void step(double r, double l, double dt) { plant.step(r, l, dt); }
+  const State& state() const { return plant.state(); }
+  double slip(Wheel w) const { return plant.slipRatio(w); }
+  void setToolDown(bool down) { plant.setToolDown(down); }
+};
+
+/// What the controllers are fed in one period.
+struct Fed {
+  Pose2D pose;  ///< yaw through the quaternion round trip
+  double v, omega;
+};
+
+/// Feedback: the plant's own state (perfect sensing; no sensors run).
+struct StateFeed {
+  void start(const State&) {}
+  Fed observe(double, const State& s, const Pose2D& truth) { return {truth, s[V], s[OMEGA]}; }
+  void afterStep(std::int64_t, const State&) {}
+  void finish(EstimatedRunResult&) const {}
+};
+
+/// The tool rule of the traction plant with a draft (tool_engagement.h), on the true tool point.
+struct ToolRule {
+  bool active;           ///< the traction plant with draft_force > 0
+  Eigen::Vector2d tool;  ///< the tool point in base_link [m]
+  ToolEngagement rule;
+  /// Lowered (true) or lifted for the step from state s.
+  bool update(const State& s) {
+    const double sn = std::sin(s[THETA]), c = std::cos(s[THETA]);
+    return rule.update({s[X] + c * tool.x() - sn * tool.y(), s[Y] + sn * tool.x() + c * tool.y()});
+  }
+};
+
+namespace loop_detail {
+
+// Whether the trace is to see this period (a RunTally always; a std::function when set), and the period
+// handed to it: LoopSample, or EstimatedSample with what the controllers were fed.
+inline bool wants(const RunTally&) { return true; }
+template <typename Sample>
+bool wants(const std::function<void(const Sample&)>& trace) {
+  return static_cast<bool>(trace);
+}
+inline void emit(const std::function<void(const LoopSample&)>& trace, const LoopSample& s, const Fed&, double, double,
+                 bool) {
+  trace(s);
+}
+inline void emit(const std::function<void(const EstimatedSample&)>& trace, const LoopSample& s, const Fed& fed,
+                 double slip_r, double slip_l, bool tool_down) {
+  trace({&s, fed.pose, fed.v, fed.omega, slip_r, slip_l, tool_down});
+}
+inline void emit(RunTally& tally, const LoopSample& s, const Fed&, double, double, bool) { tally.add(s); }
+
+}  // namespace loop_detail
+
+/// Runs scenario `sc` (its timing, start, disturbance phase) on `plant` (constructed, not yet reset) with
+/// the given feedback, controllers and reference; see the file comment for the order of a period.
+template <typename PlantT, typename Feed, typename Outer, typename Inner, typename Trace>
+EstimatedRunResult closedLoop(const Scenario& sc, PlantT& plant, Feed& feed, Outer& outer, Inner& inner,
+                              ReferenceSource& reference, bool keep_samples, Trace& trace, const RunStop& stop,
+                              ToolRule* tool = nullptr) {
+  plant.reset(startState(sc), phaseStartTime(sc));
+  reference.reset();
+  feed.start(plant.state());
+  const std::int64_t n = sc.steps();
+  const double dt = secondsFromNanos(sc.control_period_ns);
+  MetricsAccumulator metrics(keep_samples);
+  metrics.reserve(static_cast<std::size_t>(n + 1));
+  EstimatedRunResult out;
+  RunResult& result = out.run;
+
+  for (std::int64_t k = 0; k <= n; ++k) {
+    const double t = secondsFromNanos(k * sc.control_period_ns);
+    const State& s = plant.state();
+    if (!finiteSum(s)) {
+      result.diverged = true;
+      break;
+    }
+    const Pose2D truth{s[X], s[Y], yawThroughQuaternion(s[THETA])};
+    const Fed fed = feed.observe(t, s, truth);
+    const Reference& ref = reference.next(t);  // the source's copy, valid until the next call
+    double ex, ey, eth;
+    worldErrors(ref, truth, ex, ey, eth);
+    metrics.add(t, ex, ey, eth);
+    const VelocityCommand cmd = outer.compute(ref, fed.pose, fed.v, fed.omega);
+    const InnerOutput u = inner.update(cmd, fed.v, fed.omega, dt);
+    if (u.saturated) ++result.saturated_steps;
+    bool tool_down = false;
+    if constexpr (PlantT::kTraction) {
+      if (tool != nullptr && tool->active && k < n) {
+        tool_down = tool->update(s);
+        plant.setToolDown(tool_down);
+        if (tool_down) out.tool_down_time += dt;
+      }
+    }
+    if (loop_detail::wants(trace))
+      loop_detail::emit(trace, {t, &s, &ref, &cmd, &u, inner.m0Hat(), inner.i0Hat(), ex, ey, eth}, fed,
+                        plant.slip(RIGHT), plant.slip(LEFT), tool_down);
+    result.periods = k;
+    if (stop && k % kStopCheckEvery == kStopCheckEvery - 1 && k < n && stop(metrics)) {
+      result.stopped = true;
+      break;
+    }
+    if (k == n) break;
+    plant.step(u.torques.right, u.torques.left, dt);
+    if constexpr (PlantT::kTraction)
+      out.max_abs_slip = std::max({out.max_abs_slip, std::fabs(plant.slip(RIGHT)), std::fabs(plant.slip(LEFT))});
+    feed.afterStep(k + 1, plant.state());
+  }
+  closeRun(result, plant.state(), metrics);
+  feed.finish(out);
+  return out;
+}
+
+}  // namespace core
+}  // namespace sowing_robot
