@@ -137,7 +137,7 @@ void BM_ThesisRun25sTraction(benchmark::State& state) {
   volatile double itae = 0.0;
   for (auto _ : state) {
     // The one loop on the traction plant, fed its own state (no sensors), as runClosedLoop feeds the Plant.
-    SlipPlant plant{TractionPlant(sc.robot, sc.disturbance, traction)};
+    SlipPlant plant{TractionPlant(sc.robot, sc.disturbance, traction), sc.robot.R};
     StateFeed feed;
     Kanayama outer(sc.kanayama);
     SlidingModeController inner(sc.sliding, sc.robot);

@@ -305,10 +305,12 @@ const std::vector<std::string>& pendingModels() {
 
 core::BenchScenario loadScenarioFileImpl(const std::string& path) {
   const YAML::Node root = loadYaml(path);
-  onlyKeys(root,
-           {"name", "description", "track", "duration", "control_rate", "start", "line", "sine", "field", "plant",
-            "draws", "success", "envelope_period", "requires", "traction", "sensors", "estimator", "feedback"},
-           path, "");
+  onlyKeys(
+      root,
+      {"name",      "description", "track", "duration",         "control_rate",    "start",    "line",     "sine",
+       "field",     "plant",       "draws", "success",          "envelope_period", "requires", "traction", "sensors",
+       "estimator", "feedback",    "motor", "traction_control", "speed_governor"},
+      path, "");
   core::BenchScenario b;
   std::vector<PatchSpec> patch_specs;
   b.name = required(root, "name", path, "").as<std::string>();
@@ -402,9 +404,11 @@ core::BenchScenario loadScenarioFileImpl(const std::string& path) {
   // what the controllers are fed (feedback:), each block through the nodes' parameter table with the nodes'
   // keys (traction/..., sensors/..., estimator/...), so a key, a range and an error read as plant_sim's and
   // state_estimator's. Any of them puts the scenario on the estimated loop (core/evaluation/estimated_bench.h).
+  // The drive train's layers (motor:, traction_control:, speed_governor:) likewise, through their tables.
   const YAML::Node traction = root["traction"], sensors = root["sensors"], estimator = root["estimator"],
-                   feedback = root["feedback"];
-  if (traction || sensors || estimator || feedback) {
+                   feedback = root["feedback"], motor = root["motor"], traction_control = root["traction_control"],
+                   speed_governor = root["speed_governor"];
+  if (traction || sensors || estimator || feedback || motor || traction_control || speed_governor) {
     core::EstimatedRunConfig cfg;
     core::TractionParams t;
     if (traction) applyTableBlock(core::tractionTable(), traction, t, path, "traction");
@@ -419,6 +423,11 @@ core::BenchScenario loadScenarioFileImpl(const std::string& path) {
       applyTableBlock(core::sensorsTable(), sensors, cfg.sensors, path, "sensors");
     }
     if (estimator) applyTableBlock(core::ekfTable(), estimator, cfg.estimator, path, "estimator");
+    if (motor) applyTableBlock(core::motorTable(), motor, cfg.motor, path, "motor");
+    if (traction_control)
+      applyTableBlock(core::tractionControlTable(), traction_control, cfg.traction_control, path, "traction_control");
+    if (speed_governor)
+      applyTableBlock(core::speedGovernorTable(), speed_governor, cfg.speed_governor, path, "speed_governor");
     if (feedback) {
       if (!feedback.IsScalar()) fail(path, "feedback must be one of ground_truth, odometry, fused");
       const std::string e = core::parseFeedback(feedback.Scalar(), cfg.feedback);

@@ -45,10 +45,19 @@ Plant::Plant(const RobotParams& nominal, const PlantDisturbance& disturbance)
   if (!error.empty()) throw std::invalid_argument(error);
 }
 
+void Plant::setMotor(const MotorParams& motor) {
+  const std::string error = motor.validate();
+  if (!error.empty()) throw std::invalid_argument(error);
+  motor_[0] = motor_[1] = WheelMotor(motor);
+}
+
 void Plant::reset(const State& initial, double t) {
   if (!initial.allFinite() || !std::isfinite(t)) throw std::invalid_argument("plant reset: non-finite state or time");
   state_ = initial;
   time_ = t;
+  motor_[0].reset();
+  motor_[1].reset();
+  applied_[0] = applied_[1] = 0.0;
   noise_.seed(disturbance_.seed);
   cached_disturbance_time_ = std::numeric_limits<double>::quiet_NaN();
 }
@@ -199,6 +208,13 @@ inline bool Plant::stepWithHeading(double tau_right, double tau_left, double dt,
   if (!allFinite(tau_right, tau_left, dt) || !(dt > 0.0)) return false;
   double noise_r, noise_l;
   drawNoise(noise_r, noise_l);
+  if (motor_[0].params().enabled) {  // each wheel's motor at the wheel's spin rate (rolling: (v ± L w) / R)
+    const double v = state_[V], w = state_[OMEGA], R = nominal_.R, L = nominal_.L;
+    tau_right = motor_[0].apply(tau_right, (v + L * w) / R, dt);
+    tau_left = motor_[1].apply(tau_left, (v - L * w) / R, dt);
+  }
+  applied_[0] = tau_right;
+  applied_[1] = tau_left;
   // The sinusoid is evaluated at each RK4 stage time; command and noise are held over the step.
   // Stages 2 and 3 share t + h/2, and stage 4's t + h is the next step's stage 1 (disturbanceAt).
   // The heading's cos/sin come from one sincos at the start of the step, turned by each stage's small

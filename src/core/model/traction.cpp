@@ -154,9 +154,18 @@ void TractionPlant::reset(const State& initial, double t) {
   wheel_rate_[LEFT] = (initial[V] - nominal_.L * initial[OMEGA]) / nominal_.R;
   slip_[RIGHT] = slip_[LEFT] = force_[RIGHT] = force_[LEFT] = 0.0;
   draft_f_ = draft_m_ = 0.0;
+  motor_[RIGHT].reset();
+  motor_[LEFT].reset();
+  applied_[RIGHT] = applied_[LEFT] = 0.0;
   locateContacts();
   rng_.seed(disturbance_.seed);
   noise_.reset();
+}
+
+void TractionPlant::setMotor(const MotorParams& motor) {
+  const std::string error = motor.validate();
+  if (!error.empty()) throw std::invalid_argument(error);
+  motor_[RIGHT] = motor_[LEFT] = WheelMotor(motor);
 }
 
 double TractionPlant::kineticEnergy() const {
@@ -200,9 +209,16 @@ bool TractionPlant::stepWithHeading(double tau_right, double tau_left, double dt
     rr_force += draft_f_;
     rr_moment += draft_m_;
   }
+  const bool motors = motor_[RIGHT].params().enabled;
+  applied_[RIGHT] = tau_right;
+  applied_[LEFT] = tau_left;
   for (int j = 0; j < n; ++j) {
-    substep(tau_right + noise_r + amplitude * dist_s, tau_left + noise_l + amplitude * dist_c, rr_force, rr_moment, h,
-            cos_th, sin_th);
+    if (motors) {  // at the wheels' own spin rates, each sub-step
+      applied_[RIGHT] = motor_[RIGHT].apply(tau_right, wheel_rate_[RIGHT], h);
+      applied_[LEFT] = motor_[LEFT].apply(tau_left, wheel_rate_[LEFT], h);
+    }
+    substep(applied_[RIGHT] + noise_r + amplitude * dist_s, applied_[LEFT] + noise_l + amplitude * dist_c, rr_force,
+            rr_moment, h, cos_th, sin_th);
     if (disturbance_.sinusoidal) rotateHeading(dist_c, dist_s, dist_step, dist_c, dist_s);
   }
   time_ += dt;

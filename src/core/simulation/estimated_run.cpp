@@ -32,8 +32,11 @@ std::string parseFeedback(const std::string& name, Feedback& out) {
 }
 
 std::string EstimatedRunConfig::validate() const {
-  std::string e = firstError({sensors.validate(), estimator.validate(), traction ? traction->validate() : ""});
+  std::string e = firstError({sensors.validate(), estimator.validate(), traction ? traction->validate() : "",
+                              motor.validate(), traction_control.validate(), speed_governor.validate()});
   if (!e.empty()) return e;
+  if (speed_governor.enabled && !traction_control.enabled)
+    return "speed_governor/enabled needs traction_control/enabled (the governor acts on its slip verdict)";
   if (!allFinite(tool.x(), tool.y())) return "the tool point must be finite";
   for (std::size_t i = 0; i < patches.size(); ++i) {
     e = patches[i].validate("field/patches[" + std::to_string(i) + "]");
@@ -55,6 +58,7 @@ class SensorFeed {
   SensorFeed(const Scenario& sc, const EstimatedRunConfig& cfg)
       : cfg_(cfg),
         period_ns_(sc.control_period_ns),
+        L_(sc.robot.L),
         dt_(secondsFromNanos(sc.control_period_ns)),
         encoders_(cfg.sensors, sc.robot.R, sc.robot.L),
         gyro_(cfg.sensors),
@@ -78,19 +82,25 @@ class SensorFeed {
     yaw_rate_ = gyro_.measure(s[OMEGA]);
   }
 
-  Fed observe(double t, const State& s, const Pose2D& truth) {
+  Fed observe(double t, const State& s, const Pose2D& truth, double, double) {
     // odom as published (the encoders' last update) and as a subscriber reads it back.
     const Odometry2D& odom = encoders_.last();
     const Pose2D odom_pose{odom.pose.x, odom.pose.y, yawThroughQuaternion(odom.pose.theta)};
     odometry_error_final_ = std::hypot(odom.pose.x - s[X], odom.pose.y - s[Y]);
     odometry_error_max_ = std::max(odometry_error_max_, odometry_error_final_);
-    Fed fed{truth, s[V], s[OMEGA]};
+    // The traction control's wheel speeds are the encoders' (windowed); its ground twist is the fed one.
+    const double wheel_r = odom.v + L_ * odom.omega, wheel_l = odom.v - L_ * odom.omega;
+    Fed fed{truth, s[V], s[OMEGA], {wheel_r, wheel_l, s[V], s[OMEGA]}};
     if (cfg_.feedback == Feedback::odometry) {
-      fed = {odom_pose, odom.v, odom.omega};
+      fed = {odom_pose, odom.v, odom.omega, {wheel_r, wheel_l, odom.v, odom.omega}};
     } else if (ekf_) {
       fuse(t, odom_pose);
       const Ekf::Vector& m = ekf_->mean();
-      fed = {{m(Ekf::X), m(Ekf::Y), yawThroughQuaternion(m(Ekf::THETA))}, odom.v, yaw_rate_ - m(Ekf::BIAS)};
+      const double omega = yaw_rate_ - m(Ekf::BIAS);
+      fed = {{m(Ekf::X), m(Ekf::Y), yawThroughQuaternion(m(Ekf::THETA))},
+             odom.v,
+             omega,
+             {wheel_r, wheel_l, odom.v, omega}};
     }
     const double error = std::hypot(fed.pose.x - s[X], fed.pose.y - s[Y]);
     fed_sq_ += error * error;
@@ -154,6 +164,7 @@ class SensorFeed {
 
   const EstimatedRunConfig& cfg_;
   const std::int64_t period_ns_;
+  const double L_;  // nominal half track [m]
   const double dt_;
   EncoderOdometry encoders_;
   YawRateSensor gyro_;
@@ -172,25 +183,42 @@ class SensorFeed {
 template <typename PlantT>
 EstimatedRunResult run(const Scenario& sc, const EstimatedRunConfig& cfg, PlantT& plant, ReferenceSource& reference,
                        bool keep_samples, const std::function<void(const EstimatedSample&)>& trace) {
+  plant.plant.setMotor(cfg.motor);
   std::unique_ptr<OuterController> outer = makeOuterController(sc);
   std::unique_ptr<InnerController> inner = makeInnerController(sc);
   SensorFeed feed(sc, cfg);
   ToolRule tool{PlantT::kTraction && cfg.traction && cfg.traction->draft_force > 0.0, cfg.tool,
                 ToolEngagement(cfg.seeding, cfg.tool_rows, cfg.tool_rows_open_ended)};
-  return closedLoop(sc, plant, feed, *outer, *inner, reference, keep_samples, trace, RunStop{}, &tool);
+  LoopLayers layers;
+  layers.tool = &tool;
+  std::optional<TractionControl> traction_control;
+  if (cfg.traction_control.enabled) {
+    traction_control.emplace(cfg.traction_control, sc.robot.L);
+    layers.traction_control = &*traction_control;
+  }
+  if (!cfg.speed_governor.enabled)
+    return closedLoop(sc, plant, feed, *outer, *inner, reference, keep_samples, trace, RunStop{}, layers);
+  GovernedReference governed(reference, cfg.speed_governor);
+  layers.governor = &governed;
+  return closedLoop(sc, plant, feed, *outer, *inner, governed, keep_samples, trace, RunStop{}, layers);
 }
 
 }  // namespace
 
 EstimatedRunResult runEstimatedLoop(const Scenario& sc, const EstimatedRunConfig& cfg, ReferenceSource& reference,
                                     bool keep_samples, const std::function<void(const EstimatedSample&)>& trace) {
-  const std::string e = firstError({sc.validate(), cfg.validate()});
+  std::string e = firstError({sc.validate(), cfg.validate()});
+  if (e.empty() && cfg.traction) {  // the motors against the heaviest going: the worst soil's rolling resistance
+    double rolling = cfg.traction->rolling_resistance;
+    for (const SoilPatch& p : cfg.patches) rolling = std::max(rolling, p.rolling_resistance);
+    e = checkMotorsCanMove(cfg.motor, sc.robot, sc.disturbance.mass_scale, rolling, cfg.traction->draft_force);
+  }
   if (!e.empty()) throw std::invalid_argument(e);
   if (!cfg.traction) {
-    NoSlipPlant plant{Plant(sc.robot, sc.disturbance)};
+    NoSlipPlant plant{Plant(sc.robot, sc.disturbance), sc.robot.L};
     return run(sc, cfg, plant, reference, keep_samples, trace);
   }
-  SlipPlant plant{TractionPlant(sc.robot, sc.disturbance, *cfg.traction)};
+  SlipPlant plant{TractionPlant(sc.robot, sc.disturbance, *cfg.traction), sc.robot.R};
   plant.plant.setSoil(SoilMap(cfg.patches));
   plant.plant.setToolPoint(cfg.tool);
   return run(sc, cfg, plant, reference, keep_samples, trace);

@@ -32,7 +32,7 @@ namespace {
 template <typename Outer, typename Inner, typename Trace>
 RunResult loop(const Scenario& sc, ReferenceSource& reference, Outer& outer, Inner& inner, bool keep_samples,
                Trace& trace, const RunStop& stop) {
-  NoSlipPlant plant{Plant(sc.robot, sc.disturbance)};
+  NoSlipPlant plant{Plant(sc.robot, sc.disturbance), sc.robot.L};
   StateFeed feed;
   return closedLoop(sc, plant, feed, outer, inner, reference, keep_samples, trace, stop).run;
 }

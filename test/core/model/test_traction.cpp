@@ -24,7 +24,7 @@ namespace {
 /// sliding mode; tool_down: the tool held down (its draft acting) the whole run.
 EstimatedRunResult tractionRun(const Scenario& sc, const TractionParams& t, ReferenceSource& ref,
                                const std::function<void(const LoopSample&)>& trace = {}, bool tool_down = false) {
-  SlipPlant plant{TractionPlant(sc.robot, sc.disturbance, t)};
+  SlipPlant plant{TractionPlant(sc.robot, sc.disturbance, t), sc.robot.R};
   plant.plant.setToolDown(tool_down);
   StateFeed feed;
   Kanayama outer(sc.kanayama);

@@ -87,7 +87,7 @@ TEST(EstimatedRun, FedTheTruthOnTheTractionPlantItIsTheLoopOnThePlantsOwnStateBi
       0.15;  // soft: the patch changes the run (within the curve's linear part grip alone would not)
   LineReference ref;
   // The sensors' feed fed the truth against the plant's own state (closed_loop.h's StateFeed, no sensors).
-  SlipPlant plant{TractionPlant(sc.robot, sc.disturbance, t)};
+  SlipPlant plant{TractionPlant(sc.robot, sc.disturbance, t), sc.robot.R};
   plant.plant.setSoil(SoilMap({wet}));
   StateFeed state_feed;
   Kanayama outer(sc.kanayama);
@@ -316,4 +316,35 @@ TEST(EstimatedBench, ARobotThatStallsOnThePatchIsNotFinished) {
   EXPECT_GT(stall[0].end_distance, 1.0);
   EXPECT_GT(stall[0].max_slip, 0.5);
   EXPECT_GT(stall[0].tool_down_time, 0.0);
+}
+
+// The drive-train layers in the loop, on the thesis line over wet soil (mu 0.2) with the motors on: the
+// traction control keeps the wheels near the friction peak where the bare loop spins them, and the speed
+// governor slows the target while it does. With every layer off the run is the run without them (the
+// suites' runs.csv are compared byte for byte for that).
+TEST(EstimatedRun, TractionControlKeepsTheWheelsNearThePeak) {
+  Scenario sc = line(OuterKind::kanayama, InnerKind::sliding_mode, true);
+  sc.duration = 8.0;
+  EstimatedRunConfig cfg;
+  TractionParams wet;
+  wet.mu_peak = 0.2;
+  wet.mu_slide = 0.15;
+  cfg.traction = wet;
+  cfg.motor.enabled = true;
+  LineReference ref;
+  const EstimatedRunResult bare = runEstimatedLoop(sc, cfg, ref, false);
+  cfg.traction_control.enabled = true;
+  const EstimatedRunResult tc = runEstimatedLoop(sc, cfg, ref, false);
+  cfg.speed_governor.enabled = true;
+  const EstimatedRunResult governed = runEstimatedLoop(sc, cfg, ref, false);
+  std::printf("max slip: bare %.3f, traction control %.3f (slipping %.2f s), governed %.3f (slowest rate %.2f)\n",
+              bare.max_abs_slip, tc.max_abs_slip, tc.traction_control_time, governed.max_abs_slip,
+              governed.governor_min_rate);
+  EXPECT_GT(bare.max_abs_slip, 1.0);  // the bare loop spins the wheels
+  EXPECT_LT(tc.max_abs_slip, 0.5 * bare.max_abs_slip);
+  EXPECT_GT(tc.traction_control_time, 0.0);
+  EXPECT_EQ(bare.governor_min_rate, 1.0);
+  EXPECT_LT(governed.governor_min_rate, 1.0);
+  cfg.traction_control.enabled = false;
+  EXPECT_THROW(runEstimatedLoop(sc, cfg, ref, false), std::invalid_argument);  // a governor needs the control
 }

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "sowing_robot/core/common/param_table.h"
+#include "sowing_robot/core/model/motor.h"
 #include "sowing_robot/core/model/robot_params.h"
 #include "sowing_robot/core/model/torque_noise.h"
 
@@ -57,6 +58,12 @@ class Plant {
   /// Sinusoidal wheel-torque disturbance at time t [N·m] (zero when switched off).
   void sinusoidalDisturbance(double t, double& right, double& left) const;
 
+  /// The drive motors (motor.h): from the next step on, each wheel's command passes through its motor
+  /// (disabled: unchanged). Throws std::invalid_argument when the parameters do not validate.
+  void setMotor(const MotorParams& motor);
+  /// The torque [N·m] the right (0) / left (1) motor applied over the last step, before disturbance and noise.
+  double appliedTorque(int wheel) const { return applied_[wheel]; }
+
   const State& state() const { return state_; }
   double time() const { return time_; }
   /// Physical parameters the plant really has (nominal scaled by the mismatch).
@@ -79,7 +86,9 @@ class Plant {
   double m0_, i0_, mcd_;  // true effective inertias and the coupling mc·d
   State state_ = State::Zero();
   double time_ = 0.0;
-  TorqueNoise noise_;  // std::normal_distribution<double> over std::mt19937_64, to the bit
+  TorqueNoise noise_;
+  WheelMotor motor_[2];
+  double applied_[2] = {0.0, 0.0};  // std::normal_distribution<double> over std::mt19937_64, to the bit
   // Last disturbance evaluated (NaN time: none yet). Never compares equal to NaN, so reset() clears it.
   double cached_disturbance_time_ = std::numeric_limits<double>::quiet_NaN();
   double cached_disturbance_right_ = 0.0, cached_disturbance_left_ = 0.0;

@@ -53,6 +53,7 @@
 #include <vector>
 
 #include "sowing_robot/core/common/param_table.h"
+#include "sowing_robot/core/model/motor.h"
 #include "sowing_robot/core/model/plant.h"
 #include "sowing_robot/core/model/robot_params.h"
 #include "sowing_robot/core/model/soil_map.h"
@@ -159,6 +160,12 @@ class TractionPlant {
   /// as in Plant). Returns false, changing nothing, for a non-finite torque or dt <= 0.
   bool step(double tau_right, double tau_left, double dt);
 
+  /// The drive motors (motor.h), evaluated at every sub-step at the wheel's own spin rate (a spinning
+  /// wheel loses torque). Throws std::invalid_argument when the parameters do not validate.
+  void setMotor(const MotorParams& motor);
+  /// The torque [N·m] the right / left motor applied in the last sub-step, before disturbance and noise.
+  double appliedTorque(Wheel w) const { return applied_[w]; }
+
   const State& state() const { return state_; }
   double time() const { return time_; }
   /// Wheel spin rates Ω [rad/s].
@@ -219,6 +226,8 @@ class TractionPlant {
   double time_ = 0.0;
   std::mt19937_64 rng_;
   std::normal_distribution<double> noise_{0.0, 1.0};
+  WheelMotor motor_[2];
+  double applied_[2] = {0.0, 0.0};
 };
 
 }  // namespace core

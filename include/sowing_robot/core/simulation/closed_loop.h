@@ -10,10 +10,12 @@
 //   2. the feedback source gives the pose (through the quaternion round trip of nav_msgs/Odometry) and
 //      twist the controllers get;
 //   3. the reference at t_k; the errors against the TRUE pose go into the metrics;
-//   4. outer controller -> velocity command, inner controller -> wheel torques;
+//   4. outer controller -> velocity command, inner controller -> wheel torques; the traction control (if
+//      on) caps the torque of a slipping wheel, and tells the speed governor (if on) for the next period;
 //   5. with the traction plant and a draft: the tool rule on the true tool point lowers or lifts the tool;
 //   6. the trace sees the period; the caller's stop() may end the run here (every kStopCheckEvery);
-//   7. the plant steps (k < n), then the sensors see the new state at t_{k+1}.
+//   7. the plant steps (k < n; its motors, if on, between the torques sent and the wheels), then the
+//      sensors see the new state at t_{k+1}.
 //
 // The parts are template parameters, so the per-period calls are direct:
 //   Plant: NoSlipPlant or SlipPlant (below); Feed: StateFeed (the plant's state, no sensors) or the
@@ -28,7 +30,9 @@
 #include <functional>
 #include <type_traits>
 
+#include "sowing_robot/core/control/traction_control.h"
 #include "sowing_robot/core/model/traction.h"
+#include "sowing_robot/core/planning/speed_governor.h"
 #include "sowing_robot/core/planning/tool_engagement.h"
 #include "sowing_robot/core/simulation/estimated_run.h"
 #include "sowing_robot/core/simulation/runner.h"
@@ -44,7 +48,13 @@ struct NoSlipPlant {
   void step(double r, double l, double dt) { plant.step(r, l, dt); }
   const State& state() const { return plant.state(); }
   double slip(Wheel) const { return 0.0; }
+  /// R W of the wheel [m/s]: rolling, the contact point's speed.
+  double wheelSpeed(Wheel w) const {
+    const State& s = plant.state();
+    return w == RIGHT ? s[V] + L * s[OMEGA] : s[V] - L * s[OMEGA];
+  }
   void setToolDown(bool) {}
+  double L;  ///< the plant's half track [m]
 };
 
 /// The wheel–soil TractionPlant behind the same interface.
@@ -55,19 +65,24 @@ struct SlipPlant {
   void step(double r, double l, double dt) { plant.step(r, l, dt); }
   const State& state() const { return plant.state(); }
   double slip(Wheel w) const { return plant.slipRatio(w); }
+  double wheelSpeed(Wheel w) const { return R * plant.wheelRate(w); }
   void setToolDown(bool down) { plant.setToolDown(down); }
+  double R;  ///< the plant's wheel radius [m]
 };
 
 /// What the controllers are fed in one period.
 struct Fed {
   Pose2D pose;  ///< yaw through the quaternion round trip
   double v, omega;
+  WheelGroundSpeeds speeds;  ///< what the traction control measures: the wheels' R W, the ground twist
 };
 
-/// Feedback: the plant's own state (perfect sensing; no sensors run).
+/// Feedback: the plant's own state (perfect sensing: the wheels' true speeds too; no sensors run).
 struct StateFeed {
   void start(const State&) {}
-  Fed observe(double, const State& s, const Pose2D& truth) { return {truth, s[V], s[OMEGA]}; }
+  Fed observe(double, const State& s, const Pose2D& truth, double wheel_right, double wheel_left) {
+    return {truth, s[V], s[OMEGA], {wheel_right, wheel_left, s[V], s[OMEGA]}};
+  }
   void afterStep(std::int64_t, const State&) {}
   void finish(EstimatedRunResult&) const {}
 };
@@ -105,15 +120,23 @@ inline void emit(RunTally& tally, const LoopSample& s, const Fed&, double, doubl
 
 }  // namespace loop_detail
 
+/// The loop's optional layers (null: off).
+struct LoopLayers {
+  ToolRule* tool = nullptr;                     ///< the traction plant's tool rule
+  TractionControl* traction_control = nullptr;  ///< between the inner loop and the motors
+  GovernedReference* governor = nullptr;        ///< the reference the loop is given, governed
+};
+
 /// Runs scenario `sc` (its timing, start, disturbance phase) on `plant` (constructed, not yet reset) with
 /// the given feedback, controllers and reference; see the file comment for the order of a period.
 template <typename PlantT, typename Feed, typename Outer, typename Inner, typename Trace>
 EstimatedRunResult closedLoop(const Scenario& sc, PlantT& plant, Feed& feed, Outer& outer, Inner& inner,
                               ReferenceSource& reference, bool keep_samples, Trace& trace, const RunStop& stop,
-                              ToolRule* tool = nullptr) {
+                              const LoopLayers& layers = {}) {
   plant.reset(startState(sc), phaseStartTime(sc));
   reference.reset();
   feed.start(plant.state());
+  if (layers.traction_control) layers.traction_control->reset();
   const std::int64_t n = sc.steps();
   const double dt = secondsFromNanos(sc.control_period_ns);
   MetricsAccumulator metrics(keep_samples);
@@ -129,7 +152,7 @@ EstimatedRunResult closedLoop(const Scenario& sc, PlantT& plant, Feed& feed, Out
       break;
     }
     const Pose2D truth{s[X], s[Y], yawThroughQuaternion(s[THETA])};
-    const Fed fed = feed.observe(t, s, truth);
+    const Fed fed = feed.observe(t, s, truth, plant.wheelSpeed(RIGHT), plant.wheelSpeed(LEFT));
     const Reference& ref = reference.next(t);  // the source's copy, valid until the next call
     double ex, ey, eth;
     worldErrors(ref, truth, ex, ey, eth);
@@ -137,8 +160,18 @@ EstimatedRunResult closedLoop(const Scenario& sc, PlantT& plant, Feed& feed, Out
     const VelocityCommand cmd = outer.compute(ref, fed.pose, fed.v, fed.omega);
     const InnerOutput u = inner.update(cmd, fed.v, fed.omega, dt);
     if (u.saturated) ++result.saturated_steps;
+    WheelTorques sent = u.torques;
+    if (TractionControl* tc = layers.traction_control) {
+      sent = tc->limit(u.torques, fed.speeds, dt);
+      if (tc->slipping()) out.traction_control_time += dt;
+      if (layers.governor) {
+        layers.governor->report(tc->slipping(), dt);
+        out.governor_min_rate = std::min(out.governor_min_rate, layers.governor->rate());
+      }
+    }
     bool tool_down = false;
     if constexpr (PlantT::kTraction) {
+      ToolRule* tool = layers.tool;
       if (tool != nullptr && tool->active && k < n) {
         tool_down = tool->update(s);
         plant.setToolDown(tool_down);
@@ -154,7 +187,7 @@ EstimatedRunResult closedLoop(const Scenario& sc, PlantT& plant, Feed& feed, Out
       break;
     }
     if (k == n) break;
-    plant.step(u.torques.right, u.torques.left, dt);
+    plant.step(sent.right, sent.left, dt);
     if constexpr (PlantT::kTraction)
       out.max_abs_slip = std::max({out.max_abs_slip, std::fabs(plant.slip(RIGHT)), std::fabs(plant.slip(LEFT))});
     feed.afterStep(k + 1, plant.state());

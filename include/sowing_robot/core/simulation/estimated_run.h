@@ -29,11 +29,14 @@
 #include <string>
 #include <vector>
 
+#include "sowing_robot/core/control/traction_control.h"
 #include "sowing_robot/core/estimation/ekf.h"
+#include "sowing_robot/core/model/motor.h"
 #include "sowing_robot/core/model/sensors.h"
 #include "sowing_robot/core/model/soil_map.h"
 #include "sowing_robot/core/model/traction.h"
 #include "sowing_robot/core/planning/seeding.h"
+#include "sowing_robot/core/planning/speed_governor.h"
 #include "sowing_robot/core/simulation/runner.h"
 
 namespace sowing_robot {
@@ -59,6 +62,11 @@ struct EstimatedRunConfig {
   SeedingParams seeding;  ///< the tool rule's parameters (detour_margin as config/seed_drill.yaml: 4 m)
   SensorParams sensors;   ///< sensors.yaml defaults
   EkfParams estimator;    ///< estimator.yaml defaults (feedback fused)
+  MotorParams motor;      ///< the drive motors (off: the commanded torque reaches the wheel)
+  /// Between the inner loop and the motors: each wheel's torque capped while it slips (off: unchanged).
+  TractionControlParams traction_control;
+  /// The target slowed along its path while a wheel slips (needs traction_control; off: planned timing).
+  SpeedGovernorParams speed_governor;
 
   /// "" or the first bad parameter as one line naming its key.
   std::string validate() const;
@@ -86,6 +94,8 @@ struct EstimatedRunResult {
   double odometry_error_final = 0.0, odometry_error_max = 0.0;
   FixCounts fixes;  ///< fused: what happened to the fixes
   long fixes_lost_from_queue = 0;
+  double traction_control_time = 0.0;  ///< time a wheel slipped beyond the traction control's target [s]
+  double governor_min_rate = 1.0;      ///< the slowest rate the speed governor gave the target
 };
 
 /// Runs the scenario (plant, timing, start, disturbance incl. its phase, the outer/inner pair of

@@ -1,0 +1,73 @@
+// Traction control: a layer between any inner loop and the motors that keeps each drive wheel near the
+// friction peak by capping its torque, as automotive traction control (torque reduction on wheel spin)
+// and tractor slip control do. Chosen over slip-ratio regulation with its own PI loop because it needs
+// no model of the soil and leaves the inner loop in charge whenever the wheels grip: it only ever lowers
+// a torque, and only on a wheel that slips.
+//
+// Each period, per wheel: the slip is estimated from what the robot measures, the wheel's own speed
+// (its encoder: R W) against the ground speed of its contact point (v ± L w of the estimator's or the fed
+// body twist, never the plant's hidden state),
+//     kappa = (R W - u) / max(|R W|, |u|, speed_floor);
+// while |kappa| > slip_target the wheel's torque ceiling falls exponentially (cut_rate) from the torque
+// last sent, else it rises linearly (raise_rate) back to max_torque; the command is clipped to
+// [-ceiling, ceiling]. So the ceiling settles about the largest torque the soil carries at the target
+// slip (additive increase, multiplicative decrease).
+#pragma once
+
+#include <string>
+
+#include "sowing_robot/core/common/param_table.h"
+#include "sowing_robot/core/common/types.h"
+
+namespace sowing_robot {
+namespace core {
+
+/// Defaults, ranges, units and meanings: tractionControlTable().
+struct TractionControlParams {
+  TractionControlParams();
+  bool enabled;        ///< false: the torques pass unchanged
+  double slip_target;  ///< |slip ratio| above which the torque is cut (the friction curve's peak)
+  double speed_floor;  ///< [m/s] smallest speed the slip ratio is divided by
+  double cut_rate;     ///< [1/s] exponential fall of the ceiling while the wheel slips
+  double raise_rate;   ///< [N·m/s] linear rise of the ceiling while it grips
+  double min_torque;   ///< [N·m] the ceiling never falls below this (the wheel can always pull away)
+  double max_torque;   ///< [N·m] the ceiling's top (and its value at reset)
+
+  std::string validate() const;
+};
+/// traction_control/{enabled, slip_target, speed_floor, cut_rate, raise_rate, min_torque, max_torque}.
+const ParamTable<TractionControlParams>& tractionControlTable();
+
+/// What the layer measures in one period.
+struct WheelGroundSpeeds {
+  double wheel_right, wheel_left;  ///< R W of each wheel, from its encoder [m/s]
+  double v, omega;                 ///< the body's ground twist, from the estimator or the fed state [m/s, rad/s]
+};
+
+class TractionControl {
+ public:
+  /// R: nothing (the wheel speeds come as R W); L: the nominal half track [m]. Throws std::invalid_argument
+  /// when the parameters do not validate or L is not finite and > 0.
+  TractionControl(const TractionControlParams& params, double L);
+  void reset();
+  /// The torques to send [N·m] for the inner loop's `command` this period.
+  WheelTorques limit(const WheelTorques& command, const WheelGroundSpeeds& m, double dt);
+
+  /// The last estimate of each wheel's slip ratio (0 right, 1 left).
+  double slip(int wheel) const { return slip_[wheel]; }
+  double ceiling(int wheel) const { return ceiling_[wheel]; }
+  /// Either wheel slipped beyond the target in the last period.
+  bool slipping() const { return slipping_; }
+  const TractionControlParams& params() const { return params_; }
+
+ private:
+  double limitWheel(int wheel, double command, double wheel_speed, double ground_speed, double dt);
+
+  TractionControlParams params_;
+  double L_;
+  double ceiling_[2], slip_[2] = {0.0, 0.0}, sent_[2] = {0.0, 0.0};
+  bool slipping_ = false;
+};
+
+}  // namespace core
+}  // namespace sowing_robot

@@ -1,0 +1,72 @@
+// Traction control (core/control/traction_control.h): off and on gripping wheels it passes the torques;
+// a slipping wheel's torque is cut at once and recovers at the raise rate; the estimate uses the wheel's
+// speed against its contact point's ground speed; bad parameters are refused.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "sowing_robot/core/control/traction_control.h"
+
+using namespace sowing_robot::core;
+
+namespace {
+TractionControlParams on() {
+  TractionControlParams p;
+  p.enabled = true;
+  return p;
+}
+constexpr double kL = 0.2, kDt = 0.001;
+}  // namespace
+
+TEST(TractionControl, OffOrGrippingItPassesTheTorques) {
+  TractionControl off(TractionControlParams{}, kL), tc(on(), kL);
+  const WheelGroundSpeeds grip{1.0 + kL * 0.5, 1.0 - kL * 0.5, 1.0, 0.5};  // the wheels roll: no slip
+  for (int i = 0; i < 100; ++i) {
+    const WheelTorques a = off.limit({50.0, -7.0}, {5.0, 0.0, 0.0, 0.0}, kDt);
+    EXPECT_EQ(a.right, 50.0);
+    EXPECT_EQ(a.left, -7.0);
+    const WheelTorques b = tc.limit({3.0, -2.0}, grip, kDt);
+    EXPECT_EQ(b.right, 3.0);
+    EXPECT_EQ(b.left, -2.0);
+  }
+  EXPECT_FALSE(tc.slipping());
+  EXPECT_NEAR(tc.slip(0), 0.0, 1e-12);
+}
+
+TEST(TractionControl, ASlippingWheelIsCutAndRecovers) {
+  const TractionControlParams p = on();
+  TractionControl tc(p, kL);
+  // The right wheel turns at 2 m/s over ground at 1 m/s (slip 0.5); the left rolls.
+  const WheelGroundSpeeds spin{2.0, 1.0, 1.0, 0.0};
+  WheelTorques out = tc.limit({5.0, 5.0}, spin, kDt);
+  EXPECT_TRUE(tc.slipping());
+  EXPECT_NEAR(tc.slip(0), 0.5, 1e-12);
+  EXPECT_EQ(out.left, 5.0);
+  EXPECT_LT(out.right, 5.0);  // cut from the first period on (from the torque sent, not from max_torque)
+  for (int i = 0; i < 200; ++i) out = tc.limit({5.0, 5.0}, spin, kDt);
+  EXPECT_NEAR(out.right, std::max(p.min_torque, 5.0 * std::exp(-p.cut_rate * 0.201)), 1e-9);
+  // Gripping again: the ceiling rises linearly at raise_rate.
+  const double from = tc.ceiling(0);
+  const WheelGroundSpeeds grip{1.0, 1.0, 1.0, 0.0};
+  for (int i = 0; i < 500; ++i) out = tc.limit({5.0, 5.0}, grip, kDt);
+  EXPECT_NEAR(tc.ceiling(0), from + p.raise_rate * 0.5, 1e-9);
+  EXPECT_NEAR(out.right, from + p.raise_rate * 0.5, 1e-9);
+  EXPECT_FALSE(tc.slipping());
+  // Braking slip (a wheel slower than the ground) is cut the same way.
+  out = tc.limit({-5.0, 0.0}, {0.0, 1.0, 1.0, 0.0}, kDt);
+  EXPECT_TRUE(tc.slipping());
+  EXPECT_GT(out.right, -5.0);
+  tc.reset();
+  EXPECT_EQ(tc.ceiling(0), p.max_torque);
+}
+
+TEST(TractionControl, BadParametersAreRefused) {
+  TractionControlParams p = on();
+  p.slip_target = 0.0;
+  EXPECT_NE(p.validate().find("traction_control/slip_target"), std::string::npos);
+  p = on();
+  p.min_torque = 200.0;
+  EXPECT_NE(p.validate().find("traction_control/min_torque"), std::string::npos);
+  EXPECT_THROW(TractionControl(p, kL), std::invalid_argument);
+  EXPECT_THROW(TractionControl(on(), 0.0), std::invalid_argument);
+}
