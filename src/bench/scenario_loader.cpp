@@ -303,8 +303,26 @@ const std::vector<std::string>& pendingModels() {
   return pending;
 }
 
-core::BenchScenario loadScenarioFileImpl(const std::string& path) {
-  const YAML::Node root = loadYaml(path);
+/// The profile's blocks merged into the scenario's root (see loadScenarioFile).
+void applyProfile(YAML::Node& root, const std::string& profile) {
+  const YAML::Node prof = loadYaml(profile);
+  onlyKeys(prof,
+           {"name", "description", "traction", "motor", "traction_control", "speed_governor", "sensors", "estimator",
+            "feedback"},
+           profile, "");
+  for (const char* block : {"traction", "motor", "traction_control", "speed_governor", "sensors", "estimator"}) {
+    const YAML::Node from = prof[block];
+    if (!from) continue;
+    if (!from.IsMap()) fail(profile, std::string(block) + " must be a mapping");
+    if (!root[block]) root[block] = YAML::Node(YAML::NodeType::Map);
+    for (const auto& kv : from) root[block][kv.first.as<std::string>()] = YAML::Clone(kv.second);
+  }
+  if (prof["feedback"]) root["feedback"] = YAML::Clone(prof["feedback"]);
+}
+
+core::BenchScenario loadScenarioFileImpl(const std::string& path, const std::string& profile) {
+  YAML::Node root = loadYaml(path);
+  if (!profile.empty()) applyProfile(root, profile);
   onlyKeys(
       root,
       {"name",      "description", "track", "duration",         "control_rate",    "start",    "line",     "sine",
@@ -459,9 +477,9 @@ core::BenchScenario loadScenarioFileImpl(const std::string& path) {
 }
 
 // yaml-cpp's own exceptions (a list where a word was expected, ...) become the one-line error too.
-core::BenchScenario loadScenarioFile(const std::string& path) {
+core::BenchScenario loadScenarioFile(const std::string& path, const std::string& profile) {
   try {
-    return loadScenarioFileImpl(path);
+    return loadScenarioFileImpl(path, profile);
   } catch (const YAML::Exception& e) {
     fail(path, e.what());
   }
@@ -480,17 +498,17 @@ std::vector<std::string> scenarioNames(const std::string& dir) {
   return names;
 }
 
-core::BenchScenario loadScenario(const std::string& name_or_path, const std::string& dir) {
+core::BenchScenario loadScenario(const std::string& name_or_path, const std::string& dir, const std::string& profile) {
   const bool is_path = name_or_path.find('/') != std::string::npos ||
                        (name_or_path.size() > 5 && name_or_path.compare(name_or_path.size() - 5, 5, ".yaml") == 0);
-  if (is_path) return loadScenarioFile(name_or_path);
+  if (is_path) return loadScenarioFile(name_or_path, profile);
   const std::string path = dir + "/" + name_or_path + ".yaml";
   if (!fileExists(path)) {
     std::string list;
     for (const auto& n : scenarioNames(dir)) list += (list.empty() ? "" : ", ") + n;
     throw std::invalid_argument("unknown scenario '" + name_or_path + "' (known in " + dir + ": " + list + ")");
   }
-  return loadScenarioFile(path);
+  return loadScenarioFile(path, profile);
 }
 
 void applyTunedGainsImpl(const std::string& path, core::Scenario& sc) {

@@ -1,7 +1,9 @@
 // benchmark: Monte-Carlo statistics of controller pairs over the scenario suite, in-process (no ROS master),
 // issue 17 items 2 and 3.
 //   benchmark --scenarios A,B --controllers X,Y --seeds N --output DIR [--threads K]
-//             [--scenario-dir DIR] [--tuned-dir DIR] [--base-seed S]
+//             [--scenario-dir DIR] [--tuned-dir DIR] [--base-seed S] [--profile FILE]
+// --profile FILE: a set-up applied on top of every scenario file's own blocks (config/profiles/field.yaml: the
+// recommended drive train; bench::loadScenarioFile).
 // Scenarios are names in the scenario directory (default: the package's config/scenarios; `all` for every
 // file there) or paths to scenario files; controllers are outer+inner pairs (kanayama|pure_pursuit|rpp +
 // atsmc|tsmc|pid). A pair's gains come from TUNED_DIR/OUTER+INNER.yaml when that file exists (default the
@@ -148,7 +150,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> scenario_names{"thesis_line"}, controllers{"kanayama+atsmc"};
   long long seeds = -1, threads = 0, base_seed = -1;
   std::string output, scenario_dir = SOWING_SOURCE_DIR "/config/scenarios",
-                      tuned_dir = SOWING_SOURCE_DIR "/config/tuned";
+                      tuned_dir = SOWING_SOURCE_DIR "/config/tuned", profile;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (i + 1 >= argc) return fail("missing value after " + a);
@@ -163,13 +165,16 @@ int main(int argc, char** argv) {
       scenario_dir = v;
     } else if (a == "--tuned-dir") {
       tuned_dir = v;
+    } else if (a == "--profile") {
+      profile = v;
     } else if (a == "--seeds" || a == "--threads" || a == "--base-seed") {
       long long n;
       if (!parseInteger(v, n)) return fail(a + " needs an integer, not '" + v + "'");
       (a == "--seeds" ? seeds : a == "--threads" ? threads : base_seed) = n;
     } else {
-      return fail("unknown argument '" + a +
-                  "' (--scenarios --controllers --seeds --output --threads --scenario-dir --tuned-dir --base-seed)");
+      return fail(
+          "unknown argument '" + a +
+          "' (--scenarios --controllers --seeds --output --threads --scenario-dir --tuned-dir --base-seed --profile)");
     }
   }
   if (seeds < 1) return fail(seeds == -1 ? "--seeds N is required" : "--seeds must be >= 1");
@@ -184,7 +189,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> gains_source;
   try {
     for (const auto& name : scenario_names) {
-      scenarios.push_back(bench::loadScenario(name, scenario_dir));
+      scenarios.push_back(bench::loadScenario(name, scenario_dir, profile));
       if (base_seed >= 0) scenarios.back().spec.base_seed = static_cast<std::uint64_t>(base_seed);
     }
     for (const auto& c : controllers) {

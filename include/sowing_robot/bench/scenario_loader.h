@@ -20,11 +20,16 @@ namespace bench {
 /// is read relative to the scenario file's directory (with its plant_sim/field/patches, used with traction on).
 /// Blocks traction:, sensors: (sensors/seed refused: drawn per run), estimator: and feedback: set
 /// BenchScenario::realism (docs/benchmark.md).
-core::BenchScenario loadScenarioFile(const std::string& path);
+/// `profile` (a file path, "" for none): a set-up applied on top of the scenario's own blocks
+/// (config/profiles/field.yaml: the recommended drive train): its blocks traction:, motor:,
+/// traction_control:, speed_governor:, sensors:, estimator: are merged key by key into the scenario's (the
+/// profile's value wins), its feedback: replaces the scenario's; the scenario's description names it.
+core::BenchScenario loadScenarioFile(const std::string& path, const std::string& profile = "");
 
 /// `name_or_path`: a file path (contains '/' or ends with .yaml) or a scenario name looked up as
 /// DIR/NAME.yaml; an unknown name lists the known ones.
-core::BenchScenario loadScenario(const std::string& name_or_path, const std::string& dir);
+core::BenchScenario loadScenario(const std::string& name_or_path, const std::string& dir,
+                                 const std::string& profile = "");
 
 /// The scenario names in `dir` (every *.yaml, sorted).
 std::vector<std::string> scenarioNames(const std::string& dir);

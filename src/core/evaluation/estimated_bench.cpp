@@ -66,6 +66,9 @@ RunRow estimatedBenchRow(const BenchScenario& bench, std::int64_t index) {
   RunExtras extras;
   extras.series_every = seriesEvery(bench);
   if (bench.track == TrackKind::line) {
+    // The tool works the whole line (with traction and a draft, the draft acts once it is down on it).
+    cfg.tool_rows = {RowSegment{Eigen::Vector2d(bench.line_x0, bench.line_y),
+                                Eigen::Vector2d(bench.line_x0 + bench.line_v_r * sc.duration, bench.line_y)}};
     LineReference reference(bench.line_v_r, bench.line_y, bench.line_x0);
     return measureEstimated(sc, cfg, reference, spec, draw, extras);
   }
@@ -127,9 +130,26 @@ std::string describeRealism(const BenchScenario& b) {
            shortNumber(c.traction->draft_force) + " N while the tool is down), " + std::to_string(c.patches.size()) +
            " soil patch(es)";
     for (const SoilPatch& p : c.patches) out += " [mu_peak " + shortNumber(p.mu_peak) + "]";
+    // The grip budget of each soil (FIELD.md): what the drive wheels can push against what it takes.
+    const auto budget = [&](const char* what, double mu_peak, double mu_slide, double rr) {
+      const GripBudget g = gripBudget(b.base.robot, 1.0, *c.traction, mu_peak, mu_slide, rr);
+      return std::string(what) + " peak " + shortNumber(g.peak) + " N, slide " + shortNumber(g.slide) + " N, needed " +
+             shortNumber(g.needed) + " N (margin " + shortNumber(g.margin()) + " N)";
+    };
+    out += "; grip budget at the nominal mass: field" +
+           budget("", c.traction->mu_peak, c.traction->mu_slide, c.traction->rolling_resistance);
+    for (std::size_t i = 0; i < c.patches.size(); ++i)
+      out += "; patch " + std::to_string(i) +
+             budget("", c.patches[i].mu_peak, c.patches[i].mu_slide, c.patches[i].rolling_resistance);
   } else {
     out += "no slip";
   }
+  out += std::string("; motors ") +
+         (c.motor.enabled ? "on (current limit " + shortNumber(c.motor.current_limit) + " N·m, no-load " +
+                                shortNumber(c.motor.no_load_speed) + " rad/s)"
+                          : "off") +
+         ", traction control " + (c.traction_control.enabled ? "on" : "off") + ", speed governor " +
+         (c.speed_governor.enabled ? "on" : "off");
   out += "; feedback " + std::string(feedbackName(c.feedback)) +
          " (sensors: " + std::to_string(c.sensors.encoder.ticks_per_turn) + " ticks/turn, gyro noise " +
          shortNumber(c.sensors.imu.noise) + " rad/s bias " + shortNumber(c.sensors.imu.bias) + " rad/s, fix " +

@@ -168,6 +168,17 @@ void TractionPlant::setMotor(const MotorParams& motor) {
   motor_[RIGHT] = motor_[LEFT] = WheelMotor(motor);
 }
 
+GripBudget gripBudget(const RobotParams& robot, double mass_scale, const TractionParams& traction, double mu_peak,
+                      double mu_slide, double rolling_resistance) {
+  const NormalLoads n = staticNormalLoads(robot, mass_scale, traction.caster_x);
+  const double drive = n.right + n.left;
+  GripBudget b;
+  b.peak = mu_peak * drive;
+  b.slide = mu_slide * drive;
+  b.needed = rolling_resistance * (drive + n.caster) + traction.draft_force;
+  return b;
+}
+
 double TractionPlant::kineticEnergy() const {
   const double v = state_[V], w = state_[OMEGA];
   return 0.5 * (m_b_ * v * v + i_b_ * w * w +

@@ -317,3 +317,33 @@ TEST(ScenarioLoader, AFieldRunCutShortIsNotFinished) {
   const std::vector<core::RunRow> rows = core::runBenchmark(b, 1, 1);
   EXPECT_EQ(rows[0].failure, "not finished");
 }
+
+// A profile (config/profiles/field.yaml) goes on top of a scenario's own blocks: its keys win, the
+// scenario's other keys stay; a scenario without those blocks gets them; a typo in a profile is refused.
+TEST(ScenarioLoader, AProfileGoesOnTopOfTheScenariosBlocks) {
+  const std::string field = kSource + "/config/profiles/field.yaml";
+  const BenchScenario wet = bench::loadScenario("wet_soil", kSuite, field);
+  ASSERT_TRUE(wet.realism);
+  ASSERT_TRUE(wet.realism->traction);
+  EXPECT_EQ(wet.realism->traction->draft_force, 10.0);  // the scenario's own key stays
+  EXPECT_TRUE(wet.realism->motor.enabled);
+  EXPECT_TRUE(wet.realism->traction_control.enabled);
+  EXPECT_TRUE(wet.realism->speed_governor.enabled);
+  EXPECT_FALSE(wet.realism->patches.empty());  // the field file's patches, with traction on
+  EXPECT_FALSE(bench::loadScenario("wet_soil", kSuite).realism->motor.enabled);
+  const BenchScenario line = bench::loadScenario("thesis_line", kSuite, field);  // no blocks of its own
+  ASSERT_TRUE(line.realism);
+  EXPECT_TRUE(line.realism->traction);
+  EXPECT_TRUE(line.realism->motor.enabled);
+  EXPECT_EQ(line.validate(), "");
+  TempDir dir;
+  const std::string bad = dir.write("bad.yaml", "name: bad\nmotor: {enabld: true}\n");
+  try {
+    bench::loadScenario("wet_soil", kSuite, bad);
+    ADD_FAILURE() << "not refused";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("motor/enabld"), std::string::npos) << e.what();
+  }
+  const std::string stray = dir.write("stray.yaml", "name: stray\nduration: 3\n");
+  EXPECT_THROW(bench::loadScenario("wet_soil", kSuite, stray), std::invalid_argument);
+}

@@ -114,7 +114,7 @@ TEST(Motor, BadParametersAndMotorsThatCannotMoveTheRobotAreRefused) {
   EXPECT_NE(m.validate().find("motor/no_load_speed"), std::string::npos);
   Plant plant(RobotParams{}, PlantDisturbance{});
   EXPECT_THROW(plant.setMotor(m), std::invalid_argument);
-  // 0.5 N·m per wheel against 8 % rolling resistance of 17.5 kg and a 10 N draft (about 1.1 N·m needed).
+  // 0.5 N·m per wheel against 8 % rolling resistance of 18 kg and a 10 N draft (about 1.1 N·m needed).
   m = on();
   m.current_limit = 0.5;
   const std::string e = checkMotorsCanMove(m, RobotParams{}, 1.0, 0.08, 10.0);

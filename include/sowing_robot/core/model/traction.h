@@ -142,6 +142,16 @@ struct NormalLoads {
 };
 NormalLoads staticNormalLoads(const RobotParams& robot, double mass_scale, double caster_x);
 
+/// What a soil offers the drive wheels against what driving on it takes, on level ground at steady speed
+/// [N]: the friction at the peak and in full slide of both drive wheels' static loads, against the rolling
+/// resistance of every contact (m g in all) plus the tool's draft. peak < needed: no grip to be had.
+struct GripBudget {
+  double peak = 0.0, slide = 0.0, needed = 0.0;
+  double margin() const { return peak - needed; }
+};
+GripBudget gripBudget(const RobotParams& robot, double mass_scale, const TractionParams& traction, double mu_peak,
+                      double mu_slide, double rolling_resistance);
+
 enum Wheel { RIGHT = 0, LEFT = 1 };
 constexpr int kCaster = 2;  ///< contact index of the caster (patchUnder)
 
