@@ -408,7 +408,7 @@ TuningBatch threadedTuningBatch(const TuningProblem& problem, const PsoParams& p
     std::vector<TuningCost>* out = nullptr;
   };
   auto batch = std::make_shared<Batch>();
-  auto run = psoThreadPool(psoThreads(params), [batch, &problem](int j, int thread_index) {
+  auto run = psoThreadPool(std::min(psoThreads(params), problem.threads()), [batch, &problem](int j, int thread_index) {
     const auto k = static_cast<std::size_t>(j);
     (*batch->out)[k] = problem.evaluate((*batch->x)[k], thread_index, (*batch->bounds)[k]);
   });

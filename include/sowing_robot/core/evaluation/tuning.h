@@ -118,6 +118,8 @@ class TuningProblem {
   const std::vector<GainBounds>& gains() const { return gains_; }
   const Scenario& base() const { return base_; }
   const TuningObjective& objective() const { return objective_; }
+  /// How many thread indices evaluate() accepts (0..threads()-1).
+  int threads() const { return static_cast<int>(references_.size()); }
 
  private:
   Scenario base_;
@@ -148,8 +150,8 @@ struct TuningResult {
 /// farm (farm/tune_farm.h) sends the same evaluate() to other processes.
 using TuningBatch = std::function<void(const std::vector<std::vector<double>>& positions,
                                        const std::vector<double>& bounds, std::vector<TuningCost>& out)>;
-/// The batch on params.threads threads (psoThreadedBatch over problem.evaluate). The problem must have
-/// been built for at least psoThreads(params) threads.
+/// The batch on psoThreads(params) threads, at most problem.threads() (the pool of psoThreadedBatch over
+/// problem.evaluate).
 TuningBatch threadedTuningBatch(const TuningProblem& problem, const PsoParams& params);
 
 /// tuneGains in steps: the search of tuneGains (same problem, bounds, bound per particle) driven one
