@@ -23,6 +23,7 @@ const std::string kTune = SOWING_TUNE_BIN;
 const std::string kMpirun = SOWING_MPIEXEC;
 const std::string kSmall = kSource + "/test/farm/tune_small.yaml";
 const std::string kLong = kSource + "/test/farm/tune_kill.yaml";
+const std::string kBenchmark = SOWING_BENCHMARK_BIN;
 
 std::string readFile(const std::string& path) {
   std::ifstream f(path);
@@ -224,4 +225,20 @@ TEST(TuneCommand, BadInputGivesOneLine) {
   o = shell(dir, tune("--config " + kSmall + " --checkpoint " + ckpt + " --resume"));
   oneLine(o);
   EXPECT_NE(o.err.find("checksum"), std::string::npos) << o.err;
+}
+
+// The benchmark's Monte-Carlo runs on the farm: the files are those of the threaded runner, byte for byte.
+TEST(BenchmarkCommand, MpiRanksWriteTheThreadedFilesByteForByte) {
+  TempDir dir;
+  const std::string args = " --scenarios thesis_line,sine_rows --controllers kanayama+atsmc,rpp+pid --seeds 4";
+  Outcome o = shell(dir, kBenchmark + args + " --threads 2 --output " + (dir / "threads"));
+  ASSERT_EQ(o.status, 0) << o.err;
+  for (int n : {2, 3}) {
+    const std::string out = dir / ("np" + std::to_string(n));
+    o = shell(dir, kMpirun + " --allow-run-as-root --oversubscribe -np " + std::to_string(n) + " " + kBenchmark + args +
+                       " --output " + out);
+    ASSERT_EQ(o.status, 0) << o.err;
+    for (const char* f : {"runs.csv", "envelopes.csv", "report.md"})
+      EXPECT_EQ(readFile(dir / "threads/" + f), readFile(out + "/" + f)) << f << ", mpirun -np " << n;
+  }
 }
