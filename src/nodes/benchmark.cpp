@@ -15,6 +15,11 @@
 // Everything is loaded and checked before the first run, and written only when every run is done: an unknown
 // name, a seed count of 0, a scenario file with a typo or an unwritable DIR gives one error line, exit 2,
 // and no report. A progress line goes to stderr.
+//
+// Under mpirun (or srun) the runs go to an MPI evaluation farm (farm/farm.h, issue 28): every rank reads the
+// same arguments and files, rank 0 hands out one run at a time to whichever rank is free (its own evaluation
+// thread included) and writes the files; each rank runs core::benchmarkWorker, as the threads do, so the
+// files are the same byte for byte for any number of ranks or threads. --threads is then ignored.
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -22,6 +27,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -29,6 +36,7 @@
 #include "sowing_robot/core/evaluation/benchmark.h"
 #include "sowing_robot/core/evaluation/estimated_bench.h"
 #include "sowing_robot/core/simulation/runner.h"
+#include "sowing_robot/farm/farm.h"
 
 using namespace sowing_robot::core;
 namespace bench = sowing_robot::bench;
@@ -53,8 +61,10 @@ std::vector<std::string> splitComma(const std::string& s) {
   return out;
 }
 
+bool g_quiet = false;  // MPI worker ranks: rank 0 reports (every rank reads the same input)
+
 int fail(const std::string& message) {
-  std::fprintf(stderr, "benchmark: %s\n", message.c_str());
+  if (!g_quiet) std::fprintf(stderr, "benchmark: %s\n", message.c_str());
   return 2;
 }
 
@@ -146,7 +156,20 @@ std::string loadLine(const std::vector<WorkerLoad>& loads, double wall) {
 
 }  // namespace
 
+int run(sowing_robot::farm::Farm& farm, int argc, char** argv);
+
 int main(int argc, char** argv) {
+  std::unique_ptr<sowing_robot::farm::Farm> farm;
+  try {
+    farm = std::make_unique<sowing_robot::farm::Farm>(&argc, &argv);
+  } catch (const std::exception& e) {
+    return fail(std::string("cannot start MPI: ") + e.what());
+  }
+  g_quiet = !farm->root();
+  return run(*farm, argc, argv);
+}
+
+int run(sowing_robot::farm::Farm& farm, int argc, char** argv) {
   std::vector<std::string> scenario_names{"thesis_line"}, controllers{"kanayama+atsmc"};
   long long seeds = -1, threads = 0, base_seed = -1;
   std::string output, scenario_dir = SOWING_SOURCE_DIR "/config/scenarios",
@@ -206,6 +229,29 @@ int main(int argc, char** argv) {
   } catch (const std::exception& e) {
     return fail(e.what());
   }
+  // Every scenario x controller batch, in the files' order: the runs' (batch, seed) is what the farm sends.
+  std::vector<BenchScenario> batches;
+  for (const BenchScenario& scenario : scenarios) {
+    for (const Scenario& pair : pairs) {
+      BenchScenario b = scenario;  // the scenario's timing, start and plant, with the pair's controllers and gains
+      b.base.outer = pair.outer;
+      b.base.inner = pair.inner;
+      b.base.kanayama = pair.kanayama;
+      b.base.sliding = pair.sliding;
+      b.base.pure_pursuit = pair.pure_pursuit;
+      b.base.pid = pair.pid;
+      batches.push_back(b);
+    }
+  }
+  // One run on any rank: {batch, seed} -> the packed row, by each batch's benchmarkWorker (made on first use).
+  std::vector<std::function<RunRow(std::int64_t)>> workers(batches.size());
+  const sowing_robot::farm::Compute compute = [&](const sowing_robot::farm::Payload& request) {
+    const auto k = static_cast<std::size_t>(request.at(0));
+    if (!workers.at(k)) workers[k] = benchmarkWorker(batches[k]);
+    return packRow(workers[k](static_cast<std::int64_t>(request.at(1))));
+  };
+  if (!farm.root()) return farm.serve(compute) ? 0 : 1;
+
   ::mkdir(output.c_str(), 0777);  // may exist; the writes below report a real failure
   {
     std::ofstream probe(output + "/.benchmark_probe");
@@ -233,34 +279,45 @@ int main(int argc, char** argv) {
   const long long total = seeds * static_cast<long long>(scenarios.size() * pairs.size());
   long long finished = 0;
   std::vector<WorkerLoad> loads;  // per worker thread, over all batches
-  for (const BenchScenario& scenario : scenarios) {
-    for (const Scenario& pair : pairs) {
-      BenchScenario b = scenario;  // the scenario's timing, start and plant, with the pair's controllers and gains
-      b.base.outer = pair.outer;
-      b.base.inner = pair.inner;
-      b.base.kanayama = pair.kanayama;
-      b.base.sliding = pair.sliding;
-      b.base.pure_pursuit = pair.pure_pursuit;
-      b.base.pid = pair.pid;
-      const std::string name = pair.controllerName();
+  for (std::size_t k = 0; k < batches.size(); ++k) {
+    {
+      const BenchScenario& b = batches[k];
+      const std::string name = b.base.controllerName();
       std::vector<RunRow> rows;
       std::vector<WorkerLoad> batch_loads;
+      const auto progress = [&](std::int64_t done) {
+        if (!tty && done != seeds) return;
+        if (tty && done % 10 != 0 && done != seeds) return;
+        const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        const double frac = static_cast<double>(finished + done) / static_cast<double>(total);
+        std::fprintf(stderr, "%s%s / %s: %lld/%lld runs; all %lld/%lld, %.0f s, about %.0f s left%s", tty ? "\r" : "",
+                     b.name.c_str(), name.c_str(), static_cast<long long>(done), seeds, finished + done, total, wall,
+                     frac > 0 ? wall * (1.0 - frac) / frac : 0.0, tty ? "   " : "\n");
+      };
       try {
-        rows = runBenchmark(
-            b, seeds, static_cast<int>(threads),
-            [&](std::int64_t done) {
-              if (!tty && done != seeds) return;
-              if (tty && done % 10 != 0 && done != seeds) return;
-              const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-              const double frac = static_cast<double>(finished + done) / static_cast<double>(total);
-              std::fprintf(stderr, "%s%s / %s: %lld/%lld runs; all %lld/%lld, %.0f s, about %.0f s left%s",
-                           tty ? "\r" : "", b.name.c_str(), name.c_str(), static_cast<long long>(done), seeds,
-                           finished + done, total, wall, frac > 0 ? wall * (1.0 - frac) / frac : 0.0,
-                           tty ? "   " : "\n");
-            },
-            &batch_loads);
+        if (farm.active()) {
+          checkBenchmark(b, seeds);  // before any run, as runBenchmark does
+          rows.resize(static_cast<std::size_t>(seeds));
+          std::int64_t done = 0;
+          farm.run(
+              static_cast<int>(seeds),
+              [k](int i) {
+                return sowing_robot::farm::Payload{static_cast<double>(k), static_cast<double>(i)};
+              },
+              compute,
+              [&](int i, const sowing_robot::farm::Payload& packed) {
+                rows[static_cast<std::size_t>(i)] = unpackRow(packed);
+                progress(++done);
+              });
+        } else {
+          rows = runBenchmark(b, seeds, static_cast<int>(threads), progress, &batch_loads);
+        }
       } catch (const std::exception& e) {
         if (tty) std::fprintf(stderr, "\n");
+        if (farm.active()) {
+          fail(b.name + " / " + name + ": " + e.what());
+          farm.abort(2);
+        }
         return fail(b.name + " / " + name + ": " + e.what());
       }
       finished += seeds;
@@ -277,11 +334,23 @@ int main(int argc, char** argv) {
   std::string error;
   if (!writeAll(output, {{"runs.csv", &csv}, {"envelopes.csv", &envelopes}, {"report.md", &report}}, error))
     return fail(error);
+  farm.stop();
+  if (farm.active()) {
+    const double eval = farm.evaluationSeconds();
+    std::printf("benchmark: %lld runs in %.2f s wall (%.2f ms per run, %s); %s/runs.csv, envelopes.csv, report.md\n",
+                total, wall, 1e3 * wall / static_cast<double>(total), farm.describe().c_str(), output.c_str());
+    std::printf(
+        "benchmark: farm: evaluation %.2f s summed over %d evaluators, rank 0 farm work %.4f s (%.3f %% of "
+        "evaluation), evaluators busy %.1f %% of %d x wall\n",
+        eval, farm.size(), farm.overheadSeconds(), eval > 0 ? 100.0 * farm.overheadSeconds() / eval : 0.0,
+        wall > 0 ? 100.0 * eval / (wall * farm.size()) : 0.0, farm.size());
+    return 0;
+  }
   // The worker threads that ran (--threads 0 is all cores; never more workers than batches of runs).
-  const std::size_t workers = loads.size();
+  const std::size_t nworkers = loads.size();
   std::printf(
       "benchmark: %lld runs in %.2f s wall (%.2f ms per run, %zu thread%s%s); %s/runs.csv, envelopes.csv, report.md\n",
-      total, wall, 1e3 * wall / static_cast<double>(total), workers, workers == 1 ? "" : "s",
+      total, wall, 1e3 * wall / static_cast<double>(total), nworkers, nworkers == 1 ? "" : "s",
       threads == 0 ? ", all cores" : "", output.c_str());
   std::printf("%s\n", loadLine(loads, wall).c_str());
   return 0;

@@ -5,6 +5,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <ctime>
 #include <limits>
 #include <memory>
@@ -224,43 +225,146 @@ std::string BenchScenario::validate() const {
   return "unknown track";
 }
 
-std::vector<RunRow> runBenchmark(const BenchScenario& bench, std::int64_t runs, int threads,
-                                 const std::function<void(std::int64_t)>& progress, std::vector<WorkerLoad>* loads) {
+void checkBenchmark(const BenchScenario& bench, std::int64_t runs) {
   if (runs < 1) throw std::invalid_argument("the number of runs (seeds) must be >= 1, not " + std::to_string(runs));
   const std::string e = bench.validate();
   if (!e.empty()) throw std::invalid_argument(e);
-  const MonteCarloSpec& spec = bench.spec;
-  const Scenario& base = bench.base;
-  refuseBadDraws(base, spec, runs);
-  if (bench.realism)  // sensors, traction or an estimate in the loop (issue 16): estimated_bench.h
-    return parallelRows(
-        runs, threads, progress, [&]() { return [&bench](std::int64_t i) { return estimatedBenchRow(bench, i); }; },
-        loads);
+  refuseBadDraws(bench.base, bench.spec, runs);
+}
+
+std::function<RunRow(std::int64_t)> benchmarkWorker(const BenchScenario& scenario) {
+  auto bench = std::make_shared<const BenchScenario>(scenario);
+  if (bench->realism)  // sensors, traction or an estimate in the loop (issue 16): estimated_bench.h
+    return [bench](std::int64_t i) { return estimatedBenchRow(*bench, i); };
   RunExtras extras;
-  extras.series_every = seriesEvery(bench);
-  if (bench.track != TrackKind::field) {
+  extras.series_every = seriesEvery(*bench);
+  if (bench->track != TrackKind::field) {
     std::unique_ptr<ReferenceSource> proto;
-    if (bench.track == TrackKind::line)
-      proto = std::make_unique<LineReference>(bench.line_v_r, bench.line_y, bench.line_x0);
+    if (bench->track == TrackKind::line)
+      proto = std::make_unique<LineReference>(bench->line_v_r, bench->line_y, bench->line_x0);
     else
-      proto = std::make_unique<SineReference>(bench.sine);
-    return parallelRows(
-        runs, threads, progress, [&]() { return seededRuns(base, spec, *proto, extras); }, loads);
+      proto = std::make_unique<SineReference>(bench->sine);
+    std::shared_ptr<ReferenceSource> ref = proto->clone();
+    return [bench, extras, ref](std::int64_t i) {
+      const RunDraw draw = drawRun(bench->spec, bench->base, i);
+      return measure(applyDraw(bench->base, bench->spec, draw), *ref, bench->spec, draw, extras);
+    };
   }
   // Field: the path starts at the drawn start (the approach), so each run builds its own reference, and its
   // duration grows by the approach's extra time, as run_scenario --field does.
+  return [bench, extras](std::int64_t i) {
+    const MonteCarloSpec& spec = bench->spec;
+    const RunDraw draw = drawRun(spec, bench->base, i);
+    return fieldRow(*bench, applyDraw(bench->base, spec, draw), extras,
+                    [&spec, &draw](const Scenario& sc, ReferenceSource& reference, const RunExtras& e) {
+                      return measure(sc, reference, spec, draw, e);
+                    });
+  };
+}
+
+std::vector<RunRow> runBenchmark(const BenchScenario& bench, std::int64_t runs, int threads,
+                                 const std::function<void(std::int64_t)>& progress, std::vector<WorkerLoad>* loads) {
+  checkBenchmark(bench, runs);
   return parallelRows(
-      runs, threads, progress,
-      [&]() {
-        return [&bench, &base, &spec, &extras](std::int64_t i) {
-          const RunDraw draw = drawRun(spec, base, i);
-          return fieldRow(bench, applyDraw(base, spec, draw), extras,
-                          [&spec, &draw](const Scenario& sc, ReferenceSource& reference, const RunExtras& e) {
-                            return measure(sc, reference, spec, draw, e);
-                          });
-        };
-      },
-      loads);
+      runs, threads, progress, [&]() { return benchmarkWorker(bench); }, loads);
+}
+
+namespace {
+
+template <typename T>
+double bits(T v) {
+  static_assert(sizeof(T) <= sizeof(double), "fits a double");
+  std::uint64_t u = 0;
+  std::memcpy(&u, &v, sizeof(T));
+  double d;
+  std::memcpy(&d, &u, sizeof d);
+  return d;
+}
+
+template <typename T>
+T fromBits(double d) {
+  std::uint64_t u;
+  std::memcpy(&u, &d, sizeof u);
+  T v;
+  std::memcpy(&v, &u, sizeof(T));
+  return v;
+}
+
+constexpr double kRowMagic = 28.0;  ///< first entry of a packed row (its format's version)
+
+}  // namespace
+
+std::vector<double> packRow(const RunRow& r) {
+  std::vector<double> p{kRowMagic};
+  const RunDraw& d = r.draw;
+  p.insert(p.end(), {bits(d.index), d.mass_scale, d.inertia_scale, d.amplitude, d.phase, bits(d.noise_seed), d.start_x,
+                     d.start_y, d.start_theta, bits(d.sensor_seed)});
+  for (const AxisMetrics& m : r.metrics)
+    p.insert(p.end(), {m.ise, m.itse, m.iae, m.itae, m.rise_time, m.settling_time, m.overshoot, m.peak});
+  p.insert(p.end(),
+           {r.effort, r.chattering, r.time_at_limit, r.worst_cross_track, r.final_cross_track,
+            bits(static_cast<std::uint64_t>(r.contacts)), r.min_clearance, r.end_distance, r.diverged ? 1.0 : 0.0,
+            r.success ? 1.0 : 0.0, r.realism ? 1.0 : 0.0, r.max_slip, r.tool_down_time, r.fed_error_rms,
+            r.fed_error_max, r.odometry_error_max, bits(static_cast<std::int64_t>(r.fixes_applied)),
+            bits(static_cast<std::int64_t>(r.fixes_refused))});
+  p.push_back(static_cast<double>(r.failure.size()));
+  for (char c : r.failure) p.push_back(static_cast<double>(static_cast<unsigned char>(c)));
+  p.push_back(static_cast<double>(r.cross_track_series.size()));
+  p.insert(p.end(), r.cross_track_series.begin(), r.cross_track_series.end());
+  return p;
+}
+
+RunRow unpackRow(const std::vector<double>& p) {
+  std::size_t k = 0;
+  auto next = [&]() {
+    if (k >= p.size()) throw std::invalid_argument("packed row: too short");
+    return p[k++];
+  };
+  auto count = [&]() {
+    const double n = next();
+    if (!(n >= 0.0) || n > static_cast<double>(p.size())) throw std::invalid_argument("packed row: bad length");
+    return static_cast<std::size_t>(n);
+  };
+  if (next() != kRowMagic) throw std::invalid_argument("packed row: unknown format");
+  RunRow r;
+  RunDraw& d = r.draw;
+  d.index = fromBits<std::int64_t>(next());
+  d.mass_scale = next();
+  d.inertia_scale = next();
+  d.amplitude = next();
+  d.phase = next();
+  d.noise_seed = fromBits<std::uint64_t>(next());
+  d.start_x = next();
+  d.start_y = next();
+  d.start_theta = next();
+  d.sensor_seed = fromBits<std::uint64_t>(next());
+  for (AxisMetrics& m : r.metrics)
+    for (double* f : {&m.ise, &m.itse, &m.iae, &m.itae, &m.rise_time, &m.settling_time, &m.overshoot, &m.peak})
+      *f = next();
+  r.effort = next();
+  r.chattering = next();
+  r.time_at_limit = next();
+  r.worst_cross_track = next();
+  r.final_cross_track = next();
+  r.contacts = static_cast<std::size_t>(fromBits<std::uint64_t>(next()));
+  r.min_clearance = next();
+  r.end_distance = next();
+  r.diverged = next() != 0.0;
+  r.success = next() != 0.0;
+  r.realism = next() != 0.0;
+  r.max_slip = next();
+  r.tool_down_time = next();
+  r.fed_error_rms = next();
+  r.fed_error_max = next();
+  r.odometry_error_max = next();
+  r.fixes_applied = static_cast<long>(fromBits<std::int64_t>(next()));
+  r.fixes_refused = static_cast<long>(fromBits<std::int64_t>(next()));
+  r.failure.resize(count());
+  for (char& c : r.failure) c = static_cast<char>(static_cast<unsigned char>(next()));
+  r.cross_track_series.resize(count());
+  for (double& v : r.cross_track_series) v = next();
+  if (k != p.size()) throw std::invalid_argument("packed row: trailing entries");
+  return r;
 }
 
 Envelope crossTrackEnvelope(const std::vector<RunRow>& rows, double period) {

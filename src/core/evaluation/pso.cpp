@@ -5,10 +5,14 @@
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
+#include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <limits>
+#include <memory>
 #include <mutex>
 #include <random>
+#include <sstream>
 #include <stdexcept>
 #include <thread>
 
@@ -159,103 +163,270 @@ PsoResult psoMinimize(const PsoParams& p, const PsoFitness& fitness, const PsoPr
       progress);
 }
 
-PsoResult psoMinimize(const PsoParams& p, const PsoBoundedFitness& fitness, const PsoProgressCallback& progress) {
+PsoSearch::PsoSearch(const PsoParams& p) : p_(p), gbest_cost_(INF) {
   const std::string error = p.validate();
   if (!error.empty()) throw std::invalid_argument("PsoParams: " + error);
-  if (!fitness) throw std::invalid_argument("psoMinimize: fitness is empty");
-
-  const auto t0 = std::chrono::steady_clock::now();
   const std::size_t n = static_cast<std::size_t>(p.particles);
   const std::size_t dims = p.dimensions();
-
-  int threads = p.threads > 0 ? p.threads : static_cast<int>(std::thread::hardware_concurrency());
-  threads = std::clamp(threads, 1, p.particles);
-
-  std::vector<double> range(dims), v_max(dims);
+  range_.resize(dims);
+  v_max_.resize(dims);
   for (std::size_t d = 0; d < dims; ++d) {
-    range[d] = p.upper[d] - p.lower[d];
-    v_max[d] = p.max_velocity_fraction > 0.0 ? p.max_velocity_fraction * range[d] : INF;
+    range_[d] = p.upper[d] - p.lower[d];
+    v_max_[d] = p.max_velocity_fraction > 0.0 ? p.max_velocity_fraction * range_[d] : INF;
   }
-
   // One RNG stream per particle, so the random numbers a particle sees depend only on (seed, index).
-  std::vector<std::mt19937_64> rng;
-  rng.reserve(n);
-  for (std::size_t j = 0; j < n; ++j) rng.emplace_back(splitmix64(splitmix64(p.seed) ^ splitmix64(0xA5A5A5A5ULL + j)));
-
+  rng_.reserve(n);
+  for (std::size_t j = 0; j < n; ++j) rng_.emplace_back(splitmix64(splitmix64(p.seed) ^ splitmix64(0xA5A5A5A5ULL + j)));
   // Uniform random start inside the box, zero velocity.
-  std::vector<std::vector<double>> x(n, std::vector<double>(dims)), v(n, std::vector<double>(dims, 0.0));
+  x_.assign(n, std::vector<double>(dims));
+  v_.assign(n, std::vector<double>(dims, 0.0));
   for (std::size_t j = 0; j < n; ++j)
-    for (std::size_t d = 0; d < dims; ++d) x[j][d] = std::min(p.lower[d] + uniform01(rng[j]) * range[d], p.upper[d]);
+    for (std::size_t d = 0; d < dims; ++d) x_[j][d] = std::min(p.lower[d] + uniform01(rng_[j]) * range_[d], p.upper[d]);
+  pbest_ = x_;
+  pbest_cost_.assign(n, INF);
+  gbest_ = x_[0];
+  history_.reserve(static_cast<std::size_t>(p.iterations) + 1);
+}
 
-  std::vector<std::vector<double>> pbest = x;
-  std::vector<double> pbest_cost(n, INF), cost(n, INF);
-  std::vector<double> gbest = x[0];
-  double gbest_cost = INF;
+void PsoSearch::move() {
+  // Velocity (eq 4.27), position (eq 4.28) and box (eq 4.29) for every particle, serially with each
+  // particle's own stream: r1 then r2, per dimension in order.
+  const double w = psoInertia(iteration_, p_.iterations, p_.w_max, p_.w_min);
+  for (std::size_t j = 0; j < x_.size(); ++j) {
+    for (std::size_t d = 0; d < range_.size(); ++d) {
+      const double r1 = uniform01(rng_[j]);
+      const double r2 = uniform01(rng_[j]);
+      double vd = w * v_[j][d] + p_.c1 * r1 * (pbest_[j][d] - x_[j][d]) + p_.c2 * r2 * (gbest_[d] - x_[j][d]);
+      vd = std::clamp(vd, -v_max_[d], v_max_[d]);
+      double xd = x_[j][d] + vd;
+      // A particle that hits a bound stays on it with that velocity component zeroed (a common
+      // choice), so the inertia term does not keep pushing it out of the box on later iterations.
+      if (xd < p_.lower[d]) {
+        xd = p_.lower[d];
+        vd = 0.0;
+      } else if (xd > p_.upper[d]) {
+        xd = p_.upper[d];
+        vd = 0.0;
+      }
+      x_[j][d] = xd;
+      v_[j][d] = vd;
+    }
+  }
+}
 
-  PsoResult result;
-  result.best_cost_per_iteration.reserve(static_cast<std::size_t>(p.iterations) + 1);
-  result.evaluations = 0;
+void PsoSearch::tell(const std::vector<double>& costs) {
+  if (finished()) throw std::logic_error("PsoSearch::tell: the search has finished");
+  if (costs.size() != x_.size())
+    throw std::logic_error("PsoSearch::tell: " + std::to_string(costs.size()) + " costs for " +
+                           std::to_string(x_.size()) + " particles");
+  evaluations_ += static_cast<long>(x_.size());
+  // Personal and global bests (eqs 4.30, 4.31), serially in particle order; strict '<' so ties keep
+  // the older best and +inf never becomes one.
+  for (std::size_t j = 0; j < x_.size(); ++j) {
+    const double c = std::isfinite(costs[j]) ? costs[j] : INF;
+    if (c < pbest_cost_[j]) {
+      pbest_cost_[j] = c;
+      pbest_[j] = x_[j];  // same size: copies without allocating
+      if (c < gbest_cost_) {
+        gbest_cost_ = c;
+        gbest_ = x_[j];
+      }
+    }
+  }
+  history_.push_back(gbest_cost_);
+  ++iteration_;
+  if (!finished()) move();
+}
 
-  EvaluationPool pool(threads, [&](int j, int thread_index) {
-    // pbest_cost changes only between evaluation rounds, on the caller thread.
-    const double c = fitness(x[static_cast<std::size_t>(j)], thread_index, pbest_cost[static_cast<std::size_t>(j)]);
-    cost[static_cast<std::size_t>(j)] = std::isfinite(c) ? c : INF;
+PsoResult PsoSearch::result() const {
+  PsoResult r;
+  r.best_position = gbest_;
+  r.best_cost = gbest_cost_;
+  r.best_cost_per_iteration = history_;
+  r.evaluations = evaluations_;
+  return r;
+}
+
+namespace {
+
+void putHex(std::string& out, double v) {
+  char b[40];
+  std::snprintf(b, sizeof b, " %a", v);
+  out += b;
+}
+
+void putRow(std::string& out, const char* key, const std::vector<double>& row) {
+  out += key;
+  for (double v : row) putHex(out, v);
+  out += '\n';
+}
+
+/// Reads the tokens of one text state, each failure one line naming what was expected.
+class StateReader {
+ public:
+  explicit StateReader(const std::string& text) : in_(text) {}
+  void expect(const std::string& word) {
+    std::string w;
+    if (!(in_ >> w) || w != word) fail("expected '" + word + "', found '" + w + "'");
+  }
+  double number() {
+    std::string w;
+    if (!(in_ >> w)) fail("ends early");
+    char* end = nullptr;
+    const double v = std::strtod(w.c_str(), &end);
+    if (w.empty() || *end != '\0' || std::isnan(v)) fail("'" + w + "' is no number");
+    return v;
+  }
+  long long integer() {
+    std::string w;
+    if (!(in_ >> w)) fail("ends early");
+    char* end = nullptr;
+    const long long v = std::strtoll(w.c_str(), &end, 10);
+    if (w.empty() || *end != '\0') fail("'" + w + "' is no integer");
+    return v;
+  }
+  void row(const char* key, std::vector<double>& out) {
+    expect(key);
+    for (double& v : out) v = number();
+  }
+  void generator(std::mt19937_64& g) {
+    expect("rng");
+    if (!(in_ >> g)) fail("a particle's generator state is damaged");
+  }
+  void end() {
+    std::string w;
+    if (in_ >> w) fail("unexpected '" + w + "' after the end");
+  }
+  [[noreturn]] static void fail(const std::string& what) { throw std::invalid_argument("PSO state: " + what); }
+
+ private:
+  std::istringstream in_;
+};
+
+/// The parameters a state belongs to, as one line (exact: hex floats).
+std::string paramsLine(const PsoParams& p) {
+  std::string s = "params " + std::to_string(p.particles) + " " + std::to_string(p.dimensions()) + " " +
+                  std::to_string(p.iterations) + " " + std::to_string(p.seed);
+  for (double v : {p.w_max, p.w_min, p.c1, p.c2, p.max_velocity_fraction}) putHex(s, v);
+  for (double v : p.lower) putHex(s, v);
+  for (double v : p.upper) putHex(s, v);
+  return s;
+}
+
+}  // namespace
+
+std::string PsoSearch::toText() const {
+  std::string out = "pso_state 1\n" + paramsLine(p_) + "\n";
+  out += "iteration " + std::to_string(iteration_) + "\nevaluations " + std::to_string(evaluations_) + "\n";
+  out += "gbest_cost";
+  putHex(out, gbest_cost_);
+  out += "\n";
+  putRow(out, "gbest", gbest_);
+  out += "history " + std::to_string(history_.size());
+  for (double v : history_) putHex(out, v);
+  out += "\n";
+  for (std::size_t j = 0; j < x_.size(); ++j) {
+    out += "particle " + std::to_string(j) + "\n";
+    putRow(out, "x", x_[j]);
+    putRow(out, "v", v_[j]);
+    putRow(out, "pbest", pbest_[j]);
+    out += "pbest_cost";
+    putHex(out, pbest_cost_[j]);
+    out += "\n";
+    std::ostringstream g;
+    g << rng_[j];
+    out += "rng " + g.str() + "\n";
+  }
+  return out;
+}
+
+PsoSearch PsoSearch::fromText(const PsoParams& params, const std::string& text) {
+  PsoSearch s(params);
+  StateReader r(text);
+  r.expect("pso_state");
+  if (r.integer() != 1) StateReader::fail("unknown version (this build reads version 1)");
+  // The parameters line must be this search's, word for word.
+  const std::string want = paramsLine(params);
+  const std::size_t at = text.find('\n');
+  const std::size_t end = at == std::string::npos ? at : text.find('\n', at + 1);
+  if (at == std::string::npos || end == std::string::npos || text.compare(at + 1, end - at - 1, want) != 0)
+    StateReader::fail(
+        "it belongs to other PSO parameters (particles, dimensions, iterations, seed, coefficients "
+        "or bounds differ)");
+  r.expect("params");
+  for (std::size_t k = 0; k < 4 + 5 + 2 * params.dimensions(); ++k) r.number();
+  r.expect("iteration");
+  const long long it = r.integer();
+  if (it < 0 || it > params.iterations + 1) StateReader::fail("iteration " + std::to_string(it) + " out of range");
+  s.iteration_ = static_cast<int>(it);
+  r.expect("evaluations");
+  s.evaluations_ = static_cast<long>(r.integer());
+  r.expect("gbest_cost");
+  s.gbest_cost_ = r.number();
+  r.row("gbest", s.gbest_);
+  r.expect("history");
+  if (r.integer() != it) StateReader::fail("history length differs from the iteration");
+  s.history_.assign(static_cast<std::size_t>(it), 0.0);
+  for (double& v : s.history_) v = r.number();
+  for (std::size_t j = 0; j < s.x_.size(); ++j) {
+    r.expect("particle");
+    if (r.integer() != static_cast<long long>(j)) StateReader::fail("particles out of order");
+    r.row("x", s.x_[j]);
+    r.row("v", s.v_[j]);
+    r.row("pbest", s.pbest_[j]);
+    r.expect("pbest_cost");
+    s.pbest_cost_[j] = r.number();
+    r.generator(s.rng_[j]);
+  }
+  r.end();
+  return s;
+}
+
+std::function<void(int)> psoThreadPool(int threads, PsoJob job) {
+  auto pool = std::make_shared<EvaluationPool>(std::max(threads, 1), std::move(job));
+  return [pool](int jobs) { pool->run(jobs); };
+}
+
+PsoBatch psoThreadedBatch(const PsoParams& p, const PsoBoundedFitness& fitness) {
+  if (!fitness) throw std::invalid_argument("psoThreadedBatch: fitness is empty");
+  int threads = p.threads > 0 ? p.threads : static_cast<int>(std::thread::hardware_concurrency());
+  threads = std::clamp(threads, 1, std::max(p.particles, 1));
+  struct Batch {  // the batch being evaluated, set before each run
+    const std::vector<std::vector<double>>* x = nullptr;
+    const std::vector<double>* bounds = nullptr;
+    std::vector<double>* costs = nullptr;
+  };
+  auto batch = std::make_shared<Batch>();
+  auto run = psoThreadPool(threads, [batch, fitness](int j, int thread_index) {
+    const auto k = static_cast<std::size_t>(j);
+    (*batch->costs)[k] = fitness((*batch->x)[k], thread_index, (*batch->bounds)[k]);
   });
+  return [batch, run](const std::vector<std::vector<double>>& x, const std::vector<double>& bounds,
+                      std::vector<double>& costs) {
+    batch->x = &x;
+    batch->bounds = &bounds;
+    batch->costs = &costs;
+    run(static_cast<int>(x.size()));
+  };
+}
 
-  for (int it = 0; it <= p.iterations; ++it) {
-    if (it > 0) {
-      // Velocity (eq 4.27), position (eq 4.28) and box (eq 4.29) for every particle, serially on the
-      // caller thread with each particle's own stream: r1 then r2, per dimension in order.
-      const double w = psoInertia(it, p.iterations, p.w_max, p.w_min);
-      for (std::size_t j = 0; j < n; ++j) {
-        for (std::size_t d = 0; d < dims; ++d) {
-          const double r1 = uniform01(rng[j]);
-          const double r2 = uniform01(rng[j]);
-          double vd = w * v[j][d] + p.c1 * r1 * (pbest[j][d] - x[j][d]) + p.c2 * r2 * (gbest[d] - x[j][d]);
-          vd = std::clamp(vd, -v_max[d], v_max[d]);
-          double xd = x[j][d] + vd;
-          // A particle that hits a bound stays on it with that velocity component zeroed (a common
-          // choice), so the inertia term does not keep pushing it out of the box on later iterations.
-          if (xd < p.lower[d]) {
-            xd = p.lower[d];
-            vd = 0.0;
-          } else if (xd > p.upper[d]) {
-            xd = p.upper[d];
-            vd = 0.0;
-          }
-          x[j][d] = xd;
-          v[j][d] = vd;
-        }
-      }
-    }
-
-    pool.run(p.particles);
-    result.evaluations += p.particles;
-
-    // Personal and global bests (eqs 4.30, 4.31), serially in particle order; strict '<' so ties keep
-    // the older best and +inf never becomes one.
-    for (std::size_t j = 0; j < n; ++j) {
-      if (cost[j] < pbest_cost[j]) {
-        pbest_cost[j] = cost[j];
-        pbest[j] = x[j];  // same size: copies without allocating
-        if (cost[j] < gbest_cost) {
-          gbest_cost = cost[j];
-          gbest = x[j];
-        }
-      }
-    }
-    result.best_cost_per_iteration.push_back(gbest_cost);
-
+PsoResult psoMinimize(const PsoParams& p, const PsoBoundedFitness& fitness, const PsoProgressCallback& progress) {
+  PsoSearch search(p);
+  if (!fitness) throw std::invalid_argument("psoMinimize: fitness is empty");
+  const auto t0 = std::chrono::steady_clock::now();
+  const PsoBatch batch = psoThreadedBatch(p, fitness);
+  std::vector<double> cost(static_cast<std::size_t>(p.particles), INF);
+  while (!search.finished()) {
+    const int it = search.iteration();
+    batch(search.positions(), search.bounds(), cost);
+    search.tell(cost);
     if (progress) {
       const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       const double eta = elapsed / static_cast<double>(it + 1) * static_cast<double>(p.iterations - it);
-      progress(PsoProgress{it, p.iterations, gbest_cost, &gbest, elapsed, eta});
+      progress(PsoProgress{it, p.iterations, search.bestCost(), &search.bestPosition(), elapsed, eta});
     }
   }
-
-  result.best_position = gbest;
-  result.best_cost = gbest_cost;
-  return result;
+  return search.result();
 }
 
 }  // namespace core

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <stdexcept>
 #include <thread>
 
@@ -400,39 +401,107 @@ int psoThreads(const PsoParams& p) {
   return std::clamp(threads, 1, std::max(p.particles, 1));
 }
 
+TuningBatch threadedTuningBatch(const TuningProblem& problem, const PsoParams& params) {
+  struct Batch {  // the batch being evaluated, set before each run
+    const std::vector<std::vector<double>>* x = nullptr;
+    const std::vector<double>* bounds = nullptr;
+    std::vector<TuningCost>* out = nullptr;
+  };
+  auto batch = std::make_shared<Batch>();
+  auto run = psoThreadPool(std::min(psoThreads(params), problem.threads()), [batch, &problem](int j, int thread_index) {
+    const auto k = static_cast<std::size_t>(j);
+    (*batch->out)[k] = problem.evaluate((*batch->x)[k], thread_index, (*batch->bounds)[k]);
+  });
+  return [batch, run](const std::vector<std::vector<double>>& x, const std::vector<double>& bounds,
+                      std::vector<TuningCost>& out) {
+    batch->x = &x;
+    batch->bounds = &bounds;
+    batch->out = &out;
+    run(static_cast<int>(x.size()));
+  };
+}
+
+TuningSession::TuningSession(const Scenario& base, const ReferenceSource& reference,
+                             const std::vector<GainBounds>& gains, const TuningObjective& objective, PsoParams params,
+                             int problem_threads)
+    : search_([&]() -> PsoParams {
+        const std::string e = firstError({base.validate(), validateGainBounds(base, gains), objective.validate()});
+        if (!e.empty()) throw std::invalid_argument(e);
+        params.lower.clear();
+        params.upper.clear();
+        for (const auto& g : gains) {
+          params.lower.push_back(g.lower);
+          params.upper.push_back(g.upper);
+        }
+        const std::string pe = params.validate();
+        if (!pe.empty()) throw std::invalid_argument(pe);
+        return params;
+      }()) {
+  problem_ = std::make_unique<TuningProblem>(base, reference, gains, objective, problem_threads);
+}
+
+int TuningSession::step(const TuningBatch& batch) {
+  const int it = search_.iteration();
+  const std::size_t n = search_.positions().size();
+  costs_.assign(n, TuningCost());
+  batch(search_.positions(), search_.bounds(), costs_);
+  totals_.resize(n);
+  for (std::size_t j = 0; j < n; ++j) {
+    totals_[j] = costs_[j].total;
+    if (costs_[j].bounded) ++cut_;
+    simulated_ns_ += std::llround(costs_[j].simulated * 1e9);
+  }
+  search_.tell(totals_);
+  return it;
+}
+
+std::string TuningSession::toText() const {
+  return "tuning_tally " + std::to_string(cut_) + " " + std::to_string(simulated_ns_) + "\n" + search_.toText();
+}
+
+void TuningSession::restore(const std::string& text) {
+  long long cut = 0, sim = 0;
+  int used = 0;
+  if (std::sscanf(text.c_str(), "tuning_tally %lld %lld\n%n", &cut, &sim, &used) != 2 || used <= 0 || cut < 0 ||
+      sim < 0)
+    throw std::invalid_argument("tuning state: the first line is not 'tuning_tally CUT SIMULATED_NS'");
+  search_ = PsoSearch::fromText(search_.params(), text.substr(static_cast<std::size_t>(used)));
+  cut_ = static_cast<long>(cut);
+  simulated_ns_ = sim;
+}
+
+TuningResult TuningSession::result() const {
+  if (!search_.finished()) throw std::logic_error("TuningSession::result: the search has not finished");
+  TuningResult out;
+  out.pso = search_.result();
+  out.evaluations_cut = cut_;
+  out.simulated_s = simulatedSeconds();
+  out.best_gains = out.pso.best_position;
+  out.best = problem_->evaluate(out.best_gains, 0);
+  out.initial_best_cost = out.pso.best_cost_per_iteration.empty() ? INF : out.pso.best_cost_per_iteration.front();
+  return out;
+}
+
 TuningResult tuneGains(const Scenario& base, const ReferenceSource& reference, const std::vector<GainBounds>& gains,
                        const TuningObjective& objective, PsoParams params, const PsoProgressCallback& progress) {
-  std::string e = firstError({base.validate(), validateGainBounds(base, gains), objective.validate()});
-  if (!e.empty()) throw std::invalid_argument(e);
-  params.lower.clear();
-  params.upper.clear();
-  for (const auto& g : gains) {
-    params.lower.push_back(g.lower);
-    params.upper.push_back(g.upper);
-  }
-  e = params.validate();
-  if (!e.empty()) throw std::invalid_argument(e);
-
-  TuningResult out;
-  out.threads = psoThreads(params);
-  const TuningProblem problem(base, reference, gains, objective, out.threads);
+  const int threads = psoThreads(params);
+  TuningSession session(base, reference, gains, objective, params, threads);
   const auto t0 = std::chrono::steady_clock::now();
   // Bounded: a particle's run stops once it cannot beat its personal best (same search, less work).
-  std::atomic<long> cut{0};
-  std::atomic<std::int64_t> simulated_ns{0};
-  out.pso = psoMinimize(params, PsoBoundedFitness([&](const std::vector<double>& x, int thread, double bound) {
-                          const TuningCost c = problem.evaluate(x, thread, bound);
-                          if (c.bounded) ++cut;
-                          simulated_ns += std::llround(c.simulated * 1e9);
-                          return c.total;
-                        }),
-                        progress);
-  out.evaluations_cut = cut;
-  out.simulated_s = 1e-9 * static_cast<double>(simulated_ns.load());
+  const TuningBatch batch = threadedTuningBatch(session.problem(), session.params());
+  const int iterations = session.params().iterations;
+  while (!session.finished()) {
+    const int it = session.step(batch);
+    if (progress) {
+      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      const double eta = elapsed / static_cast<double>(it + 1) * static_cast<double>(iterations - it);
+      progress(
+          PsoProgress{it, iterations, session.search().bestCost(), &session.search().bestPosition(), elapsed, eta});
+    }
+  }
+  TuningResult out = session.result();
+  out.threads = threads;
   out.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  out.best_gains = out.pso.best_position;
-  out.best = problem.evaluate(out.best_gains, 0);
-  out.initial_best_cost = out.pso.best_cost_per_iteration.empty() ? INF : out.pso.best_cost_per_iteration.front();
   return out;
 }
 

@@ -157,6 +157,19 @@ std::vector<RunRow> runBenchmark(const BenchScenario& bench, std::int64_t runs, 
                                  const std::function<void(std::int64_t)>& progress = {},
                                  std::vector<WorkerLoad>* loads = nullptr);
 
+/// What runBenchmark checks before the first run (scenario, runs >= 1, every drawn run valid); throws
+/// std::invalid_argument with one line.
+void checkBenchmark(const BenchScenario& bench, std::int64_t runs);
+/// One worker of runBenchmark: run(i) -> row i of `bench` (its own copy of the scenario and its own
+/// references; call from one thread). runBenchmark's threads each run one; the MPI farm's ranks run the
+/// same, so a row is the same bits wherever it ran.
+std::function<RunRow(std::int64_t)> benchmarkWorker(const BenchScenario& bench);
+
+/// A row as doubles (integers and flags bit-cast, the failure text one character per double) and back,
+/// exactly: what the MPI farm sends. unpackRow throws std::invalid_argument on a malformed array.
+std::vector<double> packRow(const RunRow& row);
+RunRow unpackRow(const std::vector<double>& packed);
+
 /// Quantiles over the runs of the cross-track series at each sample time (runs whose series is shorter
 /// are left out there; a diverged run's non-finite samples count as +inf).
 struct Envelope {

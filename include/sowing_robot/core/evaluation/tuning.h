@@ -4,6 +4,8 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <string>
@@ -116,6 +118,8 @@ class TuningProblem {
   const std::vector<GainBounds>& gains() const { return gains_; }
   const Scenario& base() const { return base_; }
   const TuningObjective& objective() const { return objective_; }
+  /// How many thread indices evaluate() accepts (0..threads()-1).
+  int threads() const { return static_cast<int>(references_.size()); }
 
  private:
   Scenario base_;
@@ -138,6 +142,52 @@ struct TuningResult {
   double wall_s = 0.0;
   long evaluations_cut = 0;  ///< evaluations stopped early by their particle's bound
   double simulated_s = 0.0;  ///< simulated time run over all evaluations [s]
+};
+
+/// Scores a whole iteration for the tuner: out[j] = the problem's evaluate(positions[j], ., bounds[j]) for
+/// every j (any order, any parallelism; out has positions.size() entries on entry). The search uses
+/// out[j].total; bounded and simulated feed the tallies. threadedTuningBatch is tuneGains' own; the MPI
+/// farm (farm/tune_farm.h) sends the same evaluate() to other processes.
+using TuningBatch = std::function<void(const std::vector<std::vector<double>>& positions,
+                                       const std::vector<double>& bounds, std::vector<TuningCost>& out)>;
+/// The batch on psoThreads(params) threads, at most problem.threads() (the pool of psoThreadedBatch over
+/// problem.evaluate).
+TuningBatch threadedTuningBatch(const TuningProblem& problem, const PsoParams& params);
+
+/// tuneGains in steps: the search of tuneGains (same problem, bounds, bound per particle) driven one
+/// iteration at a time by any TuningBatch, so it can be checkpointed (toText / restore) and resumed, or
+/// evaluated on other processes; whatever the batch, the same costs give the same gains bit for bit.
+class TuningSession {
+ public:
+  /// Validates like tuneGains (std::invalid_argument, one line); params.lower/upper come from `gains`.
+  /// problem_threads: how many thread indices the problem's evaluate() accepts.
+  TuningSession(const Scenario& base, const ReferenceSource& reference, const std::vector<GainBounds>& gains,
+                const TuningObjective& objective, PsoParams params, int problem_threads);
+
+  const TuningProblem& problem() const { return *problem_; }
+  const PsoParams& params() const { return search_.params(); }
+  const PsoSearch& search() const { return search_; }
+  bool finished() const { return search_.finished(); }
+  /// Evaluates the current iteration with `batch` and tells the search; returns the iteration done.
+  int step(const TuningBatch& batch);
+  long evaluationsCut() const { return cut_; }
+  double simulatedSeconds() const { return 1e-9 * static_cast<double>(simulated_ns_); }
+
+  /// The whole state between two iterations as text (the search's exact text and the tallies).
+  std::string toText() const;
+  /// Back to a state toText() wrote for the same parameters; std::invalid_argument (one line) otherwise.
+  void restore(const std::string& text);
+  /// What tuneGains returns, once finished (throws std::logic_error before): the best evaluated once more.
+  /// wall_s and threads are left for the caller.
+  TuningResult result() const;
+
+ private:
+  std::unique_ptr<TuningProblem> problem_;
+  PsoSearch search_;
+  long cut_ = 0;
+  std::int64_t simulated_ns_ = 0;
+  std::vector<TuningCost> costs_;
+  std::vector<double> totals_;
 };
 
 /// Resolved number of evaluation threads psoMinimize will use for these parameters.

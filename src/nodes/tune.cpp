@@ -1,0 +1,335 @@
+// tune: the PSO gain tuner on the command line, no ROS master (issue 28). Same search and objective as the
+// pso_tuner node (core::TuningSession = core::tuneGains in steps); threads without an MPI launcher, an MPI
+// evaluation farm under mpirun / srun (rank 0 owns the search, checkpoint and output; every rank evaluates
+// one particle at a time; results go back by particle index, so the gains do not depend on the number of
+// ranks or threads, bit for bit).
+//
+//   tune --config FILE [--output GAINS.yaml] [--checkpoint FILE [--resume]] [--progress FILE.csv]
+//        [--threads N] [--stop-after K]
+//   mpirun -np N tune --config FILE ...      (rosrun sowing_robot tune ... works the same)
+//
+// --config: config/tune.yaml's format (bench/tune_config.h: the pso_tuner block of config/pso.yaml plus the
+// base scenario). --output: the gains YAML (default pso_tuner/output, else tuned_gains.yaml); its lines that
+// can differ between two equal runs (date, wall time, ranks) start with "# run:". --checkpoint: the whole
+// search state after every iteration (core/evaluation/checkpoint.h: written to FILE.tmp, then renamed);
+// --resume continues from it (a missing file starts from the beginning; a damaged one or one of another
+// setup is refused with one line); the result is that of an uninterrupted run. --progress: one CSV row per
+// iteration (rewritten from the checkpoint's iteration on --resume). --stop-after K: stop after iteration K
+// with exit code 3, as a kill would (tests). Exit codes: 0 done, 1 failed while running, 2 bad input,
+// 3 stopped by --stop-after.
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "sowing_robot/bench/tune_config.h"
+#include "sowing_robot/core/evaluation/checkpoint.h"
+#include "sowing_robot/core/evaluation/tuning.h"
+#include "sowing_robot/farm/farm.h"
+
+using namespace sowing_robot;
+using core::TuningCost;
+
+namespace {
+
+const char* const kUsage =
+    "usage: tune --config FILE [--output GAINS.yaml] [--checkpoint FILE [--resume]] [--progress FILE.csv] "
+    "[--threads N] [--stop-after K]";
+
+std::string g(double v, const char* f = "%.6g") {
+  char b[48];
+  std::snprintf(b, sizeof b, f, v);
+  return b;
+}
+
+bool parseInt(const std::string& s, long long& out) {
+  char* end = nullptr;
+  out = std::strtoll(s.c_str(), &end, 10);
+  return !s.empty() && *end == '\0';
+}
+
+struct Args {
+  std::string config, output, checkpoint, progress;
+  bool resume = false;
+  long long threads = -1, stop_after = -1;
+};
+
+/// "" or one line.
+std::string parseArgs(int argc, char** argv, Args& a) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string k = argv[i];
+    if (k == "--resume") {
+      a.resume = true;
+      continue;
+    }
+    if (k == "--help" || k == "-h") return kUsage;
+    if (k != "--config" && k != "--output" && k != "--checkpoint" && k != "--progress" && k != "--threads" &&
+        k != "--stop-after")
+      return "unknown argument '" + k + "' (" + kUsage + ")";
+    if (i + 1 >= argc) return "missing value after " + k;
+    const std::string v = argv[++i];
+    if (k == "--config") a.config = v;
+    if (k == "--output") a.output = v;
+    if (k == "--checkpoint") a.checkpoint = v;
+    if (k == "--progress") a.progress = v;
+    if (k == "--threads" || k == "--stop-after") {
+      long long n;
+      if (!parseInt(v, n) || n < 0) return k + " needs an integer >= 0, not '" + v + "'";
+      (k == "--threads" ? a.threads : a.stop_after) = n;
+    }
+  }
+  if (a.config.empty()) return std::string("--config FILE is required (") + kUsage + ")";
+  if (a.resume && a.checkpoint.empty()) return "--resume needs --checkpoint FILE";
+  return "";
+}
+
+/// The particle's evaluation on any rank: request {bound, x...} -> {total, bounded, simulated}.
+farm::Payload evaluate(const core::TuningProblem& problem, const farm::Payload& request) {
+  const std::vector<double> x(request.begin() + 1, request.end());
+  const TuningCost c = problem.evaluate(x, 0, request.front());
+  return {c.total, c.bounded ? 1.0 : 0.0, c.simulated};
+}
+
+bool writeAtomically(const std::string& path, const std::string& text, std::string& error) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
+    f << text;
+    f.flush();
+    if (!f) {
+      error = "cannot write " + tmp;
+      return false;
+    }
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    error = "cannot rename " + tmp + " to " + path;
+    return false;
+  }
+  return true;
+}
+
+/// The progress CSV kept up to (not including) iteration `from`; "" if it cannot be read.
+std::string csvUpTo(const std::string& path, int from) {
+  std::ifstream f(path);
+  std::string line, out;
+  bool header = true;
+  while (std::getline(f, line)) {
+    if (header) {
+      header = false;
+      continue;
+    }
+    long long it;
+    if (parseInt(line.substr(0, line.find(',')), it) && it < from) out += line + "\n";
+  }
+  return out;
+}
+
+int run(farm::Farm& farm, int argc, char** argv) {
+  Args args;
+  const std::string arg_error = parseArgs(argc, argv, args);
+  if (!arg_error.empty()) {
+    if (farm.root()) std::fprintf(stderr, "tune: %s\n", arg_error.c_str());
+    return 2;
+  }
+  bench::TuneConfig cfg;
+  try {
+    cfg = bench::loadTuneConfig(args.config);
+  } catch (const std::exception& e) {
+    // Every rank reads the same file: rank 0 says what is wrong, the others leave quietly.
+    if (farm.root()) std::fprintf(stderr, "tune: %s\n", e.what());
+    return 2;
+  }
+  if (args.threads >= 0) cfg.pso.threads = static_cast<int>(args.threads);
+  const core::LineReference reference = cfg.reference();
+
+  if (!farm.root()) {  // a worker rank: evaluate until rank 0 is done
+    const core::TuningProblem problem(cfg.base, reference, cfg.gains, cfg.objective, 1);
+    long evaluations = 0;
+    const char* die = std::getenv("SOWING_FARM_TEST_DIE_AFTER");  // test hook: this rank dies mid-run
+    const long die_after = die ? std::atol(die) : -1;
+    return farm.serve([&](const farm::Payload& request) {
+      if (die_after >= 0 && evaluations++ >= die_after) std::raise(SIGKILL);
+      return evaluate(problem, request);
+    })
+               ? 0
+               : 1;
+  }
+
+  const std::string output = !args.output.empty() ? args.output : !cfg.output.empty() ? cfg.output : "tuned_gains.yaml";
+  const int threads = farm.active() ? 1 : core::psoThreads(cfg.pso);
+  std::unique_ptr<core::TuningSession> session;
+  try {
+    session = std::make_unique<core::TuningSession>(cfg.base, reference, cfg.gains, cfg.objective, cfg.pso, threads);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "tune: %s: %s\n", args.config.c_str(), e.what());
+    return 2;
+  }
+  // What the run was started with: the config's bytes, the scenario as read, and the initial swarm (PSO
+  // parameters, bounds, seed). A checkpoint of anything else is refused.
+  const std::uint64_t fingerprint =
+      core::fnv1a64("tune 1\n" + cfg.text + "\n" + cfg.scenarioText() + "\n" + session->toText());
+
+  if (args.resume) {
+    std::string body;
+    if (::access(args.checkpoint.c_str(), F_OK) != 0) {
+      std::fprintf(stderr, "tune: no checkpoint at %s yet: starting from the beginning\n", args.checkpoint.c_str());
+    } else {
+      const std::string e = core::readCheckpoint(args.checkpoint, "tune", fingerprint, body);
+      if (!e.empty()) {
+        std::fprintf(stderr, "tune: %s\n", e.c_str());
+        return 2;
+      }
+      try {
+        session->restore(body);
+      } catch (const std::exception& ex) {
+        std::fprintf(stderr, "tune: checkpoint %s: %s\n", args.checkpoint.c_str(), ex.what());
+        return 2;
+      }
+      std::fprintf(stderr, "tune: resuming from %s at iteration %d/%d (best cost %s)\n", args.checkpoint.c_str(),
+                   session->search().iteration(), cfg.pso.iterations, g(session->search().bestCost(), "%.9g").c_str());
+    }
+  }
+
+  std::string csv;
+  if (!args.progress.empty()) {
+    csv = "iteration,best_cost,evaluations,evaluations_cut,simulated_s,elapsed_s";
+    for (const auto& b : cfg.gains) csv += "," + b.name;
+    csv += "\n";
+    if (session->search().iteration() > 0) csv += csvUpTo(args.progress, session->search().iteration());
+  }
+
+  std::string dims;
+  for (const auto& b : cfg.gains)
+    dims += (dims.empty() ? "" : ", ") + b.name + " [" + g(b.lower) + ", " + g(b.upper) + "]";
+  std::fprintf(stderr, "tune: %s; %s\ntune: scenario %s\ntune: searching %s\n",
+               farm.active() ? farm.describe().c_str() : (std::to_string(threads) + " thread(s)").c_str(),
+               ("particles " + std::to_string(cfg.pso.particles) + ", iterations " +
+                std::to_string(cfg.pso.iterations) + ", seed " + std::to_string(cfg.pso.seed))
+                   .c_str(),
+               cfg.scenarioText().c_str(), dims.c_str());
+
+  core::TuningBatch batch;
+  if (farm.active()) {
+    const core::TuningProblem& problem = session->problem();
+    batch = [&farm, &problem](const std::vector<std::vector<double>>& x, const std::vector<double>& bounds,
+                              std::vector<TuningCost>& out) {
+      farm.run(
+          static_cast<int>(x.size()),
+          [&](int j) {
+            farm::Payload r{bounds[static_cast<std::size_t>(j)]};
+            r.insert(r.end(), x[static_cast<std::size_t>(j)].begin(), x[static_cast<std::size_t>(j)].end());
+            return r;
+          },
+          [&problem](const farm::Payload& request) { return evaluate(problem, request); },
+          [&out](int j, const farm::Payload& r) {
+            TuningCost& c = out[static_cast<std::size_t>(j)];
+            c.total = r.at(0);
+            c.bounded = r.at(1) != 0.0;
+            c.simulated = r.at(2);
+          });
+    };
+  } else {
+    batch = core::threadedTuningBatch(session->problem(), session->params());
+  }
+
+  const auto t0 = std::chrono::steady_clock::now();
+  const int first = session->search().iteration();
+  try {
+    while (!session->finished()) {
+      const int it = session->step(batch);
+      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      std::string error;
+      if (!args.checkpoint.empty()) {
+        error = core::writeCheckpoint(args.checkpoint, "tune", fingerprint, session->toText());
+        if (!error.empty()) throw std::runtime_error(error);
+      }
+      if (!args.progress.empty()) {
+        csv += std::to_string(it) + "," + g(session->search().bestCost(), "%.17g") + "," +
+               std::to_string(static_cast<long>(it + 1) * cfg.pso.particles) + "," +
+               std::to_string(session->evaluationsCut()) + "," + g(session->simulatedSeconds(), "%.9g") + "," +
+               g(elapsed, "%.3f");
+        for (double v : session->search().bestPosition()) csv += "," + g(v, "%.17g");
+        csv += "\n";
+        if (!writeAtomically(args.progress, csv, error)) throw std::runtime_error(error);
+      }
+      const double eta = elapsed / (it + 1 - first) * (cfg.pso.iterations - it);
+      std::fprintf(stderr, "tune: iteration %d/%d  best cost %.9g  elapsed %.2f s  ETA %.2f s\n", it,
+                   cfg.pso.iterations, session->search().bestCost(), elapsed, eta);
+      if (args.stop_after >= 0 && it >= args.stop_after && !session->finished()) {
+        std::fprintf(stderr, "tune: stopped after iteration %d (--stop-after); resume with --resume\n", it);
+        return 3;
+      }
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "tune: stopped: %s; %s\n", e.what(),
+                 args.checkpoint.empty() ? "no checkpoint kept (--checkpoint FILE)"
+                                         : ("the last checkpoint is " + args.checkpoint + " (--resume)").c_str());
+    farm.abort(1);
+  }
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  farm.stop();
+
+  const core::TuningResult r = session->result();
+  if (!std::isfinite(r.pso.best_cost)) {
+    std::fprintf(stderr, "tune: every run diverged (no finite cost); nothing written. Narrow the gain bounds.\n");
+    return 1;
+  }
+  const core::Scenario tuned = session->problem().scenarioFor(r.best_gains);
+  char date[64];
+  const std::time_t now = std::time(nullptr);
+  std::strftime(date, sizeof date, "%Y-%m-%d %H:%M:%S %z", std::localtime(&now));
+  std::string h = "# Controller gains tuned offline by tune (PSO, thesis eqs 4.26-4.31, Table 5.4).\n";
+  h += "# config: " + args.config + "\n# scenario: " + cfg.scenarioText() + "\n";
+  h += "# cost: " + std::string(core::costTypeName(cfg.objective.cost)) + " summed over x, y, theta";
+  if (cfg.objective.torque_weight > 0) h += " + " + g(cfg.objective.torque_weight) + " * effort";
+  if (cfg.objective.chattering_weight > 0) h += " + " + g(cfg.objective.chattering_weight) + " * chattering";
+  h += "\n# best_cost: " + core::yamlFloat(r.pso.best_cost) + "\n";
+  h += "# initial_best_cost: " + core::yamlFloat(r.initial_best_cost) + "\n";
+  h += "# pso: particles " + std::to_string(cfg.pso.particles) + ", iterations " + std::to_string(cfg.pso.iterations) +
+       ", seed " + std::to_string(cfg.pso.seed) + ", evaluations " + std::to_string(r.pso.evaluations) + " (" +
+       std::to_string(r.evaluations_cut) + " stopped early at their particle's best)\n";
+  h += "# searched: " + dims + "\n";
+  h += "# run: " + std::string(date) + ", " +
+       (farm.active() ? farm.describe() : std::to_string(threads) + " thread(s)") + ", " + g(wall, "%.2f") + " s wall" +
+       (first > 0 ? ", resumed at iteration " + std::to_string(first) : "") + "\n";
+  std::string error;
+  if (!writeAtomically(output, h + core::gainsYaml(tuned, cfg.gains), error)) {
+    std::fprintf(stderr, "tune: %s\n", error.c_str());
+    return 1;
+  }
+  std::string best;
+  for (std::size_t d = 0; d < cfg.gains.size(); ++d)
+    best += (d ? ", " : "") + cfg.gains[d].name + " " + g(r.best_gains[d], "%.5g");
+  std::printf("tune: cost %.9g -> %.9g in %.2f s (%ld evaluations, %ld cut); %s\ntune: wrote %s\n", r.initial_best_cost,
+              r.pso.best_cost, wall, r.pso.evaluations, r.evaluations_cut, best.c_str(), output.c_str());
+  if (farm.active()) {
+    const double eval = farm.evaluationSeconds();
+    std::printf(
+        "tune: farm: %d ranks, evaluation %.2f s summed over evaluators, rank 0 farm work %.4f s (%.3f %% of "
+        "evaluation), evaluators busy %.1f %% of %d x wall\n",
+        farm.size(), eval, farm.overheadSeconds(), eval > 0 ? 100.0 * farm.overheadSeconds() / eval : 0.0,
+        wall > 0 ? 100.0 * eval / (wall * farm.size()) : 0.0, farm.size());
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::unique_ptr<farm::Farm> f;
+  try {
+    f = std::make_unique<farm::Farm>(&argc, &argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "tune: cannot start MPI: %s\n", e.what());
+    return 2;
+  }
+  return run(*f, argc, argv);
+}
