@@ -12,10 +12,7 @@ every envelope_period) and writes, into the output directory:
 - comparison.md: per scenario, where the reference pair (kanayama+atsmc) is worse than another pair by more
   than --margin (5 %): success rate, medians of the tracking, effort and chattering figures, mean time at the
   torque limit; the raw material of a reading.
-
-Usage: benchmark_plots DIR [--output OUT] [--reference kanayama+atsmc] [--margin 0.05]
 """
-import argparse
 import csv
 import math
 import os
@@ -25,6 +22,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from sowing_robot.cli import Parser  # noqa: E402
 
 # The metrics that get a box plot, with their labels; min_clearance only where there are obstacles.
 BOX_METRICS = [
@@ -248,7 +246,7 @@ def comparison(rows, reference="kanayama+atsmc", margin=0.05):
 
 
 def main(argv=None):
-    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p = Parser(__doc__, prog="benchmark_plots")
     p.add_argument("dir", help="a benchmark --output directory (runs.csv, envelopes.csv)")
     p.add_argument("--output", help="where the PNGs and comparison.md go (default: DIR)")
     p.add_argument("--reference", default="kanayama+atsmc", help="the pair compared against the others")

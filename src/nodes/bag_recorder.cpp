@@ -9,9 +9,7 @@
 // (a loaded machine) would lose them with their publishers when the launch ends. So it says how far it
 // has got: ~recorded_until (std_msgs/Time, latched) is the oldest of the newest header stamps written on
 // the ~period_topics (those published once per control period), and the node that ends a headless run
-// (run_monitor, `~recorder`) waits for it to reach the run's last period.
-//   rosrun sowing_robot bag_recorder _output:=run.bag _topics:="/odom /reference ..." [_queue:=200000]
-//     [_period_topics:="/odom ..."] [_receive_delay:=0 (s per message, tests: a recorder starved of CPU)]
+// (run_monitor, `~recorder`) waits for it to reach the run's last period. Usage: kUsage below (--help).
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
 #include <ros/serialization.h>
@@ -29,11 +27,19 @@
 #include <string>
 #include <vector>
 
+#include "sowing_robot/cli/usage.h"
 #include "sowing_robot/ros/common/failure_log.h"
 #include "sowing_robot/ros/common/param_reader.h"
 #include "sowing_robot/ros/common/ready_roster.h"
 
 namespace {
+const char* const kUsage = SOWING_NODE_USAGE(
+    "bag_recorder",
+    "Records the named topics into a bag without losing messages in lockstep runs (sim.launch record:=true):\n"
+    "  rosrun sowing_robot bag_recorder _output:=run.bag _topics:=\"/odom /reference ...\" [_queue:=200000]\n"
+    "    [_period_topics:=\"/odom ...\"] [_receive_delay:=0 (s per message, tests: a recorder starved of CPU)]\n"
+    "On SIGINT it drains what it has received, then closes the bag; ~recorded_until says how far it got.\n");
+
 volatile std::sig_atomic_t g_stop = 0;
 void onSignal(int) { g_stop = 1; }
 
@@ -205,6 +211,7 @@ int record(ros::NodeHandle& nh, ros::NodeHandle& pnh, const Options& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  sowing_robot::cli::checkNodeArguments(argc, argv, "bag_recorder", kUsage);
   ros::init(argc, argv, "bag_recorder", ros::init_options::NoSigintHandler);
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);

@@ -1,9 +1,5 @@
 // benchmark: Monte-Carlo statistics of controller pairs over the scenario suite, in-process (no ROS master),
-// issue 17 items 2 and 3.
-//   benchmark --scenarios A,B --controllers X,Y --seeds N --output DIR [--threads K]
-//             [--scenario-dir DIR] [--tuned-dir DIR] [--base-seed S] [--profile FILE]
-// --profile FILE: a set-up applied on top of every scenario file's own blocks (config/profiles/field.yaml: the
-// recommended drive train; bench::loadScenarioFile).
+// issue 17 items 2 and 3. Usage and options: kUsage below (benchmark --help).
 // Scenarios are names in the scenario directory (default: the package's config/scenarios; `all` for every
 // file there) or paths to scenario files; controllers are outer+inner pairs (kanayama|pure_pursuit|rpp +
 // atsmc|tsmc|pid). A pair's gains come from TUNED_DIR/OUTER+INNER.yaml when that file exists (default the
@@ -23,6 +19,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -33,6 +30,7 @@
 #include <vector>
 
 #include "sowing_robot/bench/scenario_loader.h"
+#include "sowing_robot/cli/usage.h"
 #include "sowing_robot/core/evaluation/benchmark.h"
 #include "sowing_robot/core/evaluation/estimated_bench.h"
 #include "sowing_robot/core/simulation/runner.h"
@@ -46,6 +44,26 @@ namespace bench = sowing_robot::bench;
 #endif
 
 namespace {
+const char* const kUsage =
+    "usage: benchmark --seeds N --output DIR [--scenarios A,B] [--controllers X,Y] [--threads K]\n"
+    "                 [--scenario-dir DIR] [--tuned-dir DIR] [--base-seed S] [--profile FILE]\n"
+    "Monte-Carlo statistics of controller pairs over the scenario suite, in-process (no ROS master).\n"
+    "Writes DIR/runs.csv, DIR/envelopes.csv and DIR/report.md (the same whatever --threads).\n\n"
+    "Options:\n"
+    "  --seeds N            seeded runs per scenario and controller (required, >= 1)\n"
+    "  --output DIR         where the files go (required)\n"
+    "  --scenarios A,B      names in the scenario directory, paths to scenario files, or `all` (default thesis_line)\n"
+    "  --controllers X,Y    outer+inner pairs: kanayama|pure_pursuit|rpp + atsmc|tsmc|pid (default kanayama+atsmc)\n"
+    "  --threads K          worker threads, 0 = all cores (default 0)\n"
+    "  --scenario-dir DIR   default: the package's config/scenarios\n"
+    "  --tuned-dir DIR      OUTER+INNER.yaml gains when present, else the tables' defaults (default config/tuned)\n"
+    "  --base-seed S        overrides every scenario's base seed\n"
+    "  --profile FILE       a set-up on top of every scenario file's blocks (config/profiles/field.yaml:\n"
+    "                       the recommended drive train)\n"
+    "  -h, --help           this text\n"
+    "A bad request (unknown name, --seeds 0, a scenario file with a typo, an unwritable DIR) gives one error\n"
+    "line, exit 2, and no report.\n";
+
 std::vector<std::string> splitComma(const std::string& s) {
   std::vector<std::string> out;
   std::string cur;
@@ -159,6 +177,7 @@ std::string loadLine(const std::vector<WorkerLoad>& loads, double wall) {
 int run(sowing_robot::farm::Farm& farm, int argc, char** argv);
 
 int main(int argc, char** argv) {
+  sowing_robot::cli::exitOnHelp(argc, argv, kUsage);  // before MPI: no rank, no farm for --help
   std::unique_ptr<sowing_robot::farm::Farm> farm;
   try {
     farm = std::make_unique<sowing_robot::farm::Farm>(&argc, &argv);
@@ -174,8 +193,13 @@ int run(sowing_robot::farm::Farm& farm, int argc, char** argv) {
   long long seeds = -1, threads = 0, base_seed = -1;
   std::string output, scenario_dir = SOWING_SOURCE_DIR "/config/scenarios",
                       tuned_dir = SOWING_SOURCE_DIR "/config/tuned", profile;
+  static const std::vector<std::string> kOptions{"--controllers",  "--scenarios", "--output",
+                                                 "--scenario-dir", "--tuned-dir", "--seeds",
+                                                 "--threads",      "--base-seed", "--profile"};
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
+    if (std::find(kOptions.begin(), kOptions.end(), a) == kOptions.end())
+      return sowing_robot::cli::unknownOption("benchmark", a);
     if (i + 1 >= argc) return fail("missing value after " + a);
     const char* v = argv[++i];
     if (a == "--controllers") {
@@ -190,14 +214,10 @@ int run(sowing_robot::farm::Farm& farm, int argc, char** argv) {
       tuned_dir = v;
     } else if (a == "--profile") {
       profile = v;
-    } else if (a == "--seeds" || a == "--threads" || a == "--base-seed") {
+    } else {  // --seeds, --threads or --base-seed: kOptions has no other
       long long n;
       if (!parseInteger(v, n)) return fail(a + " needs an integer, not '" + v + "'");
       (a == "--seeds" ? seeds : a == "--threads" ? threads : base_seed) = n;
-    } else {
-      return fail(
-          "unknown argument '" + a +
-          "' (--scenarios --controllers --seeds --output --threads --scenario-dir --tuned-dir --base-seed --profile)");
     }
   }
   if (seeds < 1) return fail(seeds == -1 ? "--seeds N is required" : "--seeds must be >= 1");

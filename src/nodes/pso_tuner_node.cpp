@@ -2,11 +2,20 @@
 // A bad parameter (NodeFailure) becomes one FATAL line and exit 1.
 #include <ros/ros.h>
 
+#include "sowing_robot/cli/usage.h"
 #include "sowing_robot/ros/common/failure_log.h"
 #include "sowing_robot/ros/common/param_reader.h"
 #include "sowing_robot/ros/pso_tuner.h"
 
+namespace {
+const char* const kUsage = SOWING_NODE_USAGE(
+    "pso_tuner",
+    "Offline PSO tuning of the controller gains on the in-process closed loop (roslaunch sowing_robot\n"
+    "tune.launch); writes the gains YAML and publishes pso/progress, then exits.\n");
+}  // namespace
+
 int main(int argc, char** argv) {
+  sowing_robot::cli::checkNodeArguments(argc, argv, "pso_tuner", kUsage);
   ros::init(argc, argv, "pso_tuner");
   ros::NodeHandle nh, pnh("~");
   int code = 0;

@@ -1,9 +1,5 @@
 // run_scenario: the thesis closed loop in-process (no ROS), for quick comparisons and benchmarks.
-//   run_scenario [--tsmc] [--atsmc] [--disturbance] [--mismatch S] [--noise STD] [--duration T] [--rate HZ]
-//                [--switching NAME --width W] [--repeat N] [--yaml FILE (metrics of the last mode)]
-//                [--traction MU [--slip-stiffness K] [--rolling-resistance C]]
-//   run_scenario --field [--potential-only] [--no-approach] [--start X Y THETA] [--rate HZ]
-//                [--tsmc] [--traction MU [--wet] [--draft N]]
+// Usage and options: kUsage below (run_scenario --help).
 // Prints the Table 5.5/5.6 metrics as Markdown and the wall time per run. --field runs the thesis field
 // (config/field_thesis.yaml: a 100 m row at y = 3, obstacles r 0.3 at x = 20, 50, 80; ATSMC, disturbance,
 // 20 % mismatch, 110 s) measured on the body (the URDF's footprint) and prints clearance, contacts, peak
@@ -25,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "sowing_robot/cli/usage.h"
 #include "sowing_robot/core/common/validation.h"
 #include "sowing_robot/core/simulation/estimated_run.h"
 #include "sowing_robot/core/simulation/field_run.h"
@@ -33,6 +30,31 @@
 using namespace sowing_robot::core;
 
 namespace {
+const char* const kUsage =
+    "usage: run_scenario [--tsmc] [--atsmc] [--disturbance] [--mismatch S] [--noise STD] [--duration T] [--rate HZ]\n"
+    "                    [--switching NAME --width W] [--repeat N] [--yaml FILE]\n"
+    "                    [--traction MU [--slip-stiffness K] [--rolling-resistance C]]\n"
+    "       run_scenario --field [--potential-only] [--no-approach] [--start X Y THETA] [--rate HZ]\n"
+    "                    [--tsmc] [--traction MU [--wet] [--draft N]]\n"
+    "The thesis closed loop in-process (no ROS): the Table 5.5/5.6 metrics as Markdown and the wall time per run.\n\n"
+    "Options (line):\n"
+    "  --atsmc, --tsmc          the modes run, in order (default both)\n"
+    "  --disturbance            the sinusoidal wheel disturbance\n"
+    "  --mismatch S             plant mass and inertia x S\n"
+    "  --noise STD              Gaussian torque noise [N.m]\n"
+    "  --duration T, --rate HZ  run length [s] and control rate\n"
+    "  --switching NAME         switching function; --width W its boundary layer\n"
+    "  --repeat N               runs per mode (wall time per run)\n"
+    "  --yaml FILE              the metrics of the last mode as YAML\n"
+    "  --traction MU            the traction plant (peak friction MU, sliding 0.75 MU); --slip-stiffness K,\n"
+    "                           --rolling-resistance C\n"
+    "Options (--field: the thesis field, 100 m row, obstacles at x = 20, 50, 80, measured on the body):\n"
+    "  --potential-only         the thesis potential field without the planned detours\n"
+    "  --no-approach            the target starts at the row start\n"
+    "  --start X Y THETA        the robot's start (default -1 0 0)\n"
+    "  --traction MU            with --wet (the wet patch of config/field_thesis_wet.yaml), --draft N (tool draft)\n"
+    "  -h, --help               this text\n";
+
 /// The thesis field on the body; returns the exit code.
 int runThesisField(bool potential_only, bool approach, const Pose2D& start, std::int64_t period_ns,
                    const TractionParams& traction, bool wet, bool adaptive) {
@@ -114,6 +136,7 @@ int main(int argc, char** argv) {
   int repeat = 1;
   std::string yaml;
   TractionParams traction;  // enabled by --traction
+  sowing_robot::cli::exitOnHelp(argc, argv, kUsage);
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto value = [&](const char* what) {
@@ -171,8 +194,7 @@ int main(int argc, char** argv) {
         return 2;
       }
     } else {
-      std::fprintf(stderr, "run_scenario: unknown argument '%s'\n", a.c_str());
-      return 2;
+      return sowing_robot::cli::unknownOption("run_scenario", a);
     }
   }
   if (field) {

@@ -2,6 +2,13 @@
 #include "sowing_robot/ros/common/node_main.h"
 #include "sowing_robot/ros/seed_drill.h"
 
+namespace {
+const char* const kUsage =
+    SOWING_NODE_USAGE("seed_drill",
+                      "The seed drill: drops seeds at the tool point of the true pose while the tool is down on a row\n"
+                      "(`seeds`, `seed_report`).\n");
+}  // namespace
+
 int main(int argc, char** argv) {
-  return sowing_robot::runCallbackNode<sowing_robot::SeedDrillNode>(argc, argv, "seed_drill");
+  return sowing_robot::runCallbackNode<sowing_robot::SeedDrillNode>(argc, argv, "seed_drill", kUsage);
 }

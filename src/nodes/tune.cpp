@@ -31,6 +31,7 @@
 #include <vector>
 
 #include "sowing_robot/bench/tune_config.h"
+#include "sowing_robot/cli/usage.h"
 #include "sowing_robot/core/evaluation/checkpoint.h"
 #include "sowing_robot/core/evaluation/tuning.h"
 #include "sowing_robot/farm/farm.h"
@@ -41,8 +42,20 @@ using core::TuningCost;
 namespace {
 
 const char* const kUsage =
-    "usage: tune --config FILE [--output GAINS.yaml] [--checkpoint FILE [--resume]] [--progress FILE.csv] "
-    "[--threads N] [--stop-after K]";
+    "usage: tune --config FILE [--output GAINS.yaml] [--checkpoint FILE [--resume]] [--progress FILE.csv]\n"
+    "            [--threads N] [--stop-after K]\n"
+    "       mpirun -np N tune ...   (an MPI evaluation farm: the same gains, bit for bit, for any N)\n"
+    "The PSO gain tuner without a ROS master (config/tune.yaml: pso_tuner keys and the base scenario).\n\n"
+    "Options:\n"
+    "  --config FILE       the tuning set-up (required)\n"
+    "  --output FILE       the gains YAML (default: stdout)\n"
+    "  --checkpoint FILE   written after every iteration (temporary file, then rename)\n"
+    "  --resume            continue from --checkpoint\n"
+    "  --progress FILE     one CSV row per iteration\n"
+    "  --threads N         evaluation threads without MPI (0: all cores)\n"
+    "  --stop-after K      stop after iteration K (tests of resume)\n"
+    "  -h, --help          this text\n"
+    "Bad input gives one line and exit 2. docs/farm.md: the farm, checkpoints, failures.\n";
 
 std::string g(double v, const char* f = "%.6g") {
   char b[48];
@@ -70,10 +83,9 @@ std::string parseArgs(int argc, char** argv, Args& a) {
       a.resume = true;
       continue;
     }
-    if (k == "--help" || k == "-h") return kUsage;
     if (k != "--config" && k != "--output" && k != "--checkpoint" && k != "--progress" && k != "--threads" &&
         k != "--stop-after")
-      return "unknown argument '" + k + "' (" + kUsage + ")";
+      return "unknown option '" + k + "' (see tune --help)";
     if (i + 1 >= argc) return "missing value after " + k;
     const std::string v = argv[++i];
     if (k == "--config") a.config = v;
@@ -86,7 +98,7 @@ std::string parseArgs(int argc, char** argv, Args& a) {
       (k == "--threads" ? a.threads : a.stop_after) = n;
     }
   }
-  if (a.config.empty()) return std::string("--config FILE is required (") + kUsage + ")";
+  if (a.config.empty()) return "--config FILE is required (see tune --help)";
   if (a.resume && a.checkpoint.empty()) return "--resume needs --checkpoint FILE";
   return "";
 }
@@ -324,6 +336,7 @@ int run(farm::Farm& farm, int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  sowing_robot::cli::exitOnHelp(argc, argv, kUsage);  // before MPI: no rank, no farm for --help
   std::unique_ptr<farm::Farm> f;
   try {
     f = std::make_unique<farm::Farm>(&argc, &argv);

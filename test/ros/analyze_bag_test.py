@@ -370,7 +370,7 @@ class AnalyzeBag(unittest.TestCase):
         self.assertOneLineError([p, "--no-plots"], 3, "at least 2")
 
     def test_usage_errors(self):
-        self.assertOneLineError([], 2, "usage")
+        self.assertOneLineError([], 2, "see analyze_bag --help")
         self.assertOneLineError([self.exp_bag, "--labels", "a,b"], 2, "--labels")
         self.assertOneLineError([self.exp_bag, "--bogus"], 2, "--bogus")
 

@@ -1,7 +1,6 @@
 """Tracking performance of recorded sowing_robot runs (thesis Tables 5.5/5.6) and the thesis-style figures.
 
-  rosrun sowing_robot analyze_bag run.bag [more.bag ...] [--labels A,B] [--plots DIR] [--markdown FILE] [--csv DIR]
-                                  [--yaml FILE] [--until T] [--thesis]
+  rosrun sowing_robot analyze_bag run.bag [more.bag ...] [options]   (--help: the options, from cli.py)
 
 Reads bags recorded by `roslaunch sowing_robot sim.launch record:=true bag:=NAME`, prints one Markdown table
 (core::metricsTable) with one column per bag, a short per-bag summary, and writes PNG figures.

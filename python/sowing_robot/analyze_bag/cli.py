@@ -1,5 +1,4 @@
 """Command line of analyze_bag: arguments, the run, one-line errors and exit codes."""
-import argparse
 import math
 import os
 import sys
@@ -9,6 +8,7 @@ from sowing_robot.analyze_bag.csv_export import write_csv
 from sowing_robot.analyze_bag.metrics import metrics_table, thesis_runs, write_yaml
 from sowing_robot.analyze_bag.plots import write_plots
 from sowing_robot.analyze_bag.report import gaps, summary
+from sowing_robot.cli import Parser
 
 EXIT_OK, EXIT_INTERNAL, EXIT_USAGE, EXIT_BAD_BAG = 0, 1, 2, 3
 PROG = "analyze_bag"
@@ -18,13 +18,17 @@ class UsageError(Exception):
     pass
 
 
-class _Parser(argparse.ArgumentParser):
+class _Parser(Parser):
+    """An unknown option is refused by Parser (one line, exit 2); other usage errors become UsageError."""
+
     def error(self, message):
+        if message.startswith("unrecognized arguments: "):
+            super().error(message)
         raise UsageError(message)
 
 
 def parse_args(argv):
-    p = _Parser(prog=PROG, description="Tracking metrics (thesis Tables 5.5/5.6) and figures of sowing_robot bags.")
+    p = _Parser("Tracking metrics (thesis Tables 5.5/5.6) and figures of sowing_robot bags.", prog=PROG)
     p.add_argument("bags", nargs="+", metavar="BAG", help="bag files recorded by sim.launch record:=true")
     p.add_argument("--labels", help="comma-separated column labels, one per bag (default: controller mode)")
     p.add_argument("--plots", metavar="DIR", help="directory for the PNG figures (default: next to the first bag)")
@@ -135,8 +139,7 @@ def main(argv=None):
     try:
         return run(argv)
     except UsageError as e:
-        sys.stderr.write("%s: error: %s (usage: %s BAG [BAG ...] [--labels A,B] [--plots DIR] [--markdown FILE] "
-                         "[--csv DIR] [--thesis]; see --help)\n" % (PROG, e, PROG))
+        sys.stderr.write("%s: error: %s (see %s --help)\n" % (PROG, e, PROG))
         return EXIT_USAGE
     except BagError as e:
         sys.stderr.write("%s: error: %s\n" % (PROG, e))

@@ -10,6 +10,7 @@
 #include <mutex>
 #include <type_traits>
 
+#include "sowing_robot/cli/usage.h"
 #include "sowing_robot/ros/common/failure_log.h"
 #include "sowing_robot/ros/common/inline_callback_queue.h"
 #include "sowing_robot/ros/common/node_failure.h"
@@ -25,8 +26,10 @@ template <typename W>
 struct HasExitCode<W, std::void_t<decltype(std::declval<const W&>().exitCode())>> : std::true_type {};
 }  // namespace detail
 
+/// `usage`: what --help prints (cli/usage.h: before ros::init, so it needs no master).
 template <typename Wrapper>
-int runCallbackNode(int argc, char** argv, const char* name) {
+int runCallbackNode(int argc, char** argv, const char* name, const char* usage) {
+  cli::checkNodeArguments(argc, argv, name, usage);
   ros::init(argc, argv, name);
   InlineCallbackQueue queue;
   ros::NodeHandle nh, pnh("~");
