@@ -28,7 +28,6 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
-#include <type_traits>
 
 #include "sowing_robot/core/control/traction_control.h"
 #include "sowing_robot/core/model/traction.h"
