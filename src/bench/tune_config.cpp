@@ -10,6 +10,7 @@
 #include <set>
 #include <stdexcept>
 
+#include "sowing_robot/bench/yaml_reading.h"
 #include "sowing_robot/core/common/validation.h"
 #include "sowing_robot/core/control/controllers.h"
 #include "sowing_robot/core/model/plant.h"
@@ -18,91 +19,9 @@
 namespace sowing_robot {
 namespace bench {
 
+using namespace yaml_reading;
+
 namespace {
-
-[[noreturn]] void fail(const std::string& file, const std::string& what) {
-  throw std::invalid_argument(file + ": " + what);
-}
-
-void onlyKeys(const YAML::Node& map, const std::set<std::string>& known, const std::string& file,
-              const std::string& where) {
-  if (!map.IsMap()) fail(file, where + " must be a mapping");
-  for (const auto& kv : map) {
-    const std::string key = kv.first.as<std::string>();
-    if (known.count(key)) continue;
-    std::string list;
-    for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
-    fail(file, "unknown key '" + where + key + "' (known: " + list + ")");
-  }
-}
-
-double toDouble(const YAML::Node& n, const std::string& file, const std::string& key) {
-  if (!n.IsScalar()) fail(file, key + " must be a number");
-  const std::string t = n.Scalar();
-  char* end = nullptr;
-  const double v = std::strtod(t.c_str(), &end);
-  if (t.empty() || *end != '\0' || !std::isfinite(v)) fail(file, key + " = '" + t + "' is not a finite number");
-  return v;
-}
-
-/// A scalar as the parameter's type (that of `like`); `loose`: type unknown (bool, int, number or text).
-core::ParamValue toValue(const YAML::Node& n, const core::ParamValue* like, const std::string& file,
-                         const std::string& key) {
-  if (!n.IsScalar()) fail(file, key + " must be a single value");
-  const std::string t = n.Scalar();
-  const bool want_bool = like && std::holds_alternative<bool>(*like);
-  if (want_bool || !like) {
-    if (t == "true" || t == "True") return true;
-    if (t == "false" || t == "False") return false;
-    if (want_bool) fail(file, key + " = '" + t + "' is not a bool");
-  }
-  char* end = nullptr;
-  if (!like || std::holds_alternative<int>(*like)) {
-    const long v = std::strtol(t.c_str(), &end, 10);
-    if (!t.empty() && *end == '\0') return static_cast<int>(v);
-    if (like) fail(file, key + " = '" + t + "' is not an integer");
-  }
-  if (!like || std::holds_alternative<double>(*like)) {
-    const double v = std::strtod(t.c_str(), &end);
-    if (!t.empty() && *end == '\0') {
-      if (!std::isfinite(v)) fail(file, key + " = '" + t + "' is not a finite number");
-      return v;
-    }
-    if (like) fail(file, key + " = '" + t + "' is not a number");
-  }
-  return t;
-}
-
-void flatten(const YAML::Node& map, const std::string& prefix, std::vector<std::pair<std::string, YAML::Node>>& out) {
-  for (const auto& kv : map) {
-    const std::string key = prefix + kv.first.as<std::string>();
-    if (kv.second.IsMap())
-      flatten(kv.second, key + "/", out);
-    else
-      out.emplace_back(key, kv.second);
-  }
-}
-
-template <typename S>
-void applyGroup(const core::ParamTable<S>& table, const YAML::Node& group, S& s, const std::string& file,
-                const std::string& where, const std::set<std::string>& skip = {}) {
-  if (!group.IsMap()) fail(file, where + " must be a mapping");
-  std::vector<std::pair<std::string, YAML::Node>> keys;
-  flatten(group, "", keys);
-  for (const auto& kv : keys) {
-    if (skip.count(kv.first)) continue;
-    const auto* entry = table.find(kv.first);
-    if (!entry) {
-      std::string list;
-      for (const auto& e : table.entries()) list += (list.empty() ? "" : ", ") + e.info.key;
-      fail(file, "unknown key '" + where + kv.first + "' (known: " + list + ")");
-    }
-    const core::ParamValue v = toValue(kv.second, &entry->info.default_value, file, where + kv.first);
-    const std::string error = entry->info.check(v, where);
-    if (!error.empty()) fail(file, error);
-    entry->set(s, v);
-  }
-}
 
 std::string g(double v) {
   char b[32];
@@ -144,7 +63,7 @@ TuneConfig loadTuneConfig(const std::string& path) {
   if (!pt) fail(path, "missing key 'pso_tuner' (config/pso.yaml's keys)");
 
   core::PsoTunerSettings settings;
-  applyGroup(core::PsoTunerSettings::table(), pt, settings, path, "pso_tuner/", {"gains"});
+  applyGroup(core::PsoTunerSettings::table(), pt, settings, path, "pso_tuner", {"gains"});
   const std::string se = settings.validate();
   if (!se.empty()) fail(path, se);
   c.pso.particles = settings.particles;
@@ -184,7 +103,7 @@ TuneConfig loadTuneConfig(const std::string& path) {
       if (l["y"]) c.line_y = toDouble(l["y"], path, "scenario/line/y");
     }
     if (const YAML::Node p = sc["plant"])
-      applyGroup(core::disturbanceTable(), p, c.base.disturbance, path, "scenario/plant/");
+      applyGroup(core::disturbanceTable(), p, c.base.disturbance, path, "scenario/plant");
     if (const YAML::Node ctl = sc["controllers"]) {
       onlyKeys(ctl, {"kinematic_controller", "torque_controller"}, path, "scenario/controllers/");
       for (const auto& node : ctl) {
@@ -194,8 +113,7 @@ TuneConfig loadTuneConfig(const std::string& path) {
         flatten(node.second, "", keys);
         for (const auto& kv : keys) {
           const std::string e = core::setControllerParam(
-              c.base, name, kv.first,
-              toValue(kv.second, nullptr, path, "scenario/controllers/" + name + "/" + kv.first));
+              c.base, name, kv.first, toParamValue(kv.second, path, "scenario/controllers/" + name + "/" + kv.first));
           if (!e.empty()) fail(path, "scenario/controllers: " + e);
         }
       }
