@@ -17,6 +17,12 @@
 #include <string>
 #include <thread>
 
+#include "../common/test_files.h"
+
+using sowing_robot::test::exists;
+using sowing_robot::test::readFile;
+using sowing_robot::test::TempDir;
+
 namespace {
 const std::string kSource = SOWING_SOURCE_DIR;
 const std::string kTune = SOWING_TUNE_BIN;
@@ -24,25 +30,6 @@ const std::string kMpirun = SOWING_MPIEXEC;
 const std::string kSmall = kSource + "/test/farm/tune_small.yaml";
 const std::string kLong = kSource + "/test/farm/tune_kill.yaml";
 const std::string kBenchmark = SOWING_BENCHMARK_BIN;
-
-std::string readFile(const std::string& path) {
-  std::ifstream f(path);
-  return std::string(std::istreambuf_iterator<char>(f), {});
-}
-bool exists(const std::string& path) {
-  struct stat st;
-  return ::stat(path.c_str(), &st) == 0;
-}
-
-struct TempDir {
-  std::string path;
-  TempDir() {
-    char tmpl[] = "/tmp/tune_command_XXXXXX";
-    path = ::mkdtemp(tmpl);
-  }
-  ~TempDir() { std::system(("rm -rf " + path).c_str()); }
-  std::string operator/(const std::string& name) const { return path + "/" + name; }
-};
 
 struct Outcome {
   int status = -1;

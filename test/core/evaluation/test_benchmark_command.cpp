@@ -13,27 +13,15 @@
 #include <regex>
 #include <string>
 
+#include "../../common/test_files.h"
+
+using sowing_robot::test::exists;
+using sowing_robot::test::readFile;
+using sowing_robot::test::TempDir;
+
 namespace {
 const std::string kSource = SOWING_SOURCE_DIR;
 const std::string kBin = SOWING_BENCHMARK_BIN;
-
-std::string readFile(const std::string& path) {
-  std::ifstream f(path);
-  return std::string(std::istreambuf_iterator<char>(f), {});
-}
-bool exists(const std::string& path) {
-  struct stat st;
-  return ::stat(path.c_str(), &st) == 0;
-}
-
-struct TempDir {
-  std::string path;
-  TempDir() {
-    char tmpl[] = "/tmp/benchmark_command_XXXXXX";
-    path = ::mkdtemp(tmpl);
-  }
-  ~TempDir() { std::system(("rm -rf " + path).c_str()); }
-};
 
 struct Outcome {
   int status = -1;

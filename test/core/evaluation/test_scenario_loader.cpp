@@ -18,28 +18,14 @@ using namespace sowing_robot;
 using core::BenchScenario;
 using core::TrackKind;
 
+#include "../../common/test_files.h"
+
+using sowing_robot::test::readFile;
+using sowing_robot::test::TempDir;
+
 namespace {
 const std::string kSource = SOWING_SOURCE_DIR;
 const std::string kSuite = kSource + "/config/scenarios";
-
-std::string readFile(const std::string& path) {
-  std::ifstream f(path);
-  return std::string(std::istreambuf_iterator<char>(f), {});
-}
-
-/// A scratch directory removed by the test's end.
-struct TempDir {
-  std::string path;
-  TempDir() {
-    char tmpl[] = "/tmp/scenario_loader_XXXXXX";
-    path = ::mkdtemp(tmpl);
-  }
-  ~TempDir() { std::system(("rm -rf " + path).c_str()); }
-  std::string write(const std::string& name, const std::string& text) const {
-    std::ofstream(path + "/" + name) << text;
-    return path + "/" + name;
-  }
-};
 
 /// thesis_line.yaml with `from` replaced by `to` (once), written as DIR/thesis_line.yaml.
 std::string variant(const TempDir& dir, const std::string& from, const std::string& to) {
