@@ -10,6 +10,7 @@
 #include <set>
 #include <stdexcept>
 
+#include "sowing_robot/bench/scenario_loader.h"
 #include "sowing_robot/bench/yaml_reading.h"
 #include "sowing_robot/core/common/validation.h"
 #include "sowing_robot/core/control/controllers.h"
@@ -29,9 +30,71 @@ std::string g(double v) {
   return b;
 }
 
+std::string directoryOf(const std::string& path) {
+  const auto slash = path.rfind('/');
+  return slash == std::string::npos ? "." : path.substr(0, slash);
+}
+
+std::string relativeTo(const std::string& dir, const std::string& file) {
+  return file.empty() || file[0] == '/' ? file : dir + "/" + file;
+}
+
+/// The robust: block: the objective and the training set, each scenario driven by c.base's pair and gains.
+void loadRobust(const YAML::Node& r, const std::string& path, TuneConfig& c) {
+  if (!r.IsMap()) fail(path, "robust must be a mapping (aggregate, quantile, failure_penalty, profile, training)");
+  onlyKeys(r, {"aggregate", "quantile", "failure_penalty", "profile", "training"}, path, "robust/");
+  if (const YAML::Node a = r["aggregate"]) {
+    const std::string name = a.as<std::string>();
+    if (!core::parseAggregate(name, c.robust.aggregate))
+      fail(path, "robust/aggregate must be mean or quantile, not '" + name + "'");
+  }
+  if (r["quantile"]) c.robust.quantile = toDouble(r["quantile"], path, "robust/quantile");
+  if (r["failure_penalty"]) c.robust.failure_penalty = toDouble(r["failure_penalty"], path, "robust/failure_penalty");
+  const std::string oe = c.robust.validate();
+  if (!oe.empty()) fail(path, oe);
+  const std::string dir = directoryOf(path);
+  const std::string profile = r["profile"] ? relativeTo(dir, r["profile"].as<std::string>()) : "";
+  const YAML::Node t = r["training"];
+  if (!t || !t.IsSequence() || t.size() == 0)
+    fail(path, "robust/training must be a non-empty list of {scenario: FILE, runs: N, base_seed: S}");
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    const std::string at = "robust/training[" + std::to_string(i) + "]";
+    onlyKeys(t[i], {"scenario", "runs", "base_seed"}, path, at + "/");
+    for (const char* k : {"scenario", "runs", "base_seed"})
+      if (!t[i][k]) fail(path, at + " has no '" + k + "'");
+    const double runs = toDouble(t[i]["runs"], path, at + "/runs");
+    const double seed = toDouble(t[i]["base_seed"], path, at + "/base_seed");
+    if (!(runs >= 1 && runs <= 1e6 && runs == std::floor(runs))) fail(path, at + "/runs must be an integer >= 1");
+    if (!(seed >= 0 && seed < 9e15 && seed == std::floor(seed))) fail(path, at + "/base_seed must be an integer >= 0");
+    core::TrainingScenario ts;
+    try {
+      ts.bench =
+          core::withController(loadScenarioFile(relativeTo(dir, t[i]["scenario"].as<std::string>()), profile), c.base);
+    } catch (const std::exception& e) {
+      fail(path, at + ": " + e.what());
+    }
+    ts.bench.spec.base_seed = static_cast<std::uint64_t>(seed);
+    ts.runs = static_cast<std::int64_t>(runs);
+    const std::string e = core::firstError({ts.bench.validate(), core::validateGainBounds(ts.bench.base, c.gains)});
+    if (!e.empty()) fail(path, at + " (" + ts.bench.name + "): " + e);
+    c.training.push_back(std::move(ts));
+  }
+}
+
 }  // namespace
 
 std::string TuneConfig::scenarioText() const {
+  if (isRobust()) {
+    std::string s =
+        "robust: " +
+        std::string(robust.aggregate == core::RobustObjective::Aggregate::mean ? "mean"
+                                                                               : "quantile " + g(robust.quantile)) +
+        " of the run costs, failure penalty " + g(robust.failure_penalty) + ", " + base.controllerName() + "; training";
+    for (const auto& t : training)
+      s += " " + t.bench.name + " (runs 0-" + std::to_string(t.runs - 1) + ", base seed " +
+           std::to_string(t.bench.spec.base_seed) + ")";
+    return s;
+  }
   const core::PlantDisturbance& d = base.disturbance;
   std::string s = g(base.duration) + " s at " + g(1e9 / static_cast<double>(base.control_period_ns)) + " Hz, " +
                   base.controllerName() + ", start (" + g(base.start.x) + ", " + g(base.start.y) + ", " +
@@ -44,7 +107,7 @@ std::string TuneConfig::scenarioText() const {
   return s;
 }
 
-TuneConfig loadTuneConfig(const std::string& path) {
+TuneConfig loadTuneConfig(const std::string& path, const std::string& controller) {
   TuneConfig c;
   {
     std::ifstream f(path, std::ios::binary);
@@ -58,7 +121,7 @@ TuneConfig loadTuneConfig(const std::string& path) {
     fail(path, std::string("not valid YAML: ") + e.what());
   }
   if (!root.IsMap()) fail(path, "must be a mapping with pso_tuner: (and optionally scenario:)");
-  onlyKeys(root, {"pso_tuner", "scenario"}, path, "");
+  onlyKeys(root, {"pso_tuner", "scenario", "robust"}, path, "");
   const YAML::Node pt = root["pso_tuner"];
   if (!pt) fail(path, "missing key 'pso_tuner' (config/pso.yaml's keys)");
 
@@ -82,11 +145,17 @@ TuneConfig loadTuneConfig(const std::string& path) {
   c.base.duration = settings.duration;
   c.base.control_period_ns = static_cast<std::int64_t>(std::llround(1e9 / settings.control_rate));
   c.base.sliding.adaptive = settings.adaptive;
+  if (!controller.empty()) settings.controller = controller;
   if (!settings.controller.empty()) {
     const std::string e =
         core::parseControllerPair(settings.controller, c.base.outer, c.base.inner, c.base.sliding.adaptive);
-    if (!e.empty()) fail(path, "pso_tuner/controller: " + e);
+    if (!e.empty()) fail(path, (controller.empty() ? "pso_tuner/controller: " : "--controller: ") + e);
   }
+  const YAML::Node robust = root["robust"];
+  if (robust && root["scenario"])
+    for (const char* k : {"start", "line", "plant"})
+      if (root["scenario"][k])
+        fail(path, std::string("scenario/") + k + " is not used with robust: (the training scenarios have their own)");
 
   if (const YAML::Node sc = root["scenario"]) {
     onlyKeys(sc, {"start", "line", "plant", "controllers"}, path, "scenario/");
@@ -137,6 +206,7 @@ TuneConfig loadTuneConfig(const std::string& path) {
   const std::string e =
       core::firstError({c.base.validate(), core::validateGainBounds(c.base, c.gains), c.objective.validate()});
   if (!e.empty()) fail(path, e);
+  if (robust) loadRobust(robust, path, c);
   for (const auto& b : c.gains) {
     c.pso.lower.push_back(b.lower);
     c.pso.upper.push_back(b.upper);

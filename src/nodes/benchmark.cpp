@@ -253,14 +253,7 @@ int run(sowing_robot::farm::Farm& farm, int argc, char** argv) {
   std::vector<BenchScenario> batches;
   for (const BenchScenario& scenario : scenarios) {
     for (const Scenario& pair : pairs) {
-      BenchScenario b = scenario;  // the scenario's timing, start and plant, with the pair's controllers and gains
-      b.base.outer = pair.outer;
-      b.base.inner = pair.inner;
-      b.base.kanayama = pair.kanayama;
-      b.base.sliding = pair.sliding;
-      b.base.pure_pursuit = pair.pure_pursuit;
-      b.base.pid = pair.pid;
-      batches.push_back(b);
+      batches.push_back(withController(scenario, pair));
     }
   }
   // One run on any rank: {batch, seed} -> the packed row, by each batch's benchmarkWorker (made on first use).

@@ -4,14 +4,17 @@
 // one particle at a time; results go back by particle index, so the gains do not depend on the number of
 // ranks or threads, bit for bit).
 //
-//   tune --config FILE [--output GAINS.yaml] [--checkpoint FILE [--resume]] [--progress FILE.csv]
-//        [--threads N] [--stop-after K]
+//   tune --config FILE [--controller PAIR] [--output GAINS.yaml] [--checkpoint FILE [--resume]]
+//        [--progress FILE.csv] [--threads N] [--stop-after K]
 //   mpirun -np N tune --config FILE ...      (rosrun sowing_robot tune ... works the same)
 //
 // --config: config/tune.yaml's format (bench/tune_config.h: the pso_tuner block of config/pso.yaml plus the
-// base scenario). --output: the gains YAML (default pso_tuner/output, else tuned_gains.yaml); its lines that
-// can differ between two equal runs (date, wall time, ranks) start with "# run:". --checkpoint: the whole
-// search state after every iteration (core/evaluation/checkpoint.h: written to FILE.tmp, then renamed);
+// base scenario; with a robust: block, robust tuning over a training set of benchmark scenarios,
+// core/evaluation/robust_tuning.h, whose runs the farm hands out one by one). --controller: the pair tuned,
+// in place of the file's pso_tuner/controller (scripts/tune_pairs --robust). --output: the gains YAML (default
+// pso_tuner/output, else tuned_gains.yaml); its lines that can differ between two equal runs (date, wall time, ranks)
+// start with "# run:". --checkpoint: the whole search state after every iteration (core/evaluation/checkpoint.h:
+// written to FILE.tmp, then renamed);
 // --resume continues from it (a missing file starts from the beginning; a damaged one or one of another
 // setup is refused with one line); the result is that of an uninterrupted run. --progress: one CSV row per
 // iteration (rewritten from the checkpoint's iteration on --resume). --stop-after K: stop after iteration K
@@ -42,12 +45,14 @@ using core::TuningCost;
 namespace {
 
 const char* const kUsage =
-    "usage: tune --config FILE [--output GAINS.yaml] [--checkpoint FILE [--resume]] [--progress FILE.csv]\n"
-    "            [--threads N] [--stop-after K]\n"
+    "usage: tune --config FILE [--controller PAIR] [--output GAINS.yaml] [--checkpoint FILE [--resume]]\n"
+    "            [--progress FILE.csv] [--threads N] [--stop-after K]\n"
     "       mpirun -np N tune ...   (an MPI evaluation farm: the same gains, bit for bit, for any N)\n"
-    "The PSO gain tuner without a ROS master (config/tune.yaml: pso_tuner keys and the base scenario).\n\n"
+    "The PSO gain tuner without a ROS master (config/tune.yaml: pso_tuner keys and the base scenario;\n"
+    "config/tuned/field/training.yaml: robust tuning over a training set of benchmark scenarios).\n\n"
     "Options:\n"
     "  --config FILE       the tuning set-up (required)\n"
+    "  --controller PAIR   the pair tuned (outer+inner), in place of the file's pso_tuner/controller\n"
     "  --output FILE       the gains YAML (default: stdout)\n"
     "  --checkpoint FILE   written after every iteration (temporary file, then rename)\n"
     "  --resume            continue from --checkpoint\n"
@@ -70,7 +75,7 @@ bool parseInt(const std::string& s, long long& out) {
 }
 
 struct Args {
-  std::string config, output, checkpoint, progress;
+  std::string config, controller, output, checkpoint, progress;
   bool resume = false;
   long long threads = -1, stop_after = -1;
 };
@@ -83,12 +88,13 @@ std::string parseArgs(int argc, char** argv, Args& a) {
       a.resume = true;
       continue;
     }
-    if (k != "--config" && k != "--output" && k != "--checkpoint" && k != "--progress" && k != "--threads" &&
-        k != "--stop-after")
+    if (k != "--config" && k != "--controller" && k != "--output" && k != "--checkpoint" && k != "--progress" &&
+        k != "--threads" && k != "--stop-after")
       return "unknown option '" + k + "' (see tune --help)";
     if (i + 1 >= argc) return "missing value after " + k;
     const std::string v = argv[++i];
     if (k == "--config") a.config = v;
+    if (k == "--controller") a.controller = v;
     if (k == "--output") a.output = v;
     if (k == "--checkpoint") a.checkpoint = v;
     if (k == "--progress") a.progress = v;
@@ -103,11 +109,55 @@ std::string parseArgs(int argc, char** argv, Args& a) {
   return "";
 }
 
-/// The particle's evaluation on any rank: request {bound, x...} -> {total, bounded, simulated}.
-farm::Payload evaluate(const core::TuningProblem& problem, const farm::Payload& request) {
+/// One task on any rank. One run on one scenario: request {bound, x...} -> {total, bounded, simulated} (a
+/// particle's evaluation). Robust: request {k, x...} -> {cost of training run k} (one run of a particle's set).
+farm::Payload evaluate(const core::GainObjective& problem, const farm::Payload& request) {
   const std::vector<double> x(request.begin() + 1, request.end());
+  if (const auto* robust = dynamic_cast<const core::RobustTuningProblem*>(&problem))
+    return {robust->runCost(x, static_cast<std::int64_t>(request.front()))};
   const TuningCost c = problem.evaluate(x, 0, request.front());
   return {c.total, c.bounded ? 1.0 : 0.0, c.simulated};
+}
+
+/// The objective the config describes: one run on its base scenario, or its robust training set.
+std::unique_ptr<const core::GainObjective> makeObjective(const bench::TuneConfig& cfg,
+                                                         const core::ReferenceSource& reference, int threads) {
+  if (cfg.isRobust()) return std::make_unique<core::RobustTuningProblem>(cfg.training, cfg.gains, cfg.robust, threads);
+  return std::make_unique<core::TuningProblem>(cfg.base, reference, cfg.gains, cfg.objective, threads);
+}
+
+/// The MPI batch: a particle per task, or (robust) every run of every particle as its own task, so runs of
+/// unequal length spread over the ranks; results land by index, so the costs do not depend on the ranks.
+core::TuningBatch farmBatch(farm::Farm& farm, const core::GainObjective& problem) {
+  const auto* robust = dynamic_cast<const core::RobustTuningProblem*>(&problem);
+  return [&farm, &problem, robust](const std::vector<std::vector<double>>& x, const std::vector<double>& bounds,
+                                   std::vector<TuningCost>& out) {
+    const std::int64_t runs = robust ? robust->runCount() : 1;
+    std::vector<double> run_costs(x.size() * static_cast<std::size_t>(runs));
+    farm.run(
+        static_cast<int>(run_costs.size()),
+        [&](int task) {
+          const auto j = static_cast<std::size_t>(task / runs);
+          farm::Payload r{robust ? static_cast<double>(task % runs) : bounds[j]};
+          r.insert(r.end(), x[j].begin(), x[j].end());
+          return r;
+        },
+        [&problem](const farm::Payload& request) { return evaluate(problem, request); },
+        [&](int task, const farm::Payload& r) {
+          if (robust) {
+            run_costs[static_cast<std::size_t>(task)] = r.at(0);
+            return;
+          }
+          TuningCost& c = out[static_cast<std::size_t>(task)];
+          c.total = r.at(0);
+          c.bounded = r.at(1) != 0.0;
+          c.simulated = r.at(2);
+        });
+    if (robust)
+      for (std::size_t j = 0; j < x.size(); ++j)
+        out[j] = robust->combine(std::vector<double>(run_costs.begin() + static_cast<std::ptrdiff_t>(j * runs),
+                                                     run_costs.begin() + static_cast<std::ptrdiff_t>((j + 1) * runs)));
+  };
 }
 
 bool writeAtomically(const std::string& path, const std::string& text, std::string& error) {
@@ -153,7 +203,7 @@ int run(farm::Farm& farm, int argc, char** argv) {
   }
   bench::TuneConfig cfg;
   try {
-    cfg = bench::loadTuneConfig(args.config);
+    cfg = bench::loadTuneConfig(args.config, args.controller);
   } catch (const std::exception& e) {
     // Every rank reads the same file: rank 0 says what is wrong, the others leave quietly.
     if (farm.root()) std::fprintf(stderr, "tune: %s\n", e.what());
@@ -163,13 +213,13 @@ int run(farm::Farm& farm, int argc, char** argv) {
   const core::LineReference reference = cfg.reference();
 
   if (!farm.root()) {  // a worker rank: evaluate until rank 0 is done
-    const core::TuningProblem problem(cfg.base, reference, cfg.gains, cfg.objective, 1);
+    const std::unique_ptr<const core::GainObjective> problem = makeObjective(cfg, reference, 1);
     long evaluations = 0;
     const char* die = std::getenv("SOWING_FARM_TEST_DIE_AFTER");  // test hook: this rank dies mid-run
     const long die_after = die ? std::atol(die) : -1;
     return farm.serve([&](const farm::Payload& request) {
       if (die_after >= 0 && evaluations++ >= die_after) std::raise(SIGKILL);
-      return evaluate(problem, request);
+      return evaluate(*problem, request);
     })
                ? 0
                : 1;
@@ -179,7 +229,7 @@ int run(farm::Farm& farm, int argc, char** argv) {
   const int threads = farm.active() ? 1 : core::psoThreads(cfg.pso);
   std::unique_ptr<core::TuningSession> session;
   try {
-    session = std::make_unique<core::TuningSession>(cfg.base, reference, cfg.gains, cfg.objective, cfg.pso, threads);
+    session = std::make_unique<core::TuningSession>(makeObjective(cfg, reference, threads), cfg.pso);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "tune: %s: %s\n", args.config.c_str(), e.what());
     return 2;
@@ -228,29 +278,8 @@ int run(farm::Farm& farm, int argc, char** argv) {
                    .c_str(),
                cfg.scenarioText().c_str(), dims.c_str());
 
-  core::TuningBatch batch;
-  if (farm.active()) {
-    const core::TuningProblem& problem = session->problem();
-    batch = [&farm, &problem](const std::vector<std::vector<double>>& x, const std::vector<double>& bounds,
-                              std::vector<TuningCost>& out) {
-      farm.run(
-          static_cast<int>(x.size()),
-          [&](int j) {
-            farm::Payload r{bounds[static_cast<std::size_t>(j)]};
-            r.insert(r.end(), x[static_cast<std::size_t>(j)].begin(), x[static_cast<std::size_t>(j)].end());
-            return r;
-          },
-          [&problem](const farm::Payload& request) { return evaluate(problem, request); },
-          [&out](int j, const farm::Payload& r) {
-            TuningCost& c = out[static_cast<std::size_t>(j)];
-            c.total = r.at(0);
-            c.bounded = r.at(1) != 0.0;
-            c.simulated = r.at(2);
-          });
-    };
-  } else {
-    batch = core::threadedTuningBatch(session->problem(), session->params());
-  }
+  const core::TuningBatch batch = farm.active() ? farmBatch(farm, session->problem())
+                                                : core::threadedTuningBatch(session->problem(), session->params());
 
   const auto t0 = std::chrono::steady_clock::now();
   const int first = session->search().iteration();
@@ -300,9 +329,22 @@ int run(farm::Farm& farm, int argc, char** argv) {
   std::strftime(date, sizeof date, "%Y-%m-%d %H:%M:%S %z", std::localtime(&now));
   std::string h = "# Controller gains tuned offline by tune (PSO, thesis eqs 4.26-4.31, Table 5.4).\n";
   h += "# config: " + args.config + "\n# scenario: " + cfg.scenarioText() + "\n";
-  h += "# cost: " + std::string(core::costTypeName(cfg.objective.cost)) + " summed over x, y, theta";
-  if (cfg.objective.torque_weight > 0) h += " + " + g(cfg.objective.torque_weight) + " * effort";
-  if (cfg.objective.chattering_weight > 0) h += " + " + g(cfg.objective.chattering_weight) + " * chattering";
+  if (cfg.isRobust()) {
+    h += "# cost: per training run min(2 ITAE(x+y+theta)/T^2, penalty) + penalty if not a success "
+         "(core/evaluation/robust_tuning.h), " +
+         std::string(cfg.robust.aggregate == core::RobustObjective::Aggregate::mean
+                         ? "mean"
+                         : "quantile " + g(cfg.robust.quantile)) +
+         " over the runs, penalty " + g(cfg.robust.failure_penalty);
+    // What the benchmark's report reads to tell held-out scenarios and draws from trained ones.
+    for (const auto& t : cfg.training)
+      h += "\n# training: " + t.bench.name + " runs " + std::to_string(t.runs) + " base_seed " +
+           std::to_string(t.bench.spec.base_seed);
+  } else {
+    h += "# cost: " + std::string(core::costTypeName(cfg.objective.cost)) + " summed over x, y, theta";
+    if (cfg.objective.torque_weight > 0) h += " + " + g(cfg.objective.torque_weight) + " * effort";
+    if (cfg.objective.chattering_weight > 0) h += " + " + g(cfg.objective.chattering_weight) + " * chattering";
+  }
   h += "\n# best_cost: " + core::yamlFloat(r.pso.best_cost) + "\n";
   h += "# initial_best_cost: " + core::yamlFloat(r.initial_best_cost) + "\n";
   h += "# pso: particles " + std::to_string(cfg.pso.particles) + ", iterations " + std::to_string(cfg.pso.iterations) +

@@ -9,6 +9,16 @@
 //     line: {x0: 0.0, v_r: 1.0, y: 3.0}               # x_d = x0 + v_r t, y_d = y
 //     plant: {disturbance: {...}, noise: {...}, mismatch: {...}}   # plant_sim's keys (disturbanceTable)
 //     controllers: {kinematic_controller: {...}, torque_controller: {...}}   # gains not tuned
+//   robust:                                           # optional: robust tuning (robust_tuning.h)
+//     aggregate: mean                                 # mean | quantile
+//     quantile: 0.9                                   # for quantile, in (0, 1]
+//     failure_penalty: 1.0                            # per failed run, and the tracking term's cap [m]
+//     profile: ../profiles/field.yaml                 # applied on every training scenario ("" none)
+//     training:                                       # benchmark scenario files, relative to this file
+//       - {scenario: ../scenarios/training/wet_turns.yaml, runs: 4, base_seed: 1001}
+// With robust:, each evaluation is the mean (or quantile) over the training runs, each scenario with its own
+// duration, rate, start, plant and draws; pso_tuner's duration and control_rate and scenario/start, line,
+// plant are then not used (refused), scenario/controllers still sets the gains not tuned.
 //
 // Absent scenario keys keep the core's defaults (Scenario, LineReference). Errors: std::invalid_argument
 // with one line "FILE: what is wrong" (unknown key, wrong type, out of range, bad gain bounds).
@@ -19,6 +29,7 @@
 
 #include "sowing_robot/core/common/reference.h"
 #include "sowing_robot/core/evaluation/pso.h"
+#include "sowing_robot/core/evaluation/robust_tuning.h"
 #include "sowing_robot/core/evaluation/tuning.h"
 #include "sowing_robot/core/simulation/runner.h"
 
@@ -33,13 +44,18 @@ struct TuneConfig {
   core::PsoParams pso;  ///< lower/upper filled from gains
   std::string output;   ///< pso_tuner/output ("" if not given)
   std::string text;     ///< the file's bytes (part of the checkpoint fingerprint)
+  /// robust: given: the training set (each scenario with the pair and gains of `base`) and its objective.
+  std::vector<core::TrainingScenario> training;
+  core::RobustObjective robust;
+  bool isRobust() const { return !training.empty(); }
 
   core::LineReference reference() const { return core::LineReference(line_v_r, line_y, line_x0); }
   /// One line: duration, rate, pair, start, line, disturbance, mismatch, noise.
   std::string scenarioText() const;
 };
 
-TuneConfig loadTuneConfig(const std::string& path);
+/// `controller` (not ""): replaces pso_tuner/controller (tune --controller), before the gains are chosen.
+TuneConfig loadTuneConfig(const std::string& path, const std::string& controller = "");
 
 }  // namespace bench
 }  // namespace sowing_robot

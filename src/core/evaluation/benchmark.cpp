@@ -232,6 +232,16 @@ void checkBenchmark(const BenchScenario& bench, std::int64_t runs) {
   refuseBadDraws(bench.base, bench.spec, runs);
 }
 
+BenchScenario withController(BenchScenario bench, const Scenario& pair) {
+  bench.base.outer = pair.outer;
+  bench.base.inner = pair.inner;
+  bench.base.kanayama = pair.kanayama;
+  bench.base.sliding = pair.sliding;
+  bench.base.pure_pursuit = pair.pure_pursuit;
+  bench.base.pid = pair.pid;
+  return bench;
+}
+
 std::function<RunRow(std::int64_t)> benchmarkWorker(const BenchScenario& scenario) {
   auto bench = std::make_shared<const BenchScenario>(scenario);
   if (bench->realism)  // sensors, traction or an estimate in the loop (issue 16): estimated_bench.h

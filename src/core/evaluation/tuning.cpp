@@ -401,7 +401,7 @@ int psoThreads(const PsoParams& p) {
   return std::clamp(threads, 1, std::max(p.particles, 1));
 }
 
-TuningBatch threadedTuningBatch(const TuningProblem& problem, const PsoParams& params) {
+TuningBatch threadedTuningBatch(const GainObjective& problem, const PsoParams& params) {
   struct Batch {  // the batch being evaluated, set before each run
     const std::vector<std::vector<double>>* x = nullptr;
     const std::vector<double>* bounds = nullptr;
@@ -421,24 +421,34 @@ TuningBatch threadedTuningBatch(const TuningProblem& problem, const PsoParams& p
   };
 }
 
+namespace {
+/// The PSO parameters with the box of `gains` (std::invalid_argument, one line, if they do not validate).
+PsoParams withBox(PsoParams params, const std::vector<GainBounds>& gains) {
+  params.lower.clear();
+  params.upper.clear();
+  for (const auto& g : gains) {
+    params.lower.push_back(g.lower);
+    params.upper.push_back(g.upper);
+  }
+  const std::string e = params.validate();
+  if (!e.empty()) throw std::invalid_argument(e);
+  return params;
+}
+}  // namespace
+
 TuningSession::TuningSession(const Scenario& base, const ReferenceSource& reference,
                              const std::vector<GainBounds>& gains, const TuningObjective& objective, PsoParams params,
                              int problem_threads)
     : search_([&]() -> PsoParams {
         const std::string e = firstError({base.validate(), validateGainBounds(base, gains), objective.validate()});
         if (!e.empty()) throw std::invalid_argument(e);
-        params.lower.clear();
-        params.upper.clear();
-        for (const auto& g : gains) {
-          params.lower.push_back(g.lower);
-          params.upper.push_back(g.upper);
-        }
-        const std::string pe = params.validate();
-        if (!pe.empty()) throw std::invalid_argument(pe);
-        return params;
+        return withBox(params, gains);
       }()) {
   problem_ = std::make_unique<TuningProblem>(base, reference, gains, objective, problem_threads);
 }
+
+TuningSession::TuningSession(std::unique_ptr<const GainObjective> problem, PsoParams params)
+    : problem_(std::move(problem)), search_(withBox(std::move(params), problem_->gains())) {}
 
 int TuningSession::step(const TuningBatch& batch) {
   const int it = search_.iteration();

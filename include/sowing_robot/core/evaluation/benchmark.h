@@ -144,6 +144,10 @@ struct BenchScenario {
   std::string validate() const;
 };
 
+/// `bench` driven by the controller pair of `pair` (outer, inner, and the tables of every controller:
+/// Kanayama, sliding mode, pure pursuit, PID): the scenario's timing, start and plant with those gains.
+BenchScenario withController(BenchScenario bench, const Scenario& pair);
+
 /// The models a scenario may require and the benchmark runs: "wet_soil", "estimated_pose".
 const std::vector<std::string>& availableModels();
 

@@ -99,27 +99,45 @@ struct TuningCost {
   double simulated = 0.0;  ///< simulated time actually run [s]
 };
 
+/// What the tuner searches: gain vectors (in the order of gains()) and their score. Two kinds: one run on
+/// one scenario (TuningProblem, below) and a training set of runs (RobustTuningProblem, robust_tuning.h).
+/// evaluate() may be called from several threads at once as long as each uses its own thread_index <
+/// threads().
+class GainObjective {
+ public:
+  virtual ~GainObjective() = default;
+  virtual const std::vector<GainBounds>& gains() const = 0;
+  /// The controller settings the gains stand for (what gainsYaml writes) with the given gains applied.
+  virtual Scenario scenarioFor(const std::vector<double>& position) const = 0;
+  /// The cost (+inf if bad); with a finite `bound` the evaluation may stop once the cost has reached it
+  /// (total >= bound, `bounded` set: what psoMinimize's bounded fitness allows).
+  virtual TuningCost evaluate(const std::vector<double>& position, int thread_index,
+                              double bound = std::numeric_limits<double>::infinity()) const = 0;
+  /// How many thread indices evaluate() accepts (0..threads()-1).
+  virtual int threads() const = 0;
+};
+
 /// Scores gain vectors (in the order of `gains`) on a base scenario. evaluate() may be called from
 /// several threads at once as long as each uses its own thread_index < threads (as psoMinimize does):
 /// each index has its own clone of the reference. No allocation per control step.
-class TuningProblem {
+class TuningProblem : public GainObjective {
  public:
   TuningProblem(const Scenario& base, const ReferenceSource& reference, std::vector<GainBounds> gains,
                 const TuningObjective& objective, int threads);
 
   /// The base scenario with the given gains applied.
-  Scenario scenarioFor(const std::vector<double>& position) const;
+  Scenario scenarioFor(const std::vector<double>& position) const override;
   /// A diverged run or any non-finite term gives total = +inf. With a finite `bound` the run stops as
   /// soon as the cost so far (every term only grows with time) has reached it; total is then that
   /// partial cost, >= bound, and `bounded` is set (what psoMinimize's bounded fitness may do).
   TuningCost evaluate(const std::vector<double>& position, int thread_index,
-                      double bound = std::numeric_limits<double>::infinity()) const;
+                      double bound = std::numeric_limits<double>::infinity()) const override;
 
-  const std::vector<GainBounds>& gains() const { return gains_; }
+  const std::vector<GainBounds>& gains() const override { return gains_; }
   const Scenario& base() const { return base_; }
   const TuningObjective& objective() const { return objective_; }
   /// How many thread indices evaluate() accepts (0..threads()-1).
-  int threads() const { return static_cast<int>(references_.size()); }
+  int threads() const override { return static_cast<int>(references_.size()); }
 
  private:
   Scenario base_;
@@ -152,7 +170,7 @@ using TuningBatch = std::function<void(const std::vector<std::vector<double>>& p
                                        const std::vector<double>& bounds, std::vector<TuningCost>& out)>;
 /// The batch on psoThreads(params) threads, at most problem.threads() (the pool of psoThreadedBatch over
 /// problem.evaluate).
-TuningBatch threadedTuningBatch(const TuningProblem& problem, const PsoParams& params);
+TuningBatch threadedTuningBatch(const GainObjective& problem, const PsoParams& params);
 
 /// tuneGains in steps: the search of tuneGains (same problem, bounds, bound per particle) driven one
 /// iteration at a time by any TuningBatch, so it can be checkpointed (toText / restore) and resumed, or
@@ -163,8 +181,10 @@ class TuningSession {
   /// problem_threads: how many thread indices the problem's evaluate() accepts.
   TuningSession(const Scenario& base, const ReferenceSource& reference, const std::vector<GainBounds>& gains,
                 const TuningObjective& objective, PsoParams params, int problem_threads);
+  /// The same search over any objective (e.g. a RobustTuningProblem); params.lower/upper come from its gains.
+  TuningSession(std::unique_ptr<const GainObjective> problem, PsoParams params);
 
-  const TuningProblem& problem() const { return *problem_; }
+  const GainObjective& problem() const { return *problem_; }
   const PsoParams& params() const { return search_.params(); }
   const PsoSearch& search() const { return search_; }
   bool finished() const { return search_.finished(); }
@@ -182,7 +202,7 @@ class TuningSession {
   TuningResult result() const;
 
  private:
-  std::unique_ptr<TuningProblem> problem_;
+  std::unique_ptr<const GainObjective> problem_;
   PsoSearch search_;
   long cut_ = 0;
   std::int64_t simulated_ns_ = 0;
