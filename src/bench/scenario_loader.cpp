@@ -5,7 +5,9 @@
 #include <dirent.h>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <functional>
 #include <map>
 #include <optional>
@@ -422,6 +424,33 @@ void applyTunedGains(const std::string& path, core::Scenario& sc) {
 std::string tunedGainsFile(const std::string& dir, const core::Scenario& sc) {
   const std::string path = dir + "/" + sc.controllerName() + ".yaml";
   return fileExists(path) ? path : "";
+}
+
+std::vector<TrainingRecord> trainingOf(const std::string& gains_path) {
+  std::vector<TrainingRecord> out;
+  std::ifstream f(gains_path);
+  std::string line;
+  while (std::getline(f, line)) {
+    char name[256];
+    long long runs = 0;
+    unsigned long long seed = 0;
+    if (std::sscanf(line.c_str(), "# training: %255s runs %lld base_seed %llu", name, &runs, &seed) == 3)
+      out.push_back({name, runs, seed});
+  }
+  return out;
+}
+
+std::string heldOutVerdict(const std::vector<TrainingRecord>& training, const std::string& scenario,
+                           unsigned long long base_seed, long long runs) {
+  bool trained_on = false;
+  for (const TrainingRecord& t : training) {
+    if (t.scenario != scenario) continue;
+    trained_on = true;
+    // Run i's draws depend on (base seed, i) only: the same base seed repeats the training's first runs.
+    if (t.base_seed == base_seed)
+      return "TRAINED ON: runs 0-" + std::to_string(std::min(t.runs, runs) - 1) + " are training runs";
+  }
+  return trained_on ? "held-out draws (the scenario was trained on with another base seed)" : "held out";
 }
 
 }  // namespace bench

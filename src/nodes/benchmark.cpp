@@ -281,8 +281,21 @@ int run(sowing_robot::farm::Farm& farm, int argc, char** argv) {
       "# Controller benchmark\n\n" + std::to_string(seeds) +
       " seeded runs per scenario and controller, in-process (`benchmark`, core/evaluation/benchmark.h); every "
       "run can be repeated alone from its row of runs.csv.\n\nGains:\n\n";
-  for (std::size_t p = 0; p < pairs.size(); ++p)
+  std::string held_out;  // for gains from a robust tuning: which scenarios and draws it never saw
+  for (std::size_t p = 0; p < pairs.size(); ++p) {
     report += "- " + pairs[p].controllerName() + ": " + gains_source[p] + "\n";
+    const auto training = bench::trainingOf(gains_source[p]);
+    if (training.empty()) continue;
+    held_out += "- " + pairs[p].controllerName() + ", trained on";
+    for (const auto& t : training)
+      held_out += " " + t.scenario + " (runs 0-" + std::to_string(t.runs - 1) + ", base seed " +
+                  std::to_string(t.base_seed) + ")";
+    held_out += ":";
+    for (const auto& b : scenarios)
+      held_out += " " + b.name + " " + bench::heldOutVerdict(training, b.name, b.spec.base_seed, seeds) + ";";
+    held_out += "\n";
+  }
+  if (!held_out.empty()) report += "\nTraining and held-out data (robust-tuned gains):\n\n" + held_out;
   report += "\nScenarios:\n\n";
   for (const auto& b : scenarios) report += describe(b) + describeRealism(b);
   std::string summary = summaryHeader(), sections;

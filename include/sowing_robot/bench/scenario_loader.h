@@ -48,5 +48,20 @@ void applyTunedGains(const std::string& path, core::Scenario& sc);
 /// DIR/OUTER+INNER.yaml for the pair of sc if that file exists, else "".
 std::string tunedGainsFile(const std::string& dir, const core::Scenario& sc);
 
+/// One scenario a robust tuning trained on: runs 0..runs-1 of base seed base_seed.
+struct TrainingRecord {
+  std::string scenario;
+  long long runs = 0;
+  unsigned long long base_seed = 0;
+};
+/// The training set a gains file records (its "# training: NAME runs N base_seed S" header lines, written by
+/// tune with a robust: block); empty for gains tuned on one run (or a file that cannot be read).
+std::vector<TrainingRecord> trainingOf(const std::string& gains_path);
+/// What the benchmark's report says of a scenario run with gains trained on `training`, for runs 0..runs-1
+/// of base seed `base_seed`: "held out" (not trained on), "held-out draws" (trained on, other draws), or
+/// "TRAINED ON: runs 0-K are training runs".
+std::string heldOutVerdict(const std::vector<TrainingRecord>& training, const std::string& scenario,
+                           unsigned long long base_seed, long long runs);
+
 }  // namespace bench
 }  // namespace sowing_robot

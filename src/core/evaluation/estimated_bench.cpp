@@ -32,6 +32,9 @@ RunRow measureEstimated(const Scenario& sc, const EstimatedRunConfig& cfg, Refer
   meter.finish(er.run);
   row.realism = true;
   row.max_slip = er.max_abs_slip;
+  row.high_slip_share = er.run.periods > 0
+                            ? er.high_slip_time / (1e-9 * static_cast<double>(er.run.periods * sc.control_period_ns))
+                            : 0.0;
   row.tool_down_time = er.tool_down_time;
   row.fed_error_rms = er.fed_error_rms;
   row.fed_error_max = er.fed_error_max;
@@ -88,21 +91,23 @@ RunRow estimatedBenchRow(const BenchScenario& bench, std::int64_t index) {
 
 std::string estimatedCsvHeader() {
   return ",sensor_seed,max_slip,tool_down_time,fed_error_rms,fed_error_max,odometry_error_max,fixes_applied,"
-         "fixes_refused";
+         "fixes_refused,high_slip_share";
 }
 
 std::string estimatedCsvFields(const RunRow& r) {
-  if (!r.realism) return ",,nan,nan,nan,nan,nan,,";
+  if (!r.realism) return ",,nan,nan,nan,nan,nan,,,nan";
   return "," + std::to_string(r.draw.sensor_seed) + "," + csvNumber(r.max_slip) + "," + csvNumber(r.tool_down_time) +
          "," + csvNumber(r.fed_error_rms) + "," + csvNumber(r.fed_error_max) + "," + csvNumber(r.odometry_error_max) +
-         "," + std::to_string(r.fixes_applied) + "," + std::to_string(r.fixes_refused);
+         "," + std::to_string(r.fixes_applied) + "," + std::to_string(r.fixes_refused) + "," +
+         csvNumber(r.high_slip_share);
 }
 
 std::string estimatedReportLine(const std::vector<RunRow>& rows) {
-  std::vector<double> slip, rms, mx, odo;
+  std::vector<double> slip, high, rms, mx, odo;
   long applied = 0, refused = 0;
   for (const RunRow& r : rows) {
     slip.push_back(r.max_slip);
+    high.push_back(r.high_slip_share);
     rms.push_back(r.fed_error_rms);
     mx.push_back(r.fed_error_max);
     odo.push_back(r.odometry_error_max);
@@ -110,11 +115,13 @@ std::string estimatedReportLine(const std::vector<RunRow>& rows) {
     refused += r.fixes_refused;
   }
   const Statistic s = statistic(slip), e = statistic(rms), m = statistic(mx), o = statistic(odo);
+  const Statistic h = statistic(high);
   std::string out = "max |slip ratio| mean " + shortNumber(s.mean) + ", worst " + shortNumber(s.worst) +
-                    "; fed-pose error against the truth: RMS mean " + shortNumber(e.mean) + " m (p95 " +
-                    shortNumber(e.p95) + "), max mean " + shortNumber(m.mean) + " m (worst " + shortNumber(m.worst) +
-                    "); encoder odometry's largest error mean " + shortNumber(o.mean) + " m (worst " +
-                    shortNumber(o.worst) + ")";
+                    "; share of the run above twice the friction peak's slip mean " + shortNumber(h.mean) + ", worst " +
+                    shortNumber(h.worst) + "; fed-pose error against the truth: RMS mean " + shortNumber(e.mean) +
+                    " m (p95 " + shortNumber(e.p95) + "), max mean " + shortNumber(m.mean) + " m (worst " +
+                    shortNumber(m.worst) + "); encoder odometry's largest error mean " + shortNumber(o.mean) +
+                    " m (worst " + shortNumber(o.worst) + ")";
   if (applied + refused > 0)
     out += "; fixes applied " + std::to_string(applied) + ", refused " + std::to_string(refused);
   return out + "\n\n";

@@ -191,6 +191,7 @@ EstimatedRunResult run(const Scenario& sc, const EstimatedRunConfig& cfg, PlantT
                 ToolEngagement(cfg.seeding, cfg.tool_rows, cfg.tool_rows_open_ended)};
   LoopLayers layers;
   layers.tool = &tool;
+  if (cfg.traction) layers.high_slip = 2.0 * cfg.traction->slip_peak;
   std::optional<TractionControl> traction_control;
   if (cfg.traction_control.enabled) {
     traction_control.emplace(cfg.traction_control, sc.robot.L);

@@ -82,7 +82,9 @@ struct RunRow {
   std::vector<double> cross_track_series;
   /// A scenario with BenchScenario::realism (estimated_bench.h): the columns below are its (NaN otherwise).
   bool realism = false;
-  double max_slip = std::numeric_limits<double>::quiet_NaN();        ///< largest |slip ratio| (0 without traction)
+  double max_slip = std::numeric_limits<double>::quiet_NaN();  ///< largest |slip ratio| (0 without traction)
+  /// Share of the run either wheel's |slip ratio| was above twice the friction peak's (0 without traction).
+  double high_slip_share = std::numeric_limits<double>::quiet_NaN();
   double tool_down_time = std::numeric_limits<double>::quiet_NaN();  ///< time the draft acted [s]
   /// Position error of the pose fed to the controllers against the truth, RMS and max over the run [m].
   double fed_error_rms = std::numeric_limits<double>::quiet_NaN();

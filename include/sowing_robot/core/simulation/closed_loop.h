@@ -28,6 +28,7 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <limits>
 
 #include "sowing_robot/core/control/traction_control.h"
 #include "sowing_robot/core/model/traction.h"
@@ -124,6 +125,8 @@ struct LoopLayers {
   ToolRule* tool = nullptr;                     ///< the traction plant's tool rule
   TractionControl* traction_control = nullptr;  ///< between the inner loop and the motors
   GovernedReference* governor = nullptr;        ///< the reference the loop is given, governed
+  /// Traction plant: a period after which either wheel's |slip ratio| exceeds this counts to high_slip_time.
+  double high_slip = std::numeric_limits<double>::infinity();
 };
 
 /// Runs scenario `sc` (its timing, start, disturbance phase) on `plant` (constructed, not yet reset) with
@@ -187,8 +190,11 @@ EstimatedRunResult closedLoop(const Scenario& sc, PlantT& plant, Feed& feed, Out
     }
     if (k == n) break;
     plant.step(sent.right, sent.left, dt);
-    if constexpr (PlantT::kTraction)
-      out.max_abs_slip = std::max({out.max_abs_slip, std::fabs(plant.slip(RIGHT)), std::fabs(plant.slip(LEFT))});
+    if constexpr (PlantT::kTraction) {
+      const double slip = std::max(std::fabs(plant.slip(RIGHT)), std::fabs(plant.slip(LEFT)));
+      out.max_abs_slip = std::max(out.max_abs_slip, slip);
+      if (slip > layers.high_slip) out.high_slip_time += dt;
+    }
     feed.afterStep(k + 1, plant.state());
   }
   closeRun(result, plant.state(), metrics);

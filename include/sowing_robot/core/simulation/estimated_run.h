@@ -83,8 +83,10 @@ struct EstimatedSample {
 };
 
 struct EstimatedRunResult {
-  RunResult run;                ///< metrics on the truth
-  double max_abs_slip = 0.0;    ///< traction: largest |slip ratio| of either wheel after a step
+  RunResult run;              ///< metrics on the truth
+  double max_abs_slip = 0.0;  ///< traction: largest |slip ratio| of either wheel after a step
+  /// Traction: time either wheel's |slip ratio| was above twice the friction peak's (traction/slip_peak) [s].
+  double high_slip_time = 0.0;
   double tool_down_time = 0.0;  ///< traction with a draft: time the tool was down [s]
   /// Position error of the fed pose against the truth over the periods run [m] (0 for ground_truth).
   double fed_error_rms = 0.0, fed_error_max = 0.0;
