@@ -214,6 +214,28 @@ TEST(TuneCommand, BadInputGivesOneLine) {
   EXPECT_NE(o.err.find("checksum"), std::string::npos) << o.err;
 }
 
+// Robust tuning (issue 26 item 4) through the command: --controller picks the pair, the gains file records
+// its training set, and MPI ranks (each training run its own task) give the threaded gains bit for bit.
+TEST(TuneCommand, RobustTuningOnRanksGivesTheThreadedGainsAndRecordsItsTrainingSet) {
+  TempDir dir;
+  const std::string config = kSource + "/test/farm/tune_robust_small.yaml";
+  const std::string threaded = dir / "threads.yaml";
+  Outcome o = shell(dir, tune("--config " + config + " --controller kanayama+pid --threads 2 --output " + threaded));
+  ASSERT_EQ(o.status, 0) << o.err;
+  const std::string ref = gains(threaded);
+  EXPECT_NE(ref.find("# training: robust_line runs 3 base_seed 11\n"), std::string::npos) << ref;
+  EXPECT_NE(ref.find("kp:"), std::string::npos) << "--controller kanayama+pid tunes the PID, not the file's ATSMC";
+  const std::string ranks = dir / "np2.yaml";
+  o = shell(dir, mpi(2, "--config " + config + " --controller kanayama+pid --output " + ranks));
+  ASSERT_EQ(o.status, 0) << o.err;
+  EXPECT_EQ(ref, gains(ranks));
+  // A robust file that also sets the line scenario's keys is refused with one line.
+  std::ofstream(dir / "both.yaml") << readFile(config) << "scenario:\n  start: {x: 0.0}\n";
+  o = shell(dir, tune("--config " + (dir / "both.yaml")));
+  EXPECT_EQ(o.status, 2);
+  EXPECT_NE(o.err.find("not used with robust"), std::string::npos) << o.err;
+}
+
 // The benchmark's Monte-Carlo runs on the farm: the files are those of the threaded runner, byte for byte.
 TEST(BenchmarkCommand, MpiRanksWriteTheThreadedFilesByteForByte) {
   TempDir dir;
