@@ -8,11 +8,13 @@
 // BM_MonteCarlo1000Runs/threads:N  runMonteCarlo of 1,000 seeded runs of the thesis line, kanayama+atsmc,
 //                            every metric (mc_benchmark's work without the files), N threads; wall time
 // BM_ThesisRun25sTraction    same with the traction plant (TractionParams defaults), issue 16's cost case
+// BM_ThesisRun25sDriveTrain/layers:N  the traction run with the DC motors (1) and traction control too (2)
 // BM_ThesisRunPotentialField same with the potential-field reference (obstacles (20,3), (50,3), (80,3))
 // BM_PsoIteration/threads:N  one PSO iteration: 20 particles evaluated on the thesis scenario (ITAE,
 //                            default gain box), N evaluation threads; wall time (UseRealTime)
 #include <benchmark/benchmark.h>
 
+#include <optional>
 #include <vector>
 
 #include "sowing_robot/core/evaluation/benchmark.h"
@@ -147,6 +149,35 @@ void BM_ThesisRun25sTraction(benchmark::State& state) {
   state.counters["itae_y"] = benchmark::Counter(itae, benchmark::Counter::kDefaults);
 }
 BENCHMARK(BM_ThesisRun25sTraction)->Unit(benchmark::kMillisecond);
+
+// The drive train's cost (issue 26: motor model and traction control at most 20 % of a traction-plant run):
+// BM_ThesisRun25sTraction with the DC motors (arg 1), and with the traction control too (arg 2); arg 0 is
+// BM_ThesisRun25sTraction itself, so the ratios come from one program run.
+void BM_ThesisRun25sDriveTrain(benchmark::State& state) {
+  const Scenario sc = bench::thesisScenario();
+  LineReference ref = bench::thesisLine();
+  const TractionParams traction;
+  MotorParams motor;
+  motor.enabled = state.range(0) >= 1;
+  TractionControlParams tc_params;
+  tc_params.enabled = state.range(0) >= 2;
+  const std::function<void(const LoopSample&)> no_trace;
+  volatile double itae = 0.0;
+  for (auto _ : state) {
+    SlipPlant plant{TractionPlant(sc.robot, sc.disturbance, traction), sc.robot.R};
+    plant.plant.setMotor(motor);
+    StateFeed feed;
+    Kanayama outer(sc.kanayama);
+    SlidingModeController inner(sc.sliding, sc.robot);
+    std::optional<TractionControl> tc;
+    LoopLayers layers;
+    if (tc_params.enabled) layers.traction_control = &tc.emplace(tc_params, sc.robot.L);
+    itae = closedLoop(sc, plant, feed, outer, inner, ref, false, no_trace, RunStop{}, layers).run.metrics[AXIS_Y].itae;
+  }
+  state.SetItemsProcessed(state.iterations() * sc.steps());
+  state.counters["itae_y"] = benchmark::Counter(itae, benchmark::Counter::kDefaults);
+}
+BENCHMARK(BM_ThesisRun25sDriveTrain)->ArgName("layers")->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
 
 void BM_ThesisRunPotentialField(benchmark::State& state) {
   PotentialField ref = bench::thesisPotentialField();
