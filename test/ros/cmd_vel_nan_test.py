@@ -35,7 +35,9 @@ class CmdVelNaN(unittest.TestCase):
                             "run (inject_bad %s) wrote no trace:\n%s" % (inject, proc.stdout[-3000:]))
             with open(out) as f:
                 traces.append(f.read())
-        self.assertGreater(traces[0].count("\ntruth "), 7990, "a short run:\n" + logs[0][-3000:])
+        for trace, log in zip(traces, logs):
+            self.assertTrue(trace.startswith("truth 0.0 "), "not recorded from t = 0:\n" + log[-3000:])
+            self.assertEqual(trace.count("truth "), 8001, "not every state recorded:\n" + log[-3000:])
         self.assertEqual(traces[0], traces[1], "the bad twists changed the run")
         self.assertIn("cmd_vel_limiter: dropped a twist", logs[1])
         self.assertIn("is ignored; publish geometry_msgs/TwistStamped", logs[1])
