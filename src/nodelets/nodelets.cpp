@@ -18,6 +18,7 @@
 #include <mutex>
 #include <thread>
 
+#include "sowing_robot/ros/cmd_vel_limiter.h"
 #include "sowing_robot/ros/common/failure_log.h"
 #include "sowing_robot/ros/kinematic_controller.h"
 #include "sowing_robot/ros/plant_sim/plant_sim.h"
@@ -88,6 +89,7 @@ using ReferenceGeneratorNodelet = WrapperNodelet<ReferenceGenerator>;
 using RunMonitorNodelet = WrapperNodelet<RunMonitor>;
 using SeedDrillNodelet = WrapperNodelet<SeedDrillNode>;
 using StateEstimatorNodelet = WrapperNodelet<StateEstimator>;
+using CmdVelLimiterNodelet = WrapperNodelet<CmdVelLimiter>;
 
 /// The plant's run() on a thread of its own: in lockstep it only supervises (the torque callback steps);
 /// in realtime it paces the steps and serves the wheel_torque queue. A run that cannot go on (the state
@@ -131,3 +133,4 @@ PLUGINLIB_EXPORT_CLASS(sowing_robot::ReferenceGeneratorNodelet, nodelet::Nodelet
 PLUGINLIB_EXPORT_CLASS(sowing_robot::RunMonitorNodelet, nodelet::Nodelet)
 PLUGINLIB_EXPORT_CLASS(sowing_robot::SeedDrillNodelet, nodelet::Nodelet)
 PLUGINLIB_EXPORT_CLASS(sowing_robot::StateEstimatorNodelet, nodelet::Nodelet)
+PLUGINLIB_EXPORT_CLASS(sowing_robot::CmdVelLimiterNodelet, nodelet::Nodelet)

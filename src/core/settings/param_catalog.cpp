@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <sstream>
 
+#include "sowing_robot/core/control/cmd_vel_input.h"
 #include "sowing_robot/core/estimation/ekf.h"
 #include "sowing_robot/core/model/sensors.h"
 #include "sowing_robot/core/model/traction.h"
@@ -119,6 +120,12 @@ const std::vector<CatalogSection>& parameterCatalog() {
        "sliding-mode controller's, [pid] ones the PID's; max_torque (the motor's limit) is both's; the parameters "
        "of the controller not selected are checked but inert",
        infos(TorqueControllerSettings::table()),
+       {}},
+      {"cmd_vel_limiter",
+       "velocity mode (sim.launch input:=cmd_vel, config/cmd_vel.yaml, docs/interfaces.md): cmd_vel through the "
+       "limiter to the inner loop; v and omega each follow the time-optimal profile within their bounds on value, "
+       "acceleration and jerk (the same in reverse), and a command older than cmd_vel_timeout ramps them to zero",
+       infos(CmdVelParams::table()),
        {}},
       {"reference_generator",
        "the reference: the thesis line, or a field of rows through the potential field "
