@@ -182,10 +182,11 @@ const std::vector<std::string>& pendingModels() {
 void applyProfile(YAML::Node& root, const std::string& profile) {
   const YAML::Node prof = loadYaml(profile);
   onlyKeys(prof,
-           {"name", "description", "traction", "motor", "traction_control", "speed_governor", "sensors", "estimator",
-            "feedback"},
+           {"name", "description", "traction", "motor", "traction_control", "speed_governor", "hitch_control",
+            "sensors", "estimator", "feedback"},
            profile, "");
-  for (const char* block : {"traction", "motor", "traction_control", "speed_governor", "sensors", "estimator"}) {
+  for (const char* block :
+       {"traction", "motor", "traction_control", "speed_governor", "hitch_control", "sensors", "estimator"}) {
     const YAML::Node from = prof[block];
     if (!from) continue;
     if (!from.IsMap()) fail(profile, std::string(block) + " must be a mapping");
@@ -198,12 +199,29 @@ void applyProfile(YAML::Node& root, const std::string& profile) {
 core::BenchScenario loadScenarioFileImpl(const std::string& path, const std::string& profile) {
   YAML::Node root = loadYaml(path);
   if (!profile.empty()) applyProfile(root, profile);
-  onlyKeys(
-      root,
-      {"name",      "description", "track", "duration",         "control_rate",    "start",    "line",     "sine",
-       "field",     "plant",       "draws", "success",          "envelope_period", "requires", "traction", "sensors",
-       "estimator", "feedback",    "motor", "traction_control", "speed_governor"},
-      path, "");
+  onlyKeys(root, {"name",
+                  "description",
+                  "track",
+                  "duration",
+                  "control_rate",
+                  "start",
+                  "line",
+                  "sine",
+                  "field",
+                  "plant",
+                  "draws",
+                  "success",
+                  "envelope_period",
+                  "requires",
+                  "traction",
+                  "sensors",
+                  "estimator",
+                  "feedback",
+                  "motor",
+                  "traction_control",
+                  "speed_governor",
+                  "hitch_control"},
+           path, "");
   core::BenchScenario b;
   std::vector<PatchSpec> patch_specs;
   b.name = required(root, "name", path, "").as<std::string>();
@@ -300,8 +318,8 @@ core::BenchScenario loadScenarioFileImpl(const std::string& path, const std::str
   // The drive train's layers (motor:, traction_control:, speed_governor:) likewise, through their tables.
   const YAML::Node traction = root["traction"], sensors = root["sensors"], estimator = root["estimator"],
                    feedback = root["feedback"], motor = root["motor"], traction_control = root["traction_control"],
-                   speed_governor = root["speed_governor"];
-  if (traction || sensors || estimator || feedback || motor || traction_control || speed_governor) {
+                   speed_governor = root["speed_governor"], hitch_control = root["hitch_control"];
+  if (traction || sensors || estimator || feedback || motor || traction_control || speed_governor || hitch_control) {
     core::EstimatedRunConfig cfg;
     core::TractionParams t;
     if (traction) applyTableBlock(core::tractionTable(), traction, t, path, "traction");
@@ -321,6 +339,8 @@ core::BenchScenario loadScenarioFileImpl(const std::string& path, const std::str
       applyTableBlock(core::tractionControlTable(), traction_control, cfg.traction_control, path, "traction_control");
     if (speed_governor)
       applyTableBlock(core::speedGovernorTable(), speed_governor, cfg.speed_governor, path, "speed_governor");
+    if (hitch_control)
+      applyTableBlock(core::hitchControlTable(), hitch_control, cfg.hitch_control, path, "hitch_control");
     if (feedback) {
       if (!feedback.IsScalar()) fail(path, "feedback must be one of ground_truth, odometry, fused");
       const std::string e = core::parseFeedback(feedback.Scalar(), cfg.feedback);

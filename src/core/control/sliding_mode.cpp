@@ -125,9 +125,25 @@ void SlidingModeController::setParams(const SlidingModeParams& params) {
   }
 }
 
-inline void SlidingModeController::surface(Channel& c, double e, double xd_dot, double beta, double dt, double& s,
-                                           double& phi) const {
-  c.integral += e * dt;
+void SlidingModeController::heldBack(const WheelTorques& sent) {
+  // Per wheel: +1 held below the output, -1 held above, 0 sent as computed.
+  const auto held = [](double out, double got) { return got < out ? 1 : got > out ? -1 : 0; };
+  const int r = held(last_output_.torques.right, sent.right), l = held(last_output_.torques.left, sent.left);
+  // Which way each channel is blocked: v rises with both wheels, omega with the right and against the left.
+  const auto mark = [](bool up, bool down) { return up && down ? 2 : up ? 1 : down ? -1 : 0; };
+  linear_.held = mark(r > 0 || l > 0, r < 0 || l < 0);
+  angular_.held = mark(r > 0 || l < 0, r < 0 || l > 0);
+}
+
+inline bool SlidingModeController::heldAgainst(Channel& c, double e) {
+  const bool against = c.held == 2 || (c.held > 0 && e > 0.0) || (c.held < 0 && e < 0.0);
+  c.held = 0;
+  return against;
+}
+
+inline void SlidingModeController::surface(Channel& c, double e, double xd_dot, double beta, double dt, bool held,
+                                           double& s, double& phi) const {
+  if (!held) c.integral += e * dt;
   // S = e + beta (int e)^(p/q)  (eq 4.7).  The derivative term uses (int e)^(p/q - 1): for 1 < p/q < 2
   // its exponent (p-q)/q lies in (0, 1), so it is finite and equals 0 at int e = 0 (no division, no
   // singularity); only its own derivative would be unbounded there, and that never enters the law.
@@ -164,8 +180,9 @@ SlidingModeOutput SlidingModeController::update(const VelocityCommand& desired, 
   out.e_v = desired.v - v;  // e = X_d - X: the sign eq 4.9 onwards uses (eq 4.5 prints X - X_d)
   out.e_omega = desired.omega - omega;
   double phi_v, phi_w;
-  surface(linear_, out.e_v, desired.v_dot, params_.beta_v, dt, out.s_v, phi_v);
-  surface(angular_, out.e_omega, desired.omega_dot, params_.beta_omega, dt, out.s_omega, phi_w);
+  const bool held_v = heldAgainst(linear_, out.e_v), held_w = heldAgainst(angular_, out.e_omega);
+  surface(linear_, out.e_v, desired.v_dot, params_.beta_v, dt, held_v, out.s_v, phi_v);
+  surface(angular_, out.e_omega, desired.omega_dot, params_.beta_omega, dt, held_w, out.s_omega, phi_w);
 
   // eq 4.13 with gamma_hat = m0_hat R and alpha_hat = I0_hat R / L (eq 4.10).
   const double gamma_hat = m0_hat_ * R_, alpha_hat = i0_hat_ * R_ / L_;
@@ -177,8 +194,8 @@ SlidingModeOutput SlidingModeController::update(const VelocityCommand& desired, 
     // m0_hat' = +rate S1 phi1 (4.22 prints a minus). Euler step followed by the projection onto the
     // bounds, the discrete form of the discontinuous projection (Liu 2011).
     // rate_m_, rate_i_: params_.rate_m, rate_i themselves, or scaled for eq 4.22's gamma_hat, alpha_hat.
-    m0_hat_ = std::clamp(m0_hat_ + dt * rate_m_ * out.s_v * phi_v, params_.m0_min, params_.m0_max);
-    i0_hat_ = std::clamp(i0_hat_ + dt * rate_i_ * out.s_omega * phi_w, params_.i0_min, params_.i0_max);
+    if (!held_v) m0_hat_ = std::clamp(m0_hat_ + dt * rate_m_ * out.s_v * phi_v, params_.m0_min, params_.m0_max);
+    if (!held_w) i0_hat_ = std::clamp(i0_hat_ + dt * rate_i_ * out.s_omega * phi_w, params_.i0_min, params_.i0_max);
   }
 
   const double right = 0.5 * (out.u1 + out.u2), left = 0.5 * (out.u1 - out.u2);

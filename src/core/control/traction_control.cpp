@@ -26,6 +26,9 @@ const ParamTable<TractionControlParams>& tractionControlTable() {
              "the ceiling never falls below this"),
       number("traction_control/max_torque", &P::max_torque, 100.0, Limits::positive(), "N·m",
              "the ceiling's top and its value at the start"),
+      flag("traction_control/anti_windup", &P::anti_windup, false,
+           "tell the inner loop which torques were held back, so that its integrators (PID integral, sliding-mode "
+           "surface integral and adaptation) do not wind up against the ceiling"),
   });
   return table;
 }
@@ -51,7 +54,7 @@ TractionControl::TractionControl(const TractionControlParams& params, double L) 
 void TractionControl::reset() {
   ceiling_[0] = ceiling_[1] = params_.max_torque;
   slip_[0] = slip_[1] = sent_[0] = sent_[1] = 0.0;
-  slipping_ = false;
+  slipping_ = limiting_ = false;
 }
 
 double TractionControl::limitWheel(int wheel, double command, double wheel_speed, double ground_speed, double dt) {
@@ -67,12 +70,13 @@ double TractionControl::limitWheel(int wheel, double command, double wheel_speed
     ceiling = std::min(params_.max_torque, ceiling + params_.raise_rate * dt);
   }
   sent_[wheel] = std::clamp(command, -ceiling, ceiling);
+  if (sent_[wheel] != command) limiting_ = true;
   return sent_[wheel];
 }
 
 WheelTorques TractionControl::limit(const WheelTorques& command, const WheelGroundSpeeds& m, double dt) {
   if (!params_.enabled) return command;
-  slipping_ = false;
+  slipping_ = limiting_ = false;
   WheelTorques out;
   out.right = limitWheel(0, command.right, m.wheel_right, m.v + L_ * m.omega, dt);
   out.left = limitWheel(1, command.left, m.wheel_left, m.v - L_ * m.omega, dt);

@@ -56,16 +56,26 @@ double WheelPid::wheel(Wheel& s, double w_d, double w, double ff, double dt, dou
   if (params_.anti_windup) {
     const double limit = params_.max_torque;
     const double u_candidate = rest + params_.ki * integral;
-    // Conditional integration: do not integrate further into a saturated output.
-    if ((u_candidate > limit && e > 0.0) || (u_candidate < -limit && e < 0.0)) integral = s.integral;
+    // Conditional integration: do not integrate further into a saturated output, nor into one a layer
+    // after this controller held back (heldBack).
+    if ((u_candidate > limit && e > 0.0) || (u_candidate < -limit && e < 0.0) || (s.held > 0 && e > 0.0) ||
+        (s.held < 0 && e < 0.0))
+      integral = s.integral;
     // Clamping: the integral term alone never exceeds the motor limit.
     if (params_.ki > 0.0) integral = std::clamp(integral, -limit / params_.ki, limit / params_.ki);
   }
   s.integral = integral;
+  s.held = 0;
   s.last_w = w;
   s.has_last = true;
   i_term = params_.ki * integral;
   return rest + i_term;
+}
+
+void WheelPid::heldBack(const WheelTorques& sent) {
+  const auto held = [](double out, double got) { return got < out ? 1 : got > out ? -1 : 0; };
+  right_.held = held(last_output_.torques.right, sent.right);
+  left_.held = held(last_output_.torques.left, sent.left);
 }
 
 WheelPidOutput WheelPid::update(const VelocityCommand& desired, double v, double omega, double dt) {

@@ -300,7 +300,7 @@ T fromBits(double d) {
   return v;
 }
 
-constexpr double kRowMagic = 28.0;  ///< first entry of a packed row (its format's version)
+constexpr double kRowMagic = 30.0;  ///< first entry of a packed row (its format's version)
 
 }  // namespace
 
@@ -316,7 +316,7 @@ std::vector<double> packRow(const RunRow& r) {
             bits(static_cast<std::uint64_t>(r.contacts)), r.min_clearance, r.end_distance, r.diverged ? 1.0 : 0.0,
             r.success ? 1.0 : 0.0, r.realism ? 1.0 : 0.0, r.max_slip, r.tool_down_time, r.fed_error_rms,
             r.fed_error_max, r.odometry_error_max, bits(static_cast<std::int64_t>(r.fixes_applied)),
-            bits(static_cast<std::int64_t>(r.fixes_refused)), r.high_slip_share});
+            bits(static_cast<std::int64_t>(r.fixes_refused)), r.high_slip_share, r.unsown_distance, r.seeds_unsown});
   p.push_back(static_cast<double>(r.failure.size()));
   for (char c : r.failure) p.push_back(static_cast<double>(static_cast<unsigned char>(c)));
   p.push_back(static_cast<double>(r.cross_track_series.size()));
@@ -370,6 +370,8 @@ RunRow unpackRow(const std::vector<double>& p) {
   r.fixes_applied = static_cast<long>(fromBits<std::int64_t>(next()));
   r.fixes_refused = static_cast<long>(fromBits<std::int64_t>(next()));
   r.high_slip_share = next();
+  r.unsown_distance = next();
+  r.seeds_unsown = next();
   r.failure.resize(count());
   for (char& c : r.failure) c = static_cast<char>(static_cast<unsigned char>(next()));
   r.cross_track_series.resize(count());

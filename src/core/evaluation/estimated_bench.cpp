@@ -41,6 +41,8 @@ RunRow measureEstimated(const Scenario& sc, const EstimatedRunConfig& cfg, Refer
   row.odometry_error_max = er.odometry_error_max;
   row.fixes_applied = er.fixes.applied;
   row.fixes_refused = er.fixes.refused();
+  row.unsown_distance = er.unsown_distance;
+  row.seeds_unsown = er.unsown_distance / cfg.seeding.spacing;
   return row;
 }
 
@@ -91,15 +93,15 @@ RunRow estimatedBenchRow(const BenchScenario& bench, std::int64_t index) {
 
 std::string estimatedCsvHeader() {
   return ",sensor_seed,max_slip,tool_down_time,fed_error_rms,fed_error_max,odometry_error_max,fixes_applied,"
-         "fixes_refused,high_slip_share";
+         "fixes_refused,high_slip_share,unsown_distance,seeds_unsown";
 }
 
 std::string estimatedCsvFields(const RunRow& r) {
-  if (!r.realism) return ",,nan,nan,nan,nan,nan,,,nan";
+  if (!r.realism) return ",,nan,nan,nan,nan,nan,,,nan,nan,nan";
   return "," + std::to_string(r.draw.sensor_seed) + "," + csvNumber(r.max_slip) + "," + csvNumber(r.tool_down_time) +
          "," + csvNumber(r.fed_error_rms) + "," + csvNumber(r.fed_error_max) + "," + csvNumber(r.odometry_error_max) +
          "," + std::to_string(r.fixes_applied) + "," + std::to_string(r.fixes_refused) + "," +
-         csvNumber(r.high_slip_share);
+         csvNumber(r.high_slip_share) + "," + csvNumber(r.unsown_distance) + "," + csvNumber(r.seeds_unsown);
 }
 
 std::string estimatedReportLine(const std::vector<RunRow>& rows) {
@@ -124,6 +126,19 @@ std::string estimatedReportLine(const std::vector<RunRow>& rows) {
                     " m (worst " + shortNumber(o.worst) + ")";
   if (applied + refused > 0)
     out += "; fixes applied " + std::to_string(applied) + ", refused " + std::to_string(refused);
+  std::vector<double> unsown, seeds;
+  for (const RunRow& r : rows)
+    if (r.unsown_distance > 0.0) {
+      unsown.push_back(r.unsown_distance);
+      seeds.push_back(r.seeds_unsown);
+    }
+  if (!unsown.empty()) {  // the hitch control raised the tool on slip in these runs
+    const Statistic u = statistic(unsown), n = statistic(seeds);
+    out += "; tool raised on slip (hitch control) in " + std::to_string(unsown.size()) + " of " +
+           std::to_string(rows.size()) + " runs: row left unsown mean " + shortNumber(u.mean) + " m (worst " +
+           shortNumber(u.worst) + " m), seeds lost mean " + shortNumber(n.mean) + " (worst " + shortNumber(n.worst) +
+           ")";
+  }
   return out + "\n\n";
 }
 
@@ -156,7 +171,7 @@ std::string describeRealism(const BenchScenario& b) {
                                 shortNumber(c.motor.no_load_speed) + " rad/s)"
                           : "off") +
          ", traction control " + (c.traction_control.enabled ? "on" : "off") + ", speed governor " +
-         (c.speed_governor.enabled ? "on" : "off");
+         (c.speed_governor.enabled ? "on" : "off") + ", hitch control " + (c.hitch_control.enabled ? "on" : "off");
   out += "; feedback " + std::string(feedbackName(c.feedback)) +
          " (sensors: " + std::to_string(c.sensors.encoder.ticks_per_turn) + " ticks/turn, gyro noise " +
          shortNumber(c.sensors.imu.noise) + " rad/s bias " + shortNumber(c.sensors.imu.bias) + " rad/s, fix " +

@@ -17,6 +17,9 @@ const ParamTable<SpeedGovernorParams>& speedGovernorTable() {
              "fall of the rate while a wheel slips"),
       number("speed_governor/speed_up", &P::speed_up, 0.2, Limits::positive(), "1/s",
              "rise of the rate while the wheels grip"),
+      flag("speed_governor/on_grip_limit", &P::on_grip_limit, false,
+           "slow down also while the traction control holds a wheel's torque below the command (the wheels at "
+           "their grip limit); false: only while a wheel slips beyond the traction control's target"),
   });
   return table;
 }
@@ -36,10 +39,11 @@ GovernedReference::GovernedReference(std::unique_ptr<ReferenceSource> source, co
   owned_ = std::move(source);
 }
 
-void GovernedReference::report(bool slipping, double dt) {
+void GovernedReference::report(bool slipping, bool grip_limited, double dt) {
   if (!params_.enabled) return;
-  rate_ = slipping ? std::max(params_.min_rate, rate_ - params_.slow_down * dt)
-                   : std::min(1.0, rate_ + params_.speed_up * dt);
+  rate_ = slipping || (grip_limited && params_.on_grip_limit)
+              ? std::max(params_.min_rate, rate_ - params_.slow_down * dt)
+              : std::min(1.0, rate_ + params_.speed_up * dt);
 }
 
 std::unique_ptr<ReferenceSource> GovernedReference::clone() const {

@@ -32,11 +32,14 @@ std::string parseFeedback(const std::string& name, Feedback& out) {
 }
 
 std::string EstimatedRunConfig::validate() const {
-  std::string e = firstError({sensors.validate(), estimator.validate(), traction ? traction->validate() : "",
-                              motor.validate(), traction_control.validate(), speed_governor.validate()});
+  std::string e =
+      firstError({sensors.validate(), estimator.validate(), traction ? traction->validate() : "", motor.validate(),
+                  traction_control.validate(), speed_governor.validate(), hitch_control.validate()});
   if (!e.empty()) return e;
   if (speed_governor.enabled && !traction_control.enabled)
     return "speed_governor/enabled needs traction_control/enabled (the governor acts on its slip verdict)";
+  if (hitch_control.enabled && !traction_control.enabled)
+    return "hitch_control/enabled needs traction_control/enabled (the hitch acts on its grip verdict)";
   if (!allFinite(tool.x(), tool.y())) return "the tool point must be finite";
   for (std::size_t i = 0; i < patches.size(); ++i) {
     e = patches[i].validate("field/patches[" + std::to_string(i) + "]");
@@ -197,11 +200,21 @@ EstimatedRunResult run(const Scenario& sc, const EstimatedRunConfig& cfg, PlantT
     traction_control.emplace(cfg.traction_control, sc.robot.L);
     layers.traction_control = &*traction_control;
   }
-  if (!cfg.speed_governor.enabled)
-    return closedLoop(sc, plant, feed, *outer, *inner, reference, keep_samples, trace, RunStop{}, layers);
-  GovernedReference governed(reference, cfg.speed_governor);
-  layers.governor = &governed;
-  return closedLoop(sc, plant, feed, *outer, *inner, governed, keep_samples, trace, RunStop{}, layers);
+  std::optional<HitchControl> hitch;
+  if (cfg.hitch_control.enabled) {
+    hitch.emplace(cfg.hitch_control);
+    layers.hitch = &*hitch;
+  }
+  EstimatedRunResult out;
+  if (!cfg.speed_governor.enabled) {
+    out = closedLoop(sc, plant, feed, *outer, *inner, reference, keep_samples, trace, RunStop{}, layers);
+  } else {
+    GovernedReference governed(reference, cfg.speed_governor);
+    layers.governor = &governed;
+    out = closedLoop(sc, plant, feed, *outer, *inner, governed, keep_samples, trace, RunStop{}, layers);
+  }
+  if (hitch) out.hitch_raises = hitch->raises();
+  return out;
 }
 
 }  // namespace

@@ -281,6 +281,35 @@ TEST(WheelPid, AntiWindupStopsTheIntegratorRunningAwayAtSaturation) {
   }
 }
 
+// A layer after the PID (the traction control) holding its torque back is the PID's saturation too: the
+// integral does not grow in the held direction while the layer holds it (heldBack), and does again after.
+TEST(WheelPid, ATorqueHeldBackByALayerStopsTheIntegral) {
+  const RobotParams robot;
+  WheelPid pid(WheelPidParams{}, robot);
+  VelocityCommand far;
+  far.v = 1.0;  // the wheels stand: a steady positive error
+  WheelPidOutput out = pid.update(far, 0.0, 0.0, 1e-3);
+  const double first = out.i_right;
+  ASSERT_GT(first, 0.0);
+  for (int k = 0; k < 100; ++k) {
+    pid.heldBack({0.5 * out.torques.right, out.torques.left});  // right held below its output, left not
+    out = pid.update(far, 0.0, 0.0, 1e-3);
+  }
+  EXPECT_EQ(out.i_right, first);        // held: no integration upwards
+  EXPECT_GT(out.i_left, 50.0 * first);  // the left wheel integrated on
+  // An error the other way still integrates (it pulls out of the held torque).
+  pid.heldBack({0.5 * out.torques.right, out.torques.left});
+  VelocityCommand back;
+  back.v = -1.0;
+  out = pid.update(back, 0.0, 0.0, 1e-3);
+  EXPECT_LT(out.i_right, first);
+  // Not held any more: integrates again.
+  out = pid.update(far, 0.0, 0.0, 1e-3);
+  const double again = out.i_right;
+  out = pid.update(far, 0.0, 0.0, 1e-3);
+  EXPECT_GT(out.i_right, again);
+}
+
 TEST(WheelPid, FeedforwardIsTheNominalInertiaAndTheSpeedsComeFromRAndL) {
   const RobotParams robot;
   WheelPidParams p;

@@ -61,6 +61,33 @@ TEST(SlidingMode, FirstUpdateFollowsEquation413) {
   EXPECT_NEAR(o.torques.left, 0.5 * (o.u1 - o.u2), 1e-12);
 }
 
+// A layer after the controller (the traction control) holding a wheel's torque back: the channel whose
+// error pushes against it keeps its surface integral and its estimate (heldBack), so S repeats; the
+// channels are v (both wheels) and omega (right up, left down).
+TEST(SlidingMode, ATorqueHeldBackByALayerHoldsTheChannelsIntegralAndEstimate) {
+  SlidingModeController c(SlidingModeParams{}, RobotParams{});
+  const VelocityCommand d{1.0, 0.5, 0.0, 0.0};  // both errors positive (the robot stands)
+  const SlidingModeOutput first = c.update(d, 0.0, 0.0, 1e-3);
+  const double m0 = c.m0Hat(), i0 = c.i0Hat();
+  // The right wheel held below its output: v cannot rise, nor omega (right up): both hold.
+  c.heldBack({first.torques.right - 1.0, first.torques.left});
+  const SlidingModeOutput held = c.update(d, 0.0, 0.0, 1e-3);
+  EXPECT_EQ(held.s_v, first.s_v);
+  EXPECT_EQ(held.s_omega, first.s_omega);
+  EXPECT_EQ(c.m0Hat(), m0);
+  EXPECT_EQ(c.i0Hat(), i0);
+  // The left wheel held below its output: v holds, omega (which lowers the left wheel) integrates on.
+  c.heldBack({held.torques.right, held.torques.left - 1.0});
+  const SlidingModeOutput left = c.update(d, 0.0, 0.0, 1e-3);
+  EXPECT_EQ(left.s_v, first.s_v);
+  EXPECT_GT(left.s_omega, first.s_omega);
+  EXPECT_GT(c.i0Hat(), i0);
+  // Nothing held: both integrate.
+  const SlidingModeOutput free = c.update(d, 0.0, 0.0, 1e-3);
+  EXPECT_GT(free.s_v, first.s_v);
+  EXPECT_GT(c.m0Hat(), m0);
+}
+
 TEST(SlidingMode, TsmcKeepsItsNominalParameters) {
   SlidingModeParams p;
   p.adaptive = false;

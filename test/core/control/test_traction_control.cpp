@@ -60,6 +60,26 @@ TEST(TractionControl, ASlippingWheelIsCutAndRecovers) {
   EXPECT_EQ(tc.ceiling(0), p.max_torque);
 }
 
+// limiting(): the verdict the hitch control and the governor read -- a command cut to the ceiling, not a slip.
+TEST(TractionControl, LimitingSaysWhenACommandIsHeldBack) {
+  TractionControl tc(on(), kL);
+  const WheelGroundSpeeds spin{2.0, 1.0, 1.0, 0.0}, grip{1.0, 1.0, 1.0, 0.0};
+  tc.limit({5.0, 5.0}, grip, kDt);
+  EXPECT_FALSE(tc.limiting());
+  tc.limit({5.0, 5.0}, spin, kDt);  // cut at once: held back
+  EXPECT_TRUE(tc.limiting());
+  EXPECT_TRUE(tc.slipping());
+  // Gripping again, the ceiling (about 4.9 N·m) still holds a 5 N·m command back, not a 1 N·m one.
+  tc.limit({5.0, 5.0}, grip, kDt);
+  EXPECT_FALSE(tc.slipping());
+  EXPECT_TRUE(tc.limiting());
+  tc.limit({1.0, -1.0}, grip, kDt);
+  EXPECT_FALSE(tc.limiting());
+  TractionControl off(TractionControlParams{}, kL);
+  off.limit({500.0, 5.0}, spin, kDt);
+  EXPECT_FALSE(off.limiting());
+}
+
 TEST(TractionControl, BadParametersAreRefused) {
   TractionControlParams p = on();
   p.slip_target = 0.0;

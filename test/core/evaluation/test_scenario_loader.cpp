@@ -13,6 +13,7 @@
 #include <string>
 
 #include "sowing_robot/bench/scenario_loader.h"
+#include "sowing_robot/core/evaluation/bench_row.h"
 
 using namespace sowing_robot;
 using core::BenchScenario;
@@ -332,4 +333,43 @@ TEST(ScenarioLoader, AProfileGoesOnTopOfTheScenariosBlocks) {
   }
   const std::string stray = dir.write("stray.yaml", "name: stray\nduration: 3\n");
   EXPECT_THROW(bench::loadScenario("wet_soil", kSuite, stray), std::invalid_argument);
+}
+
+// The hitch control's block in a scenario or a profile, through its table; the field profile turns it on.
+TEST(ScenarioLoader, TheHitchControlBlockIsRead) {
+  const BenchScenario wet = bench::loadScenario("wet_soil", kSuite, kSource + "/config/profiles/field.yaml");
+  ASSERT_TRUE(wet.realism);
+  EXPECT_TRUE(wet.realism->hitch_control.enabled);
+  EXPECT_FALSE(bench::loadScenario("wet_soil", kSuite).realism->hitch_control.enabled);
+  TempDir dir;
+  const std::string prof = dir.write("p.yaml",
+                                     "name: p\ntraction_control: {enabled: true}\n"
+                                     "hitch_control: {enabled: true, lower_after: 7.5}\n");
+  const BenchScenario b = bench::loadScenario("wet_soil", kSuite, prof);
+  EXPECT_EQ(b.realism->hitch_control.lower_after, 7.5);
+  const std::string bad = dir.write("bad.yaml", "name: bad\nhitch_control: {lower_after: -1}\n");
+  try {
+    bench::loadScenario("wet_soil", kSuite, bad);
+    ADD_FAILURE() << "not refused";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("hitch_control/lower_after"), std::string::npos) << e.what();
+  }
+}
+
+// A speed governor that slows the path's own time: a robot at its slowed target, short of the path's
+// end when the run ends, has not finished (the finish check reads the reference's last time).
+TEST(ScenarioLoader, ARunWhoseGovernedTargetHasNotReachedTheEndIsNotFinished) {
+  TempDir dir;
+  BenchScenario b = shortField(dir, true);
+  const std::vector<core::RunRow> plain = core::runBenchmark(b, 1, 1);
+  ASSERT_TRUE(plain[0].success) << plain[0].failure;
+  core::FieldReference reference(b.field, b.obstacles);
+  core::RunRow row = plain[0];
+  reference.next(0.5 * reference.duration());  // the target half way along its path
+  core::markNotFinished(row, reference, 2.0 * reference.duration(), b.finish_tolerance);
+  EXPECT_EQ(row.failure, "not finished");
+  row = plain[0];
+  reference.next(reference.duration());
+  core::markNotFinished(row, reference, 2.0 * reference.duration(), b.finish_tolerance);
+  EXPECT_EQ(row.failure, "");
 }

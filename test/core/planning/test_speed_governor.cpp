@@ -51,6 +51,27 @@ TEST(SpeedGovernor, SlippingSlowsTheTargetAlongItsPath) {
   EXPECT_EQ(g.rate(), 1.0);
 }
 
+// The traction control's grip verdict (a torque held back without a slip beyond the target) slows the
+// target only with on_grip_limit.
+TEST(SpeedGovernor, TheGripVerdictSlowsOnlyWithOnGripLimit) {
+  for (bool on_limit : {false, true}) {
+    SpeedGovernorParams p;
+    p.enabled = true;
+    p.on_grip_limit = on_limit;
+    LineReference line(1.0, 3.0);
+    GovernedReference g(line, p);
+    g.reset();
+    for (int k = 0; k <= 100; ++k) {
+      g.next(0.01 * k);
+      g.report(false, true, 0.01);
+    }
+    if (on_limit)
+      EXPECT_LT(g.rate(), 1.0);
+    else
+      EXPECT_EQ(g.rate(), 1.0);
+  }
+}
+
 TEST(SpeedGovernor, BadParametersAreRefused) {
   SpeedGovernorParams p;
   p.min_rate = 0.0;

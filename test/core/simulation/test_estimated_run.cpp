@@ -348,3 +348,65 @@ TEST(EstimatedRun, TractionControlKeepsTheWheelsNearThePeak) {
   cfg.traction_control.enabled = false;
   EXPECT_THROW(runEstimatedLoop(sc, cfg, ref, false), std::invalid_argument);  // a governor needs the control
 }
+
+// Slip-limit hitch control in the loop (FIELD.md's grip budget): on a patch where the wheels' peak grip
+// cannot pull the tool's draft (mu 0.2 at mass 1.3: 38.7 N against 18.4 N of rolling resistance plus a 25 N
+// draft) the robot with the tool kept down stalls behind its target; with the hitch the traction control's
+// grip verdict raises the tool, the robot crosses, and the row it left unsown is counted. The hitch needs
+// the traction control.
+TEST(EstimatedRun, TheHitchControlLiftsTheToolThroughAPatchTheDraftCannotBePulledAcross) {
+  Scenario sc = line(OuterKind::kanayama, InnerKind::pid);
+  sc.duration = 14.0;
+  EstimatedRunConfig cfg;
+  TractionParams t;
+  t.draft_force = 25.0;
+  cfg.traction = t;
+  SoilPatch wet;
+  wet.polygon = {{4.0, 0.0}, {9.0, 0.0}, {9.0, 6.0}, {4.0, 6.0}};
+  wet.mu_peak = 0.2;
+  wet.mu_slide = 0.15;
+  wet.rolling_resistance = 0.08;
+  cfg.patches = {wet};
+  cfg.tool_rows = {RowSegment{Eigen::Vector2d(0.0, 3.0), Eigen::Vector2d(100.0, 3.0)}};
+  cfg.tool_rows_open_ended = true;
+  cfg.motor.enabled = true;
+  cfg.traction_control.enabled = true;
+  cfg.traction_control.raise_rate = 10.0;
+  LineReference ref;
+  const EstimatedRunResult down = runEstimatedLoop(sc, cfg, ref, false);
+  cfg.hitch_control.enabled = true;
+  const EstimatedRunResult hitch = runEstimatedLoop(sc, cfg, ref, false);
+  std::printf("end x: tool kept down %.2f m, hitch %.2f m (raised %d times, %.2f m unsown, tool down %.1f s)\n",
+              down.run.final_state[X], hitch.run.final_state[X], hitch.hitch_raises, hitch.unsown_distance,
+              hitch.tool_down_time);
+  EXPECT_LT(down.run.final_state[X], 9.0);  // stalled on the patch
+  EXPECT_EQ(down.unsown_distance, 0.0);
+  EXPECT_EQ(down.hitch_raises, 0);
+  EXPECT_GT(hitch.run.final_state[X], 13.0);  // crossed it and caught up with the target
+  EXPECT_GE(hitch.hitch_raises, 1);
+  EXPECT_GT(hitch.unsown_distance, 2.0);  // the patch's rows, at least in part
+  EXPECT_LT(hitch.unsown_distance, 14.0);
+  EXPECT_LT(hitch.tool_down_time, down.tool_down_time);
+  cfg.traction_control.enabled = false;
+  EXPECT_THROW(runEstimatedLoop(sc, cfg, ref, false), std::invalid_argument);
+}
+
+// The traction control's anti-windup reaches the inner loop: with it the run differs (the integrators
+// hold while a torque is held back), without it the run is the one of today's layers bit for bit.
+TEST(EstimatedRun, TheTractionControlsAntiWindupReachesTheInnerLoop) {
+  Scenario sc = line(OuterKind::kanayama, InnerKind::pid);
+  EstimatedRunConfig cfg;
+  TractionParams wet;
+  wet.mu_peak = 0.2;
+  wet.mu_slide = 0.15;
+  cfg.traction = wet;
+  cfg.motor.enabled = true;
+  cfg.traction_control.enabled = true;
+  LineReference ref;
+  const EstimatedRunResult plain = runEstimatedLoop(sc, cfg, ref, false);
+  const EstimatedRunResult again = runEstimatedLoop(sc, cfg, ref, false);
+  expectSameRun(plain.run, again.run);
+  cfg.traction_control.anti_windup = true;
+  const EstimatedRunResult held = runEstimatedLoop(sc, cfg, ref, false);
+  EXPECT_FALSE(sameBits(plain.run.final_state[X], held.run.final_state[X]));
+}

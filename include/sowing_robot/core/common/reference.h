@@ -17,6 +17,7 @@ class ReferenceSource {
   /// Back to the state at t = 0.
   void reset() {
     last_ = Reference{};
+    last_t_ = 0.0;
     rejected_ = 0;
     restart();
   }
@@ -31,8 +32,12 @@ class ReferenceSource {
       return last_;
     }
     last_ = evaluate(t);
+    last_t_ = t;
     return last_;
   }
+  /// The time of the last accepted next() since reset() [s] (0 before the first): where a wrapper that
+  /// runs the source at its own pace (the speed governor) has taken it.
+  double lastTime() const { return last_t_; }
   /// Number of calls to next() refused since reset() for a non-finite time.
   std::int64_t rejected() const { return rejected_; }
   /// An independent copy in its reset state (the PSO tuner gives each thread its own).
@@ -46,6 +51,7 @@ class ReferenceSource {
 
  private:
   Reference last_;
+  double last_t_ = 0.0;
   std::int64_t rejected_ = 0;
 };
 

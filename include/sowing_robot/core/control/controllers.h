@@ -53,6 +53,9 @@ class InnerController {
   /// The model estimates in use [kg], [kg·m^2] (adaptive: the current estimates; otherwise nominal).
   virtual double m0Hat() const = 0;
   virtual double i0Hat() const = 0;
+  /// The torques a layer after this controller sent for its last output (WheelPid::heldBack,
+  /// SlidingModeController::heldBack: anti-windup against the traction control).
+  virtual void heldBack(const WheelTorques& sent) = 0;
 };
 
 /// Kanayama or PurePursuit behind OuterController.
@@ -96,6 +99,7 @@ class InnerAdapter<SlidingModeController> final : public InnerController {
   void reset() override { c_.reset(); }
   double m0Hat() const override { return c_.m0Hat(); }
   double i0Hat() const override { return c_.i0Hat(); }
+  void heldBack(const WheelTorques& sent) override { c_.heldBack(sent); }
   SlidingModeController& controller() { return c_; }
 
  private:
@@ -112,6 +116,7 @@ class InnerAdapter<WheelPid> final : public InnerController {
   void reset() override { c_.reset(); }
   double m0Hat() const override { return c_.m0(); }
   double i0Hat() const override { return c_.i0(); }
+  void heldBack(const WheelTorques& sent) override { c_.heldBack(sent); }
   WheelPid& controller() { return c_; }
 
  private:

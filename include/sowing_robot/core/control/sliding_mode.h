@@ -75,13 +75,21 @@ class SlidingModeController {
   /// Change gains live (integrals and estimates are kept; estimates clamped into new bounds). Throws
   /// std::invalid_argument, keeping the old parameters, when params do not validate.
   void setParams(const SlidingModeParams& params);
+  /// What a layer between this controller and the motors (the traction control) sent for the last
+  /// output: a channel (v: u1 = tau_r + tau_l, omega: u2 = tau_r - tau_l) whose error pushes against a
+  /// wheel torque that was held back does not advance its sliding-surface integral or its adaptive
+  /// estimate in the next update (anti-windup; this controller has none at max_torque). Cleared by that update.
+  void heldBack(const WheelTorques& sent);
 
  private:
   struct Channel {
     double integral = 0.0;
+    int held = 0;  ///< +1: pushing this channel up was held back, -1: down, 2: both (heldBack), 0: neither
   };
-  /// S and phi = x_dot_d + beta (p/q) e (int e)^(p/q-1) for one channel; updates its integral.
-  void surface(Channel& c, double e, double xd_dot, double beta, double dt, double& s, double& phi) const;
+  /// Whether the channel's error e pushes against what a layer held back (and clears the mark).
+  static bool heldAgainst(Channel& c, double e);
+  /// S and phi = x_dot_d + beta (p/q) e (int e)^(p/q-1) for one channel; updates its integral (not while held).
+  void surface(Channel& c, double e, double xd_dot, double beta, double dt, bool held, double& s, double& phi) const;
 
   SlidingModeParams params_;
   double R_, L_;

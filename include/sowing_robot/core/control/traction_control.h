@@ -32,10 +32,13 @@ struct TractionControlParams {
   double raise_rate;   ///< [N·m/s] linear rise of the ceiling while it grips
   double min_torque;   ///< [N·m] the ceiling never falls below this (the wheel can always pull away)
   double max_torque;   ///< [N·m] the ceiling's top (and its value at reset)
+  /// Tell the inner loop which torques were held back, so that its integrators do not wind up against
+  /// the ceiling (InnerController::heldBack).
+  bool anti_windup;
 
   std::string validate() const;
 };
-/// traction_control/{enabled, slip_target, speed_floor, cut_rate, raise_rate, min_torque, max_torque}.
+/// traction_control/{enabled, slip_target, speed_floor, cut_rate, raise_rate, min_torque, max_torque, anti_windup}.
 const ParamTable<TractionControlParams>& tractionControlTable();
 
 /// What the layer measures in one period.
@@ -58,6 +61,11 @@ class TractionControl {
   double ceiling(int wheel) const { return ceiling_[wheel]; }
   /// Either wheel slipped beyond the target in the last period.
   bool slipping() const { return slipping_; }
+  /// Either wheel's command was cut to its ceiling in the last period: the inner loop asked for more
+  /// torque than the soil has carried (the wheel is held at the friction peak). This, not slipping(), is
+  /// the grip-limit verdict while the control works: it keeps the slip about the target, so slipping()
+  /// fires only in the short bursts that cut the ceiling.
+  bool limiting() const { return limiting_; }
   const TractionControlParams& params() const { return params_; }
 
  private:
@@ -66,7 +74,7 @@ class TractionControl {
   TractionControlParams params_;
   double L_;
   double ceiling_[2], slip_[2] = {0.0, 0.0}, sent_[2] = {0.0, 0.0};
-  bool slipping_ = false;
+  bool slipping_ = false, limiting_ = false;
 };
 
 }  // namespace core

@@ -64,6 +64,11 @@ class WheelPid {
   const WheelPidParams& params() const { return params_; }
   /// Change gains live (integrals kept). Throws std::invalid_argument, keeping the old parameters.
   void setParams(const WheelPidParams& params);
+  /// What a layer between this controller and the motors (the traction control) sent for the last
+  /// output: where it held a wheel's torque below (above) the output, the next update does not integrate
+  /// that wheel's error further upwards (downwards), as with its own max_torque (anti-windup on). Cleared
+  /// by that update.
+  void heldBack(const WheelTorques& sent);
   /// The feedforward's model parameters (what the loop reports as the "estimates").
   double m0() const { return m0_; }
   double i0() const { return i0_; }
@@ -73,6 +78,7 @@ class WheelPid {
     double integral = 0.0;  ///< int e dt [rad]
     double last_w = 0.0;    ///< measured speed of the previous accepted period
     bool has_last = false;
+    int held = 0;  ///< +1: a layer held the last output down, -1: up (heldBack), 0: not
   };
   /// One wheel's PID; returns the unclipped output and updates the wheel's memory.
   double wheel(Wheel& s, double w_d, double w, double ff, double dt, double& e, double& i_term) const;

@@ -107,11 +107,14 @@ class RowMeter {
 
 /// A field run's finish check: not finished when the plan stops short of a row end, the path had not
 /// ended, or the robot is not within `tolerance` of its end. A contact or a divergence is the reason
-/// given before this one; a cross-track failure comes after.
+/// given before this one; a cross-track failure comes after. The path's end is checked at the time the
+/// reference was last asked for (ReferenceSource::lastTime()), not the run's duration: a speed governor
+/// slows the path's own time, and a robot close to a slowed target that is still short of the path's
+/// end has not finished.
 inline void markNotFinished(RunRow& row, const FieldReference& reference, double duration, double tolerance) {
   if (!row.failure.empty() && row.failure != "cross-track") return;
   const bool stopped = reference.status().code != AvoidanceStatus::Code::kOk;
-  const bool ended = reference.finished(duration);
+  const bool ended = reference.finished(std::min(duration, reference.lastTime()));
   if (stopped || !ended || !(row.end_distance < tolerance)) {
     row.failure = "not finished";
     row.success = false;

@@ -91,6 +91,10 @@ struct RunRow {
   double fed_error_max = std::numeric_limits<double>::quiet_NaN();
   double odometry_error_max = std::numeric_limits<double>::quiet_NaN();  ///< the encoders' dead reckoning [m]
   long fixes_applied = 0, fixes_refused = 0;                             ///< feedback fused
+  /// Hitch control: row length the tool missed while raised on slip [m], and the seeds that would have
+  /// fallen there (that length over the seed drill's spacing). 0 without the hitch control.
+  double unsown_distance = std::numeric_limits<double>::quiet_NaN();
+  double seeds_unsown = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// What one worker thread of a benchmark did: how many runs, and the CPU time its thread used

@@ -23,10 +23,13 @@ struct SpeedGovernorParams {
   double min_rate;   ///< the slowest rate s of the target
   double slow_down;  ///< [1/s] fall of s while a wheel slips
   double speed_up;   ///< [1/s] rise of s while they grip
+  /// Slow down also while the traction control holds a wheel's torque below the command (its grip
+  /// verdict), not only while a wheel slips beyond its target.
+  bool on_grip_limit;
 
   std::string validate() const;
 };
-/// speed_governor/{enabled, min_rate, slow_down, speed_up}.
+/// speed_governor/{enabled, min_rate, slow_down, speed_up, on_grip_limit}.
 const ParamTable<SpeedGovernorParams>& speedGovernorTable();
 
 /// `source` at the governed time.
@@ -37,8 +40,10 @@ class GovernedReference : public ReferenceSource {
   GovernedReference(ReferenceSource& source, const SpeedGovernorParams& params);
   /// The same over a source of its own (clone()).
   GovernedReference(std::unique_ptr<ReferenceSource> source, const SpeedGovernorParams& params);
-  /// This period's verdict of the traction control, for the next reference.
-  void report(bool slipping, double dt);
+  /// This period's verdicts of the traction control, for the next reference: a wheel slipped beyond
+  /// its target; a wheel's command was cut to its ceiling (counted only with on_grip_limit).
+  void report(bool slipping, bool grip_limited, double dt);
+  void report(bool slipping, double dt) { report(slipping, false, dt); }
   double rate() const { return rate_; }
   /// The wrapped source's time [s].
   double governedTime() const { return tau_; }

@@ -30,6 +30,7 @@
 #include <functional>
 #include <limits>
 
+#include "sowing_robot/core/control/hitch_control.h"
 #include "sowing_robot/core/control/traction_control.h"
 #include "sowing_robot/core/model/traction.h"
 #include "sowing_robot/core/planning/speed_governor.h"
@@ -92,11 +93,23 @@ struct ToolRule {
   bool active;           ///< the traction plant with draft_force > 0
   Eigen::Vector2d tool;  ///< the tool point in base_link [m]
   ToolEngagement rule;
+  /// The tool point's speed over ground at state s [m/s] (rigid body: v - w yt along, w xt across).
+  double speed(const State& s) const { return std::hypot(s[V] - s[OMEGA] * tool.y(), s[OMEGA] * tool.x()); }
   /// Lowered (true) or lifted for the step from state s.
   bool update(const State& s) {
     const double sn = std::sin(s[THETA]), c = std::cos(s[THETA]);
     return rule.update({s[X] + c * tool.x() - sn * tool.y(), s[Y] + sn * tool.x() + c * tool.y()});
   }
+};
+
+/// The loop's optional layers (null: off).
+struct LoopLayers {
+  ToolRule* tool = nullptr;                     ///< the traction plant's tool rule
+  TractionControl* traction_control = nullptr;  ///< between the inner loop and the motors
+  GovernedReference* governor = nullptr;        ///< the reference the loop is given, governed
+  HitchControl* hitch = nullptr;                ///< raises the tool on the traction control's grip verdict
+  /// Traction plant: a period after which either wheel's |slip ratio| exceeds this counts to high_slip_time.
+  double high_slip = std::numeric_limits<double>::infinity();
 };
 
 namespace loop_detail {
@@ -109,25 +122,19 @@ bool wants(const std::function<void(const Sample&)>& trace) {
   return static_cast<bool>(trace);
 }
 inline void emit(const std::function<void(const LoopSample&)>& trace, const LoopSample& s, const Fed&, double, double,
-                 bool) {
+                 bool, const WheelTorques&, const LoopLayers&) {
   trace(s);
 }
 inline void emit(const std::function<void(const EstimatedSample&)>& trace, const LoopSample& s, const Fed& fed,
-                 double slip_r, double slip_l, bool tool_down) {
-  trace({&s, fed.pose, fed.v, fed.omega, slip_r, slip_l, tool_down});
+                 double slip_r, double slip_l, bool tool_down, const WheelTorques& sent, const LoopLayers& layers) {
+  trace({&s, fed.pose, fed.v, fed.omega, slip_r, slip_l, tool_down, sent, &layers});
 }
-inline void emit(RunTally& tally, const LoopSample& s, const Fed&, double, double, bool) { tally.add(s); }
+inline void emit(RunTally& tally, const LoopSample& s, const Fed&, double, double, bool, const WheelTorques&,
+                 const LoopLayers&) {
+  tally.add(s);
+}
 
 }  // namespace loop_detail
-
-/// The loop's optional layers (null: off).
-struct LoopLayers {
-  ToolRule* tool = nullptr;                     ///< the traction plant's tool rule
-  TractionControl* traction_control = nullptr;  ///< between the inner loop and the motors
-  GovernedReference* governor = nullptr;        ///< the reference the loop is given, governed
-  /// Traction plant: a period after which either wheel's |slip ratio| exceeds this counts to high_slip_time.
-  double high_slip = std::numeric_limits<double>::infinity();
-};
 
 /// Runs scenario `sc` (its timing, start, disturbance phase) on `plant` (constructed, not yet reset) with
 /// the given feedback, controllers and reference; see the file comment for the order of a period.
@@ -139,6 +146,7 @@ EstimatedRunResult closedLoop(const Scenario& sc, PlantT& plant, Feed& feed, Out
   reference.reset();
   feed.start(plant.state());
   if (layers.traction_control) layers.traction_control->reset();
+  if (layers.hitch) layers.hitch->reset();
   const std::int64_t n = sc.steps();
   const double dt = secondsFromNanos(sc.control_period_ns);
   MetricsAccumulator metrics(keep_samples);
@@ -165,9 +173,10 @@ EstimatedRunResult closedLoop(const Scenario& sc, PlantT& plant, Feed& feed, Out
     WheelTorques sent = u.torques;
     if (TractionControl* tc = layers.traction_control) {
       sent = tc->limit(u.torques, fed.speeds, dt);
+      if (tc->params().anti_windup) inner.heldBack(sent);
       if (tc->slipping()) out.traction_control_time += dt;
       if (layers.governor) {
-        layers.governor->report(tc->slipping(), dt);
+        layers.governor->report(tc->slipping(), tc->limiting(), dt);
         out.governor_min_rate = std::min(out.governor_min_rate, layers.governor->rate());
       }
     }
@@ -176,13 +185,21 @@ EstimatedRunResult closedLoop(const Scenario& sc, PlantT& plant, Feed& feed, Out
       ToolRule* tool = layers.tool;
       if (tool != nullptr && tool->active && k < n) {
         tool_down = tool->update(s);
+        if (HitchControl* hitch = layers.hitch) {
+          const bool raised = hitch->update(layers.traction_control->limiting(), std::fabs(fed.v) * dt, dt);
+          if (tool_down && raised) {
+            tool_down = false;
+            // Where the seed drill would sow (the reference's tool_down too), the row goes unsown.
+            if (ref.tool_down) out.unsown_distance += tool->speed(s) * dt;
+          }
+        }
         plant.setToolDown(tool_down);
         if (tool_down) out.tool_down_time += dt;
       }
     }
     if (loop_detail::wants(trace))
       loop_detail::emit(trace, {t, &s, &ref, &cmd, &u, inner.m0Hat(), inner.i0Hat(), ex, ey, eth}, fed,
-                        plant.slip(RIGHT), plant.slip(LEFT), tool_down);
+                        plant.slip(RIGHT), plant.slip(LEFT), tool_down, sent, layers);
     result.periods = k;
     if (stop && k % kStopCheckEvery == kStopCheckEvery - 1 && k < n && stop(metrics)) {
       result.stopped = true;

@@ -29,6 +29,7 @@
 #include <string>
 #include <vector>
 
+#include "sowing_robot/core/control/hitch_control.h"
 #include "sowing_robot/core/control/traction_control.h"
 #include "sowing_robot/core/estimation/ekf.h"
 #include "sowing_robot/core/model/motor.h"
@@ -67,10 +68,15 @@ struct EstimatedRunConfig {
   TractionControlParams traction_control;
   /// The target slowed along its path while a wheel slips (needs traction_control; off: planned timing).
   SpeedGovernorParams speed_governor;
+  /// The tool raised while the traction control holds the wheels at their grip limit (needs
+  /// traction_control; off: the seed drill's rule alone).
+  HitchControlParams hitch_control;
 
   /// "" or the first bad parameter as one line naming its key.
   std::string validate() const;
 };
+
+struct LoopLayers;  // closed_loop.h
 
 /// One period as the estimated loop sees it: the LoopSample on the truth (errors against the truth), and
 /// what the controllers were fed.
@@ -80,6 +86,9 @@ struct EstimatedSample {
   double fed_v, fed_omega;  ///< the twist they got
   double slip_right = 0.0, slip_left = 0.0;  ///< traction: the wheels' slip ratios at this state
   bool tool_down = false;                    ///< traction with a draft: the tool is down over the next step
+  WheelTorques sent;                         ///< the torques sent to the motors (after the layers) [N·m]
+  /// The loop's layers this period (their state after it: ceilings, slip estimates, the governor's rate).
+  const LoopLayers* layers = nullptr;
 };
 
 struct EstimatedRunResult {
@@ -98,6 +107,10 @@ struct EstimatedRunResult {
   long fixes_lost_from_queue = 0;
   double traction_control_time = 0.0;  ///< time a wheel slipped beyond the traction control's target [s]
   double governor_min_rate = 1.0;      ///< the slowest rate the speed governor gave the target
+  /// Hitch control: the tool point's travel while the seed drill's rule had the tool down but the hitch
+  /// held it up, i.e. the length of row left unsown [m]; and how often it raised the tool.
+  double unsown_distance = 0.0;
+  int hitch_raises = 0;
 };
 
 /// Runs the scenario (plant, timing, start, disturbance incl. its phase, the outer/inner pair of
