@@ -10,8 +10,9 @@
 //   2. the feedback source gives the pose (through the quaternion round trip of nav_msgs/Odometry) and
 //      twist the controllers get;
 //   3. the reference at t_k; the errors against the TRUE pose go into the metrics;
-//   4. outer controller -> velocity command, inner controller -> wheel torques; the traction control (if
-//      on) caps the torque of a slipping wheel, and tells the speed governor (if on) for the next period;
+//   4. outer controller -> velocity command, inner controller -> wheel torques; at a stop hold (the
+//      reference's stop: the inner loop frozen) the standstill hold brakes on the fed twist instead; the traction
+//      control (if on) caps the torque of a slipping wheel, and tells the speed governor (if on) for the next period;
 //   5. with the traction plant and a draft: the tool rule on the true tool point lowers or lifts the tool;
 //   6. the trace sees the period; the caller's stop() may end the run here (every kStopCheckEvery);
 //   7. the plant steps (k < n; its motors, if on, between the torques sent and the wheels), then the
@@ -29,6 +30,7 @@
 #include <cstdint>
 #include <functional>
 
+#include "sowing_robot/core/control/standstill_hold.h"
 #include "sowing_robot/core/control/traction_control.h"
 #include "sowing_robot/core/model/traction.h"
 #include "sowing_robot/core/planning/speed_governor.h"
@@ -142,6 +144,8 @@ EstimatedRunResult closedLoop(const Scenario& sc, PlantT& plant, Feed& feed, Out
   metrics.reserve(static_cast<std::size_t>(n + 1));
   EstimatedRunResult out;
   RunResult& result = out.run;
+  StandstillHold hold(sc.hold, sc.robot, sc.inner == InnerKind::pid ? sc.pid.max_torque : sc.sliding.max_torque);
+  bool holding = false;
 
   for (std::int64_t k = 0; k <= n; ++k) {
     const double t = secondsFromNanos(k * sc.control_period_ns);
@@ -157,7 +161,16 @@ EstimatedRunResult closedLoop(const Scenario& sc, PlantT& plant, Feed& feed, Out
     worldErrors(ref, truth, ex, ey, eth);
     metrics.add(t, ex, ey, eth);
     const VelocityCommand cmd = outer.compute(ref, fed.pose, fed.v, fed.omega);
-    const InnerOutput u = inner.update(cmd, fed.v, fed.omega, dt);
+    InnerOutput u = inner.update(cmd, fed.v, fed.omega, dt);
+    if (u.holding) {  // a stop: the inner loop is frozen, the brake holds the robot where it is
+      if (!holding) hold.engage();
+      const HoldTorques h = hold.update(fed.v, fed.omega, dt);
+      u.torques = h.torques;
+      u.u1 = h.u1;
+      u.u2 = h.u2;
+      u.saturated = h.saturated;
+    }
+    holding = u.holding;
     if (u.saturated) ++result.saturated_steps;
     WheelTorques sent = u.torques;
     if (TractionControl* tc = layers.traction_control) {
