@@ -32,10 +32,14 @@ struct TractionControlParams {
   double raise_rate;   ///< [N·m/s] linear rise of the ceiling while it grips
   double min_torque;   ///< [N·m] the ceiling never falls below this (the wheel can always pull away)
   double max_torque;   ///< [N·m] the ceiling's top (and its value at reset)
+  /// No traction (traction_monitor.h): the window [s] (0: never), the progress that restarts it [m], the
+  /// share of it the wheels must slip [-], and how long the robot is held after the verdict [s].
+  double no_traction_window, no_traction_progress, no_traction_slip_share, no_traction_hold;
 
   std::string validate() const;
 };
-/// traction_control/{enabled, slip_target, speed_floor, cut_rate, raise_rate, min_torque, max_torque}.
+/// traction_control/{enabled, slip_target, speed_floor, cut_rate, raise_rate, min_torque, max_torque,
+/// no_traction_window, no_traction_progress, no_traction_slip_share, no_traction_hold}.
 const ParamTable<TractionControlParams>& tractionControlTable();
 
 /// What the layer measures in one period.

@@ -14,6 +14,9 @@
 //      reference's stop: the inner loop frozen) the standstill hold brakes on the fed twist instead; the traction
 //      control (if on) caps the torque of a slipping wheel, and tells the speed governor (if on) for the next period;
 //   5. with the traction plant and a draft: the tool rule on the true tool point lowers or lifts the tool;
+//      With the traction control, its progress check (traction_monitor.h) may find the robot without
+//      traction: from the next period on the robot is held (a stop hold whatever the reference), and
+//      the run ends traction_control/no_traction_hold later;
 //   6. the trace sees the period; the caller's stop() may end the run here (every kStopCheckEvery);
 //   7. the plant steps (k < n; its motors, if on, between the torques sent and the wheels), then the
 //      sensors see the new state at t_{k+1}.
@@ -126,6 +129,7 @@ struct LoopLayers {
   ToolRule* tool = nullptr;                     ///< the traction plant's tool rule
   TractionControl* traction_control = nullptr;  ///< between the inner loop and the motors
   GovernedReference* governor = nullptr;        ///< the reference the loop is given, governed
+  TractionMonitor* monitor = nullptr;           ///< the traction control's progress check (needs it)
 };
 
 /// Runs scenario `sc` (its timing, start, disturbance phase) on `plant` (constructed, not yet reset) with
@@ -138,6 +142,8 @@ EstimatedRunResult closedLoop(const Scenario& sc, PlantT& plant, Feed& feed, Out
   reference.reset();
   feed.start(plant.state());
   if (layers.traction_control) layers.traction_control->reset();
+  if (layers.monitor) layers.monitor->reset();
+  double end_at = 0.0;  // no traction: the run ends here
   const std::int64_t n = sc.steps();
   const double dt = secondsFromNanos(sc.control_period_ns);
   MetricsAccumulator metrics(keep_samples);
@@ -160,7 +166,8 @@ EstimatedRunResult closedLoop(const Scenario& sc, PlantT& plant, Feed& feed, Out
     double ex, ey, eth;
     worldErrors(ref, truth, ex, ey, eth);
     metrics.add(t, ex, ey, eth);
-    const VelocityCommand cmd = outer.compute(ref, fed.pose, fed.v, fed.omega);
+    const bool no_traction = layers.monitor != nullptr && layers.monitor->detected();
+    const VelocityCommand cmd = no_traction ? holdCommand() : outer.compute(ref, fed.pose, fed.v, fed.omega);
     InnerOutput u = inner.update(cmd, fed.v, fed.omega, dt);
     if (u.holding) {  // a stop: the inner loop is frozen, the brake holds the robot where it is
       if (!holding) hold.engage();
@@ -180,6 +187,10 @@ EstimatedRunResult closedLoop(const Scenario& sc, PlantT& plant, Feed& feed, Out
         layers.governor->report(tc->slipping(), dt);
         out.governor_min_rate = std::min(out.governor_min_rate, layers.governor->rate());
       }
+      if (layers.monitor && !no_traction && layers.monitor->update(t, fed.pose, !cmd.hold, tc->slipping(), dt)) {
+        out.no_traction = layers.monitor->report();
+        end_at = t + tc->params().no_traction_hold;
+      }
     }
     bool tool_down = false;
     if constexpr (PlantT::kTraction) {
@@ -194,6 +205,7 @@ EstimatedRunResult closedLoop(const Scenario& sc, PlantT& plant, Feed& feed, Out
       loop_detail::emit(trace, {t, &s, &ref, &cmd, &u, inner.m0Hat(), inner.i0Hat(), ex, ey, eth}, fed,
                         plant.slip(RIGHT), plant.slip(LEFT), tool_down);
     result.periods = k;
+    if (no_traction && t >= end_at) break;  // held since the verdict: the run ends with its report
     if (stop && k % kStopCheckEvery == kStopCheckEvery - 1 && k < n && stop(metrics)) {
       result.stopped = true;
       break;

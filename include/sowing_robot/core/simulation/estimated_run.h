@@ -30,6 +30,7 @@
 #include <vector>
 
 #include "sowing_robot/core/control/traction_control.h"
+#include "sowing_robot/core/control/traction_monitor.h"
 #include "sowing_robot/core/estimation/ekf.h"
 #include "sowing_robot/core/model/motor.h"
 #include "sowing_robot/core/model/sensors.h"
@@ -96,6 +97,9 @@ struct EstimatedRunResult {
   long fixes_lost_from_queue = 0;
   double traction_control_time = 0.0;  ///< time a wheel slipped beyond the traction control's target [s]
   double governor_min_rate = 1.0;      ///< the slowest rate the speed governor gave the target
+  /// With the traction control: the robot found without traction (the run then ended
+  /// traction_control/no_traction_hold after the verdict, the robot held at rest).
+  NoTractionReport no_traction;
 };
 
 /// Runs the scenario (plant, timing, start, disturbance incl. its phase, the outer/inner pair of
