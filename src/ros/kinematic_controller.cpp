@@ -79,11 +79,12 @@ void KinematicController::stopIfStale(const nav_msgs::Odometry& odom) {
   if (lockstep_) return;
   const double age = (odom.header.stamp - (inputs_.any() ? inputs_.lastStamp() : ros::Time(0))).toSec();
   if (age <= input_timeout_) return;
-  // No reference (generator dead or restarting): ask the inner loop to stop the robot.
+  // No reference (generator dead or restarting): ask the inner loop to stop the robot and hold it.
   ROS_WARN_THROTTLE(1.0, "kinematic_controller: no reference for %.3f s (input_timeout %.3f s): commanding stop", age,
                     input_timeout_);
   desired_.header.stamp = odom.header.stamp;
   desired_.v = desired_.omega = desired_.v_dot = desired_.omega_dot = 0.0;
+  desired_.hold = true;
   publishShared(desired_pub_, desired_);
 }
 
@@ -105,12 +106,15 @@ void KinematicController::compute() {
   ref.omega = r.omega;
   ref.v_dot = r.v_dot;
   ref.omega_dot = r.omega_dot;
+  ref.tool_down = r.tool_down != 0;
+  ref.stop = r.stop != 0;
   const core::VelocityCommand cmd = outer_->compute(ref, pose, odom.twist.twist.linear.x, odom.twist.twist.angular.z);
   desired_.header.stamp = odom.header.stamp;
   desired_.v = cmd.v;
   desired_.omega = cmd.omega;
   desired_.v_dot = cmd.v_dot;
   desired_.omega_dot = cmd.omega_dot;
+  desired_.hold = cmd.hold;
   publishShared(desired_pub_, desired_);
 
   const core::PostureError pe = core::Kanayama::postureError(ref.pose, pose);

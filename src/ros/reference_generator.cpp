@@ -269,6 +269,7 @@ void ReferenceGenerator::fill(ReferenceState& out, const ros::Time& stamp) {
   out.v_dot = r.v_dot;
   out.omega_dot = r.omega_dot;
   out.tool_down = r.tool_down;
+  out.stop = r.stop;
 }
 
 void ReferenceGenerator::clockCallback(const rosgraph_msgs::Clock::ConstPtr& msg) {

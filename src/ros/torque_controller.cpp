@@ -31,6 +31,8 @@ TorqueController::TorqueController(ros::NodeHandle nh, ros::NodeHandle pnh) {
     smc_ = &smc->controller();
     inner_ = std::move(smc);
   }
+  // The brake at a stop (validated above), at the motor's limit.
+  hold_ = std::make_unique<core::StandstillHold>(settings.hold, robot, params.max_torque);
   logSettings("torque_controller", core::TorqueControllerSettings::table(), settings);
   ROS_INFO("torque_controller: inner controller %s; m0_hat starts at %.4f kg, I0_hat at %.5f kg m^2; %.0f Hz",
            settings.innerName().c_str(), inner_->m0Hat(), inner_->i0Hat(), 1.0 / dt_);
@@ -100,7 +102,7 @@ void TorqueController::desiredCallback(const DesiredVelocity::ConstPtr& msg) {
 void TorqueController::compute() {
   const nav_msgs::Odometry& odom = inputs_.first();
   const DesiredVelocity& d = inputs_.second();
-  const core::VelocityCommand cmd{d.v, d.omega, d.v_dot, d.omega_dot};
+  const core::VelocityCommand cmd{d.v, d.omega, d.v_dot, d.omega_dot, d.hold != 0};
   if (stale_) {  // input is back after a gap: restart the integrals (sliding mode: keep the estimates)
     if (smc_)
       smc_->resetSurfaces();
@@ -109,7 +111,17 @@ void TorqueController::compute() {
     stale_ = false;
     ROS_INFO("torque_controller: desired_velocity is back at t = %.3f s: resuming", odom.header.stamp.toSec());
   }
-  const core::InnerOutput out = inner_->update(cmd, odom.twist.twist.linear.x, odom.twist.twist.angular.z, dt_);
+  const double v = odom.twist.twist.linear.x, omega = odom.twist.twist.angular.z;
+  core::InnerOutput out = inner_->update(cmd, v, omega, dt_);
+  if (out.holding) {  // a stop: the inner loop is frozen, the brake holds the robot (closed_loop.h, step 4)
+    if (!holding_) hold_->engage();  // the robot is held where the hold began
+    const core::HoldTorques h = hold_->update(v, omega, dt_);
+    out.torques = h.torques;
+    out.u1 = h.u1;
+    out.u2 = h.u2;
+    out.saturated = h.saturated;
+  }
+  holding_ = out.holding;
   torque_.header.stamp = odom.header.stamp;
   torque_.right = out.torques.right;
   torque_.left = out.torques.left;
@@ -128,6 +140,7 @@ void TorqueController::compute() {
   state_.u1 = out.u1;
   state_.u2 = out.u2;
   state_.saturated = out.saturated;
+  state_.holding = out.holding;
   publishShared(state_pub_, state_);
 }
 

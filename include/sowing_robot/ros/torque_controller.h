@@ -21,6 +21,7 @@
 #include "sowing_robot/WheelTorque.h"
 #include "sowing_robot/core/control/controllers.h"
 #include "sowing_robot/core/control/sliding_mode.h"
+#include "sowing_robot/core/control/standstill_hold.h"
 #include "sowing_robot/ros/common/ready_roster.h"
 #include "sowing_robot/ros/common/stamp_pair.h"
 
@@ -40,6 +41,8 @@ class TorqueController {
   std::unique_ptr<core::InnerController> inner_;
   core::SlidingModeController* smc_ = nullptr;  // inner_'s sliding-mode controller (live gains), else null
   core::WheelPid* pid_ = nullptr;               // inner_'s PID, else null
+  std::unique_ptr<core::StandstillHold> hold_;  // the brake at a stop (desired_velocity's hold)
+  bool holding_ = false;                        // the last period was a hold
   double dt_ = 0.001;
   bool lockstep_;               // run/mode: wait for the paired desired velocity, never time out
   double input_timeout_ = 0.1;  // [s] sim

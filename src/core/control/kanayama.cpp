@@ -39,6 +39,7 @@ PostureError Kanayama::postureError(const Pose2D& r, const Pose2D& a) {
 }
 
 VelocityCommand Kanayama::compute(const Reference& ref, const Pose2D& actual, double v, double omega) const {
+  if (ref.stop) return holdCommand();
   if (!allFinite(ref.pose.x, ref.pose.y, ref.pose.theta, ref.v, ref.omega, ref.v_dot, ref.omega_dot, actual.x, actual.y,
                  actual.theta, v, omega))
     return VelocityCommand{};

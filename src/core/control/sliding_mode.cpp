@@ -177,6 +177,13 @@ SlidingModeOutput SlidingModeController::update(const VelocityCommand& desired, 
     out.rejected = true;
     return out;
   }
+  if (desired.hold) {  // a stop: frozen, the standstill hold brakes
+    out.e_v = -v;
+    out.e_omega = -omega;
+    out.holding = true;
+    last_output_ = out;
+    return out;
+  }
   out.e_v = desired.v - v;  // e = X_d - X: the sign eq 4.9 onwards uses (eq 4.5 prints X - X_d)
   out.e_omega = desired.omega - omega;
   double phi_v, phi_w;
@@ -214,6 +221,7 @@ SlidingModeOutput SlidingModeController::update(const VelocityCommand& desired, 
   last_output_.u2 = out.u2;
   last_output_.saturated = saturated;
   last_output_.rejected = false;
+  last_output_.holding = false;
   return out;
 }
 

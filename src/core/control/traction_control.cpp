@@ -29,6 +29,15 @@ const ParamTable<TractionControlParams>& tractionControlTable() {
       flag("traction_control/anti_windup", &P::anti_windup, false,
            "tell the inner loop which torques were held back, so that its integrators (PID integral, sliding-mode "
            "surface integral and adaptation) do not wind up against the ceiling"),
+      number("traction_control/no_traction_window", &P::no_traction_window, 5.0, Limits::nonNegative(), "s",
+             "no traction: this long without no_traction_progress of ground progress, the wheels slipping for "
+             "no_traction_slip_share of it, and the robot is stopped and the run ends (0 = never)"),
+      number("traction_control/no_traction_progress", &P::no_traction_progress, 0.25, Limits::positive(), "m",
+             "no traction: the ground progress (fed pose) that restarts the window"),
+      number("traction_control/no_traction_slip_share", &P::no_traction_slip_share, 0.5, Limits::above(0.0, 1.0), "",
+             "no traction: the share of the window the wheels must have slipped"),
+      number("traction_control/no_traction_hold", &P::no_traction_hold, 3.0, Limits::nonNegative(), "s",
+             "no traction: the robot is held at rest this long after the verdict, then the run ends"),
   });
   return table;
 }

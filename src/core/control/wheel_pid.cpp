@@ -84,6 +84,19 @@ WheelPidOutput WheelPid::update(const VelocityCommand& desired, double v, double
     held.rejected = true;
     return held;
   }
+  if (desired.hold) {  // a stop: integrals frozen, the standstill hold brakes
+    WheelPidOutput out;
+    out.e_right = -(v + L_ * omega) / R_;
+    out.e_left = -(v - L_ * omega) / R_;
+    out.i_right = params_.ki * right_.integral;
+    out.i_left = params_.ki * left_.integral;
+    out.holding = true;
+    right_.last_w = -out.e_right;
+    left_.last_w = -out.e_left;
+    right_.has_last = left_.has_last = true;
+    last_output_ = out;
+    return out;
+  }
   const double sum = params_.feedforward * m0_ * R_ * desired.v_dot;            // tau_r + tau_l
   const double diff = params_.feedforward * i0_ * R_ / L_ * desired.omega_dot;  // tau_r - tau_l
   WheelPidOutput out;

@@ -497,7 +497,12 @@ std::string runsCsvLines(const std::string& scenario, const std::string& control
 }
 
 namespace {
-const char* const kFailureReasons[] = {"diverged", "contact", "not finished", "cross-track"};
+const char* const kFailureReasons[] = {"diverged", "contact", "not finished", "cross-track", "no traction"};
+/// The reasons always listed in a report section; "no traction" (the traction control's) only when a row has it.
+constexpr std::size_t kListedReasons = 4;
+
+/// Whether row r failed for `reason` (a failure text starts with its reason: "no traction at (x y): ...").
+bool failedFor(const RunRow& r, const char* reason) { return r.failure.rfind(reason, 0) == 0; }
 
 double successRate(const std::vector<RunRow>& rows) {
   std::int64_t ok = 0;
@@ -520,9 +525,11 @@ std::string reportSection(const std::string& scenario, const std::string& contro
   out += "runs " + std::to_string(rows.size()) + ", success " + std::to_string(ok) + " (" +
          shortNumber(successRate(rows)) + " %); failures:";
   bool first = true;
+  std::size_t listed = 0;
   for (const char* reason : kFailureReasons) {
     std::int64_t n = 0;
-    for (const RunRow& r : rows) n += r.failure == reason;
+    for (const RunRow& r : rows) n += failedFor(r, reason);
+    if (listed++ >= kListedReasons && n == 0) continue;
     out += std::string(first ? " " : ", ") + reason + " " + std::to_string(n);
     first = false;
   }
@@ -564,7 +571,7 @@ std::string summaryLine(const std::string& scenario, const std::string& controll
   std::string failures;
   for (const char* reason : kFailureReasons) {
     std::int64_t n = 0;
-    for (const RunRow& r : rows) n += r.failure == reason;
+    for (const RunRow& r : rows) n += failedFor(r, reason);
     if (n > 0) failures += (failures.empty() ? "" : ", ") + std::string(reason) + " " + std::to_string(n);
   }
   const Statistic itae = statistic(column(rows, [](const RunRow& r) { return r.metrics[AXIS_Y].itae; }));

@@ -30,6 +30,12 @@ RunRow measureEstimated(const Scenario& sc, const EstimatedRunConfig& cfg, Refer
   const EstimatedRunResult er =
       runEstimatedLoop(sc, cfg, reference, true, [&](const EstimatedSample& es) { meter.add(*es.loop); });
   meter.finish(er.run);
+  // No traction is why the run ended early: it comes before a cross-track failure (and the finish check,
+  // which leaves it be), after a divergence or a contact.
+  if (er.no_traction.detected && (row.failure.empty() || row.failure == "cross-track")) {
+    row.failure = er.no_traction.text();
+    row.success = false;
+  }
   row.realism = true;
   row.max_slip = er.max_abs_slip;
   row.high_slip_share = er.run.periods > 0

@@ -171,6 +171,7 @@ const ParamTable<TorqueControllerSettings>& TorqueControllerSettings::table() {
     }
     nestMarked(t, &S::pid, wheelPidTable(),
                [](const std::string& key) { return key == "max_torque" ? std::string() : std::string("[pid]"); });
+    t.nest("", &S::hold, standstillHoldTable());  // whichever controller runs
     return t;
   }();
   return table;
@@ -179,7 +180,7 @@ const ParamTable<TorqueControllerSettings>& TorqueControllerSettings::table() {
 TorqueControllerSettings::TorqueControllerSettings() { table().applyDefaults(*this); }
 
 std::string TorqueControllerSettings::validate() const {
-  return firstError({table().checkRanges(*this), sliding.validate(), pid.validate()});
+  return firstError({table().checkRanges(*this), sliding.validate(), pid.validate(), hold.validate()});
 }
 
 const ParamTable<ReferenceGeneratorSettings>& ReferenceGeneratorSettings::table() {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <memory>
 #include <stdexcept>
@@ -183,6 +184,25 @@ class SensorFeed {
   double odometry_error_final_ = 0.0, odometry_error_max_ = 0.0;
 };
 
+/// What the simulation knows beyond the measurements at a no-traction verdict: the grip budget of the soil
+/// under the robot there (no slip: nothing to say).
+template <typename PlantT>
+std::string gripDiagnosis(const Scenario& sc, const EstimatedRunConfig& cfg, const PlantT& plant, const Pose2D& where) {
+  if constexpr (!PlantT::kTraction) {
+    return "";
+  } else {
+    const TractionParams& t = *cfg.traction;
+    const int i = plant.plant.soil().patchAt({where.x, where.y});
+    const SoilPatch* p = i >= 0 ? &plant.plant.soil().patches()[static_cast<std::size_t>(i)] : nullptr;
+    const GripBudget g = gripBudget(sc.robot, sc.disturbance.mass_scale, t, p ? p->mu_peak : t.mu_peak,
+                                    p ? p->mu_slide : t.mu_slide, p ? p->rolling_resistance : t.rolling_resistance);
+    char b[200];
+    std::snprintf(b, sizeof(b), "%s grip budget: peak traction %.1f N (sliding %.1f N) against %.1f N needed",
+                  i >= 0 ? ("soil patch " + std::to_string(i)).c_str() : "field soil", g.peak, g.slide, g.needed);
+    return b;
+  }
+}
+
 template <typename PlantT>
 EstimatedRunResult run(const Scenario& sc, const EstimatedRunConfig& cfg, PlantT& plant, ReferenceSource& reference,
                        bool keep_samples, const std::function<void(const EstimatedSample&)>& trace) {
@@ -196,24 +216,27 @@ EstimatedRunResult run(const Scenario& sc, const EstimatedRunConfig& cfg, PlantT
   layers.tool = &tool;
   if (cfg.traction) layers.high_slip = 2.0 * cfg.traction->slip_peak;
   std::optional<TractionControl> traction_control;
+  std::optional<TractionMonitor> monitor;
   if (cfg.traction_control.enabled) {
     traction_control.emplace(cfg.traction_control, sc.robot.L);
     layers.traction_control = &*traction_control;
+    monitor.emplace(cfg.traction_control);
+    layers.monitor = &*monitor;
   }
   std::optional<HitchControl> hitch;
   if (cfg.hitch_control.enabled) {
     hitch.emplace(cfg.hitch_control);
     layers.hitch = &*hitch;
   }
-  EstimatedRunResult out;
-  if (!cfg.speed_governor.enabled) {
-    out = closedLoop(sc, plant, feed, *outer, *inner, reference, keep_samples, trace, RunStop{}, layers);
-  } else {
-    GovernedReference governed(reference, cfg.speed_governor);
-    layers.governor = &governed;
-    out = closedLoop(sc, plant, feed, *outer, *inner, governed, keep_samples, trace, RunStop{}, layers);
+  std::optional<GovernedReference> governed;
+  if (cfg.speed_governor.enabled) {
+    governed.emplace(reference, cfg.speed_governor);
+    layers.governor = &*governed;
   }
+  EstimatedRunResult out = closedLoop(sc, plant, feed, *outer, *inner, governed ? *governed : reference, keep_samples,
+                                      trace, RunStop{}, layers);
   if (hitch) out.hitch_raises = hitch->raises();
+  if (out.no_traction.detected) out.no_traction.diagnosis = gripDiagnosis(sc, cfg, plant, out.no_traction.where);
   return out;
 }
 

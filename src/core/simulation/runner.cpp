@@ -9,12 +9,13 @@ namespace sowing_robot {
 namespace core {
 
 std::string Scenario::validate() const {
-  std::string e = firstError(
-      {checkPositive("duration", duration, "s"), control_period_ns > 0 ? "" : "control_period must be > 0",
-       allFinite(start.x, start.y, start.theta) ? "" : "start pose must be finite",
-       std::isfinite(disturbance_phase) ? "" : "disturbance_phase must be finite", robot.validate(),
-       disturbance.validate(), kanayama.validate(), sliding.validate(),
-       outer == OuterKind::kanayama ? "" : pure_pursuit.validate(), inner == InnerKind::pid ? pid.validate() : ""});
+  std::string e =
+      firstError({checkPositive("duration", duration, "s"), control_period_ns > 0 ? "" : "control_period must be > 0",
+                  allFinite(start.x, start.y, start.theta) ? "" : "start pose must be finite",
+                  std::isfinite(disturbance_phase) ? "" : "disturbance_phase must be finite", robot.validate(),
+                  disturbance.validate(), kanayama.validate(), sliding.validate(),
+                  outer == OuterKind::kanayama ? "" : pure_pursuit.validate(),
+                  inner == InnerKind::pid ? pid.validate() : "", hold.validate()});
   return e;
 }
 

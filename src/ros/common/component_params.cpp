@@ -132,6 +132,7 @@ std::string loadPipelineScenario(core::Scenario& sc, double& duration) {
   sc.inner = torque_settings.inner;
   sc.sliding = torque_settings.sliding;
   sc.pid = torque_settings.pid;
+  sc.hold = torque_settings.hold;
   return sc.validate();
 }
 

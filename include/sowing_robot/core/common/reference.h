@@ -69,7 +69,7 @@ class LineReference : public ReferenceSource {
   void restart() override {}
   Reference evaluate(double t) override {
     // Every field in one initialiser: built in registers, not zeroed on the stack and patched.
-    return Reference{Pose2D{x0_ + v_r_ * t, row_y_, 0.0}, v_r_, 0.0, 0.0, 0.0, true};
+    return Reference{Pose2D{x0_ + v_r_ * t, row_y_, 0.0}, v_r_, 0.0, 0.0, 0.0, true, false};
   }
 
  private:

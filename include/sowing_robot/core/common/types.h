@@ -22,13 +22,27 @@ struct Reference {
   double v_dot = 0.0;      ///< [m/s^2]
   double omega_dot = 0.0;  ///< [rad/s^2]
   bool tool_down = true;   ///< on a sowing row
+  /// A stop hold: the plan keeps the robot at rest here (its end, a stop short of an obstacle). The outer
+  /// controllers then command the hold (holdCommand()) instead of chasing the pose.
+  bool stop = false;
 };
 
 /// Output of the kinematic controller.
 struct VelocityCommand {
   double v = 0.0, omega = 0.0;          ///< [m/s], [rad/s]
   double v_dot = 0.0, omega_dot = 0.0;  ///< [m/s^2], [rad/s^2]
+  /// Hold the robot at rest (a stop): the inner loop brakes the wheels with its own states frozen
+  /// (standstill_hold.h); v, omega and their derivatives are then 0.
+  bool hold = false;
 };
+
+/// The outer loop's answer to a stop hold: zero velocities, and the hold for the inner loop. A robot that
+/// cannot move sideways cannot remove a lateral error at rest, so a stop chases no pose.
+inline VelocityCommand holdCommand() {
+  VelocityCommand c;
+  c.hold = true;
+  return c;
+}
 
 /// Wheel torques [N·m].
 struct WheelTorques {

@@ -82,6 +82,7 @@ inline InnerOutput toInnerOutput(const WheelPidOutput& p, const VelocityCommand&
   o.u2 = p.u_right - p.u_left;
   o.saturated = p.saturated;
   o.rejected = p.rejected;
+  o.holding = p.holding;
   return o;
 }
 

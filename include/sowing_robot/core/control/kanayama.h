@@ -35,7 +35,8 @@ class Kanayama {
   /// eq 4.2 for the velocities. The accelerations are the exact time derivatives of eq 4.2 along the
   /// error dynamics (eq 4.15) evaluated with the measured velocities v, omega, so no numerical
   /// differentiation (and no filter lag) enters the inner loop. A non-finite input gives the stop
-  /// command (all zero), never a NaN: the safe output of a stateless controller.
+  /// command (all zero), never a NaN: the safe output of a stateless controller. A stop hold in the
+  /// reference (ref.stop) gives holdCommand(): at rest the pose is not chased.
   VelocityCommand compute(const Reference& ref, const Pose2D& actual, double v, double omega) const;
 
   /// eq 4.14: L0 = (xe^2 + ye^2)/2 + (1 - cos thetae)/ky.

@@ -59,7 +59,8 @@ class PurePursuit {
   /// std::invalid_argument when the parameters do not validate.
   explicit PurePursuit(const PurePursuitParams& params = {}, bool regulated = true);
 
-  /// One command. A non-finite input gives the stop command (all zero), as Kanayama::compute.
+  /// One command. A non-finite input gives the stop command (all zero), as Kanayama::compute; a stop
+  /// hold in the reference (ref.stop) gives holdCommand().
   VelocityCommand compute(const Reference& ref, const Pose2D& actual, double v, double omega) const;
 
   /// The lookahead distance in use at measured speed v.

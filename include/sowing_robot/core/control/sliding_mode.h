@@ -51,6 +51,9 @@ struct SlidingModeOutput {
   double u1 = 0.0, u2 = 0.0;        ///< before saturation
   bool saturated = false;
   bool rejected = false;  ///< the input was not finite: the previous output, held (see update())
+  /// A stop hold (VelocityCommand::hold): the controller's states are frozen and its torques are 0; the
+  /// standstill hold (standstill_hold.h), which measures the wheels, sets the torques sent.
+  bool holding = false;
 };
 
 class SlidingModeController {
@@ -66,7 +69,9 @@ class SlidingModeController {
 
   /// One control period of length dt [s]. A non-finite input (or dt not a finite positive number) is
   /// rejected: integrals and adaptive estimates are untouched and the previous output is returned
-  /// again with rejected = true (zero torques before the first accepted period).
+  /// again with rejected = true (zero torques before the first accepted period). With desired.hold the
+  /// integrals and estimates stay as they are (nothing winds up at rest) and the output is zero torque with
+  /// holding = true; the first period without it carries on from them.
   SlidingModeOutput update(const VelocityCommand& desired, double v, double omega, double dt);
 
   double m0Hat() const { return m0_hat_; }

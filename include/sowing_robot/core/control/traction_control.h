@@ -36,9 +36,14 @@ struct TractionControlParams {
   /// the ceiling (InnerController::heldBack).
   bool anti_windup;
 
+  /// No traction (traction_monitor.h): the window [s] (0: never), the progress that restarts it [m], the
+  /// share of it the wheels must slip [-], and how long the robot is held after the verdict [s].
+  double no_traction_window, no_traction_progress, no_traction_slip_share, no_traction_hold;
+
   std::string validate() const;
 };
-/// traction_control/{enabled, slip_target, speed_floor, cut_rate, raise_rate, min_torque, max_torque, anti_windup}.
+/// traction_control/{enabled, slip_target, speed_floor, cut_rate, raise_rate, min_torque, max_torque, anti_windup,
+/// no_traction_window, no_traction_progress, no_traction_slip_share, no_traction_hold}.
 const ParamTable<TractionControlParams>& tractionControlTable();
 
 /// What the layer measures in one period.

@@ -45,6 +45,7 @@ struct WheelPidOutput {
   double u_right = 0.0, u_left = 0.0;  ///< before clipping [N·m]
   bool saturated = false;
   bool rejected = false;  ///< the input was not finite: the previous output, held
+  bool holding = false;   ///< a stop hold: integrals frozen, zero torques (as SlidingModeOutput::holding)
 };
 
 class WheelPid {
@@ -58,7 +59,9 @@ class WheelPid {
 
   /// One control period of length dt [s]. A non-finite input (or dt not a finite positive number) is
   /// rejected: integrals and derivative memory untouched, the previous output returned again with
-  /// rejected = true (zero torques before the first accepted period).
+  /// rejected = true (zero torques before the first accepted period). With desired.hold the integrals stay
+  /// as they are and the output is zero torque with holding = true (the standstill hold brakes); the
+  /// derivative's memory follows the wheels, so the first period after the hold has no kick.
   WheelPidOutput update(const VelocityCommand& desired, double v, double omega, double dt);
 
   const WheelPidParams& params() const { return params_; }

@@ -77,7 +77,8 @@ struct RunRow {
   double end_distance = std::numeric_limits<double>::quiet_NaN();
   bool diverged = false;
   bool success = false;
-  std::string failure;  ///< why not a success ("" on success): diverged, contact, not finished, cross-track
+  std::string failure;  ///< why not a success ("" on success): diverged, contact, not finished, cross-track,
+                        ///< or "no traction at (x y): why" (traction control on; one line, no commas)
   /// Signed cross-track error sampled every envelope period from t = 0 (runBenchmark only; empty otherwise).
   std::vector<double> cross_track_series;
   /// A scenario with BenchScenario::realism (estimated_bench.h): the columns below are its (NaN otherwise).

@@ -197,8 +197,14 @@ class FieldReference : public ReferenceSource {
 
  protected:
   void restart() override { field_.reset(); }
-  /// Reference at t; tool_down = true on rows, false on turns and once finished.
-  Reference evaluate(double t) override { return field_.next(t); }
+  /// Reference at t; tool_down = true on rows, false on turns and once finished. Once the path has ended
+  /// (finished(t): the last row's end, or a stop short of an obstacle) and the reference has come to rest
+  /// (slower than potential/heading_hold_speed), it is a stop hold (Reference::stop).
+  Reference evaluate(double t) override {
+    Reference r = field_.next(t);
+    r.stop = t >= duration_ && r.v <= field_.params().heading_hold_speed;
+    return r;
+  }
 
  private:
   FieldParams params_;

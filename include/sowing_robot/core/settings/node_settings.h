@@ -13,6 +13,7 @@
 #include "sowing_robot/core/control/controllers.h"
 #include "sowing_robot/core/control/kanayama.h"
 #include "sowing_robot/core/control/sliding_mode.h"
+#include "sowing_robot/core/control/standstill_hold.h"
 #include "sowing_robot/core/model/plant.h"
 #include "sowing_robot/core/planning/field.h"
 #include "sowing_robot/core/planning/seeding.h"
@@ -74,7 +75,8 @@ struct TorqueControllerSettings {
   double input_timeout;
   InnerKind inner;
   SlidingModeParams sliding;
-  WheelPidParams pid;  ///< pid.max_torque is always sliding.max_torque (the one `max_torque` key)
+  WheelPidParams pid;         ///< pid.max_torque is always sliding.max_torque (the one `max_torque` key)
+  StandstillHoldParams hold;  ///< the standstill hold at a stop (either controller)
   std::string validate() const;
   /// "atsmc", "tsmc" or "pid": the pair's inner name.
   std::string innerName() const { return core::innerName(inner, sliding.adaptive); }

@@ -10,9 +10,13 @@
 //   2. the feedback source gives the pose (through the quaternion round trip of nav_msgs/Odometry) and
 //      twist the controllers get;
 //   3. the reference at t_k; the errors against the TRUE pose go into the metrics;
-//   4. outer controller -> velocity command, inner controller -> wheel torques; the traction control (if
-//      on) caps the torque of a slipping wheel, and tells the speed governor (if on) for the next period;
+//   4. outer controller -> velocity command, inner controller -> wheel torques; at a stop hold (the
+//      reference's stop: the inner loop frozen) the standstill hold brakes on the fed twist instead; the traction
+//      control (if on) caps the torque of a slipping wheel, and tells the speed governor (if on) for the next period;
 //   5. with the traction plant and a draft: the tool rule on the true tool point lowers or lifts the tool;
+//      With the traction control, its progress check (traction_monitor.h) may find the robot without
+//      traction: from the next period on the robot is held (a stop hold whatever the reference), and
+//      the run ends traction_control/no_traction_hold later;
 //   6. the trace sees the period; the caller's stop() may end the run here (every kStopCheckEvery);
 //   7. the plant steps (k < n; its motors, if on, between the torques sent and the wheels), then the
 //      sensors see the new state at t_{k+1}.
@@ -31,6 +35,7 @@
 #include <limits>
 
 #include "sowing_robot/core/control/hitch_control.h"
+#include "sowing_robot/core/control/standstill_hold.h"
 #include "sowing_robot/core/control/traction_control.h"
 #include "sowing_robot/core/model/traction.h"
 #include "sowing_robot/core/planning/speed_governor.h"
@@ -108,6 +113,7 @@ struct LoopLayers {
   TractionControl* traction_control = nullptr;  ///< between the inner loop and the motors
   GovernedReference* governor = nullptr;        ///< the reference the loop is given, governed
   HitchControl* hitch = nullptr;                ///< raises the tool on the traction control's grip verdict
+  TractionMonitor* monitor = nullptr;           ///< the traction control's progress check (needs it)
   /// Traction plant: a period after which either wheel's |slip ratio| exceeds this counts to high_slip_time.
   double high_slip = std::numeric_limits<double>::infinity();
 };
@@ -147,12 +153,16 @@ EstimatedRunResult closedLoop(const Scenario& sc, PlantT& plant, Feed& feed, Out
   feed.start(plant.state());
   if (layers.traction_control) layers.traction_control->reset();
   if (layers.hitch) layers.hitch->reset();
+  if (layers.monitor) layers.monitor->reset();
+  double end_at = 0.0;  // no traction: the run ends here
   const std::int64_t n = sc.steps();
   const double dt = secondsFromNanos(sc.control_period_ns);
   MetricsAccumulator metrics(keep_samples);
   metrics.reserve(static_cast<std::size_t>(n + 1));
   EstimatedRunResult out;
   RunResult& result = out.run;
+  StandstillHold hold(sc.hold, sc.robot, sc.inner == InnerKind::pid ? sc.pid.max_torque : sc.sliding.max_torque);
+  bool holding = false;
 
   for (std::int64_t k = 0; k <= n; ++k) {
     const double t = secondsFromNanos(k * sc.control_period_ns);
@@ -167,8 +177,18 @@ EstimatedRunResult closedLoop(const Scenario& sc, PlantT& plant, Feed& feed, Out
     double ex, ey, eth;
     worldErrors(ref, truth, ex, ey, eth);
     metrics.add(t, ex, ey, eth);
-    const VelocityCommand cmd = outer.compute(ref, fed.pose, fed.v, fed.omega);
-    const InnerOutput u = inner.update(cmd, fed.v, fed.omega, dt);
+    const bool no_traction = layers.monitor != nullptr && layers.monitor->detected();
+    const VelocityCommand cmd = no_traction ? holdCommand() : outer.compute(ref, fed.pose, fed.v, fed.omega);
+    InnerOutput u = inner.update(cmd, fed.v, fed.omega, dt);
+    if (u.holding) {  // a stop: the inner loop is frozen, the brake holds the robot where it is
+      if (!holding) hold.engage();
+      const HoldTorques h = hold.update(fed.v, fed.omega, dt);
+      u.torques = h.torques;
+      u.u1 = h.u1;
+      u.u2 = h.u2;
+      u.saturated = h.saturated;
+    }
+    holding = u.holding;
     if (u.saturated) ++result.saturated_steps;
     WheelTorques sent = u.torques;
     if (TractionControl* tc = layers.traction_control) {
@@ -178,6 +198,10 @@ EstimatedRunResult closedLoop(const Scenario& sc, PlantT& plant, Feed& feed, Out
       if (layers.governor) {
         layers.governor->report(tc->slipping(), tc->limiting(), dt);
         out.governor_min_rate = std::min(out.governor_min_rate, layers.governor->rate());
+      }
+      if (layers.monitor && !no_traction && layers.monitor->update(t, fed.pose, !cmd.hold, tc->slipping(), dt)) {
+        out.no_traction = layers.monitor->report();
+        end_at = t + tc->params().no_traction_hold;
       }
     }
     bool tool_down = false;
@@ -201,6 +225,7 @@ EstimatedRunResult closedLoop(const Scenario& sc, PlantT& plant, Feed& feed, Out
       loop_detail::emit(trace, {t, &s, &ref, &cmd, &u, inner.m0Hat(), inner.i0Hat(), ex, ey, eth}, fed,
                         plant.slip(RIGHT), plant.slip(LEFT), tool_down, sent, layers);
     result.periods = k;
+    if (no_traction && t >= end_at) break;  // held since the verdict: the run ends with its report
     if (stop && k % kStopCheckEvery == kStopCheckEvery - 1 && k < n && stop(metrics)) {
       result.stopped = true;
       break;

@@ -31,6 +31,7 @@
 
 #include "sowing_robot/core/control/hitch_control.h"
 #include "sowing_robot/core/control/traction_control.h"
+#include "sowing_robot/core/control/traction_monitor.h"
 #include "sowing_robot/core/estimation/ekf.h"
 #include "sowing_robot/core/model/motor.h"
 #include "sowing_robot/core/model/sensors.h"
@@ -111,6 +112,9 @@ struct EstimatedRunResult {
   /// held it up, i.e. the length of row left unsown [m]; and how often it raised the tool.
   double unsown_distance = 0.0;
   int hitch_raises = 0;
+  /// With the traction control: the robot found without traction (the run then ended
+  /// traction_control/no_traction_hold after the verdict, the robot held at rest).
+  NoTractionReport no_traction;
 };
 
 /// Runs the scenario (plant, timing, start, disturbance incl. its phase, the outer/inner pair of

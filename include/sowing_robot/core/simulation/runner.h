@@ -19,6 +19,7 @@
 #include "sowing_robot/core/control/controllers.h"
 #include "sowing_robot/core/control/kanayama.h"
 #include "sowing_robot/core/control/sliding_mode.h"
+#include "sowing_robot/core/control/standstill_hold.h"
 #include "sowing_robot/core/model/plant.h"
 #include "sowing_robot/core/simulation/metrics.h"
 
@@ -40,6 +41,7 @@ struct Scenario {
   InnerKind inner = InnerKind::sliding_mode;  ///< which inner controller (atsmc/tsmc: sliding.adaptive)
   PurePursuitParams pure_pursuit;             ///< outer = pure_pursuit or rpp
   WheelPidParams pid;                         ///< inner = pid
+  StandstillHoldParams hold;                  ///< the brake at a stop in the plan (closed_loop.h, step 4)
 
   /// "kanayama+atsmc", "rpp+pid", ...
   std::string controllerName() const;
