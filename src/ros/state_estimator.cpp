@@ -61,7 +61,7 @@ StateEstimator::StateEstimator(ros::NodeHandle nh, ros::NodeHandle pnh)
     : StateEstimator(nh, pnh, loadParams(nh, pnh)) {}
 
 StateEstimator::StateEstimator(ros::NodeHandle nh, ros::NodeHandle pnh, const Loaded& loaded)
-    : ekf_(loaded.params),
+    : ekf_(loaded.params, loaded.half_track),
       fixes_(loaded.params.fix_delay),
       increment_covariance_(core::encoderIncrementCovariance(loaded.params.increment_sigma, loaded.half_track)) {
   if (loaded.fix_schedule) await_ = std::make_unique<core::FixAwait>(*loaded.fix_schedule, loaded.params.fix_delay);
@@ -81,6 +81,13 @@ StateEstimator::~StateEstimator() {
       "awaited but never received %ld; inputs rejected %ld",
       c.applied, c.refused(), c.too_old, c.future, c.invalid, c.gated, c.reanchored, c.slip_onsets, late_fixes_,
       fixes_.dropped(), lost_fixes_, rejected_inputs_);
+  if (ekf_.params().slip.detect) {
+    const core::SlipCounts s = ekf_.slipCounts();
+    ROS_INFO(
+        "state_estimator: slip-aware (estimator/slip/detect): a wheel loose %ld time(s), the fixes' slip alarms "
+        "%ld, a wheel slipping for %.1f s",
+        s.loose, s.by_fixes, s.time);
+  }
 }
 
 void StateEstimator::odomCallback(const nav_msgs::Odometry::ConstPtr& msg) {

@@ -45,8 +45,12 @@ TEST(FusedLockstep, NodePipelineEqualsTheInProcessEstimatedLoop) {
   loadTable(plant, core::sensorsTable(), cfg.sensors);
   loadTable(estimator, core::ekfTable(), cfg.estimator);
   ASSERT_EQ(core::firstError({plant.error(), estimator.error(), cfg.validate()}), "");
-  std::printf("fused lockstep: pair %s, %g s, sensors seed %llu, bias state %s\n", sc.controllerName().c_str(),
-              duration, static_cast<unsigned long long>(cfg.sensors.seed), cfg.estimator.estimate_bias ? "on" : "off");
+  bool slip_aware = false;  // what the .test expects of state_estimator's estimator/slip/detect
+  pnh.getParam("slip_aware", slip_aware);
+  ASSERT_EQ(cfg.estimator.slip.detect, slip_aware);
+  std::printf("fused lockstep: pair %s, %g s, sensors seed %llu, bias state %s, slip-aware %s\n",
+              sc.controllerName().c_str(), duration, static_cast<unsigned long long>(cfg.sensors.seed),
+              cfg.estimator.estimate_bias ? "on" : "off", slip_aware ? "on" : "off");
 
   Recorded rec;
   const auto hints = ros::TransportHints().tcpNoDelay();

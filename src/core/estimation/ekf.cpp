@@ -11,6 +11,9 @@ namespace core {
 namespace {
 
 constexpr double kStampTolerance = 1e-6;  // [s] fixes are sampled on plant steps (1 ms apart at 1 kHz)
+// A wheel found loose by the averaged tests is taken as loose from this many slip/window before (the
+// averages' delay in finding a spin-up).
+constexpr double kSlipLookback = 4.0;
 
 using Vector6 = Eigen::Matrix<double, 6, 1>;
 using Matrix6 = Eigen::Matrix<double, 6, 6>;
@@ -50,12 +53,17 @@ const ParamTable<EkfParams>& ekfTable() {
               "covariance from it; heading and bias kept): the way back after wheel slip; 0: never"),
       number("estimator/slip/inflation", &P::slip_inflation, 100.0, Limits::closed(1.0, 1e6), "",
              "after a fix outside the gate (wheel slip), the distance noise's variance times this until an applied "
-             "fix agrees with the prediction within the fix's own noise; 1: off"),
+             "fix agrees with the prediction within the fix's own noise; 1: off (the filter without slip/detect)"),
       number("estimator/fix/delay", &P::fix_delay, 0.15, Limits::closed(0.0, 100.0), "s",
              "a fix is applied once the estimate is this much newer than its stamp, so runs are repeatable; >= "
              "the fix's latency plus two control periods, and within history/length"),
   });
-  return table;
+  static const ParamTable<P> with_slip = [] {
+    ParamTable<P> t = table;
+    t.nest("estimator/slip/", &P::slip, slipParamsTable());
+    return t;
+  }();
+  return with_slip;
 }
 
 EkfParams::EkfParams() { ekfTable().applyDefaults(*this); }
@@ -74,9 +82,10 @@ const char* fixOutcomeName(FixOutcome o) {
   return "?";
 }
 
-Ekf::Ekf(const EkfParams& params) : params_(params) {
+Ekf::Ekf(const EkfParams& params, double half_track) : params_(params), half_track_(half_track) {
   const std::string error = params.validate();
   if (!error.empty()) throw std::invalid_argument(error);
+  if (params.slip.detect) detector_.emplace(params.slip, half_track);  // throws for a bad half track
 }
 
 void Ekf::pinBias(Vector& mean, Matrix& cov) const {
@@ -105,9 +114,18 @@ void Ekf::reset(double t, const Vector& mean, const Matrix& covariance) {
   Entry e{t, mean, covariance, EkfStepInput{}, {}};
   e.mean(THETA) = wrapAngle(e.mean(THETA));
   pinBias(e.mean, e.cov);
+  if (detector_) {  // at rest (half the top speed's std), the wheels gripping (slip/speed_tolerance's std)
+    e.smean.head<4>() = e.mean;
+    e.scov.topLeftCorner<4, 4>() = e.cov;
+    const double speed = 0.5 * params_.slip.max_ground_speed, slip = params_.slip.speed_tolerance;
+    e.scov(kSpeed, kSpeed) = speed * speed;
+    e.scov(kSlipRight, kSlipRight) = e.scov(kSlipLeft, kSlipLeft) = slip * slip;
+    detector_->reset();
+  }
   history_.clear();
   history_.push_back(std::move(e));
   slipping_ = false;
+  pending_inflation_.setZero();
 }
 
 Ekf::Vector Ekf::motion(const Vector6& a) {
@@ -199,6 +217,7 @@ bool Ekf::predict(double t, const EkfStepInput& in) {
   if (history_.empty() || !std::isfinite(t) || !(t > time())) return false;
   if (!allFinite(in.distance, in.dtheta, in.rate, in.rate_variance) || !finiteMatrix(in.covariance)) return false;
   if (in.covariance(0, 0) < 0.0 || in.covariance(1, 1) < 0.0 || in.rate_variance < 0.0) return false;
+  if (detector_) return predictSlipAware(t, in);
   Entry e{t, mean(), covariance(), in, {}};
   if (slipping_)  // kept in the entry's input: a re-propagation meets the same inflation
     e.input.covariance(0, 0) +=
@@ -224,6 +243,7 @@ FixOutcome Ekf::fuse(const EkfFix& fix) {
   // The newest kept state not after the stamp.
   std::size_t k = history_.size() - 1;
   while (k > 0 && history_[k].t > fix.stamp + kStampTolerance) --k;
+  if (detector_) return fuseSlipAware(fix, k);
   Entry& at = history_[k];
   bool anchor = false;
   if (params_.gate > 0.0 && update(fix, at.mean, at.cov, false) > params_.gate) {
@@ -265,6 +285,127 @@ FixOutcome Ekf::fuse(const EkfFix& fix) {
     }
     pinBias(e.mean, e.cov);
   }
+  ++counts_.applied;
+  if (!anchor) return FixOutcome::APPLIED;
+  ++counts_.reanchored;
+  return FixOutcome::REANCHORED;
+}
+
+void Ekf::settle(Entry& e) const {
+  if (!params_.estimate_bias) {
+    e.smean(BIAS) = 0.0;
+    e.scov.row(BIAS).setZero();
+    e.scov.col(BIAS).setZero();
+  }
+  e.mean = e.smean.head<4>();
+  e.cov = e.scov.topLeftCorner<4, 4>();
+}
+
+unsigned Ekf::slippingAt(const Entry& e) const {
+  unsigned out = e.loose;
+  if (std::fabs(e.smean(kSlipRight)) > params_.slip.speed_tolerance) out |= SLIP_RIGHT;
+  if (std::fabs(e.smean(kSlipLeft)) > params_.slip.speed_tolerance) out |= SLIP_LEFT;
+  return out;
+}
+
+void Ekf::stepSlipAware(const Entry& before, Entry& e) const {
+  e.smean = before.smean;
+  e.scov = before.scov;
+  for (int i = 0; i < 3; ++i) e.scov(kSpeed + i, kSpeed + i) += e.inflation(i);
+  slipAwarePropagate(params_, half_track_, e.t - before.t, e.input, e.loose, e.smean, e.scov);
+  settle(e);
+}
+
+bool Ekf::predictSlipAware(double t, const EkfStepInput& in) {
+  const Entry& last = history_.back();
+  const double dt = t - last.t, L = half_track_;
+  SlipEvidence ev;
+  ev.dt = dt;
+  ev.travel_right = in.distance + L * in.dtheta;
+  ev.travel_left = in.distance - L * in.dtheta;
+  ev.has_rate = in.has_rate;
+  ev.rate = in.rate - last.smean(BIAS);
+  unsigned onset = SLIP_NONE;
+  Entry e{t, last.mean, last.cov, in, {}};
+  e.loose = detector_->step(ev, onset);
+  e.inflation = pending_inflation_;
+  pending_inflation_.setZero();
+  // A wheel plausible again: its slip is whatever it is now (spinning on at a new speed, or gripping);
+  // its variance is opened, and the next steps take it from the other wheel, the gyro and the fixes.
+  const unsigned regained = last.loose & ~e.loose;
+  const double open = params_.slip.max_ground_speed * params_.slip.max_ground_speed;
+  if (regained & SLIP_RIGHT) e.inflation(1) += open;
+  if (regained & SLIP_LEFT) e.inflation(2) += open;
+  stepSlipAware(last, e);
+  if (!e.smean.allFinite() || !e.scov.allFinite()) return false;
+  history_.push_back(std::move(e));
+  while (history_.size() > static_cast<std::size_t>(params_.history_length)) history_.pop_front();
+  if (onset != SLIP_NONE) {
+    // Found with the averages' delay: the wheel broke loose kSlipLookback windows before.
+    std::size_t k = history_.size() - 1;
+    while (k > 0 && history_[k].t > t - kSlipLookback * params_.slip.window + kStampTolerance) --k;
+    markLoose(k, onset);
+    repropagateSlipAware(k);
+  }
+  if (slippingAt(history_.back()) != SLIP_NONE) detector_->countSlipping(dt);
+  return true;
+}
+
+void Ekf::markLoose(std::size_t k, unsigned wheels) {
+  for (std::size_t i = k + 1; i < history_.size(); ++i) history_[i].loose |= wheels;
+}
+
+void Ekf::reacquire(std::size_t k, unsigned wheels, double open) {
+  Eigen::Vector3d& inflation = k + 1 < history_.size() ? history_[k + 1].inflation : pending_inflation_;
+  if (wheels & SLIP_RIGHT) inflation(1) += open;
+  if (wheels & SLIP_LEFT) inflation(2) += open;
+}
+
+void Ekf::repropagateSlipAware(std::size_t k) {
+  for (std::size_t i = k + 1; i < history_.size(); ++i) {
+    Entry& e = history_[i];
+    stepSlipAware(history_[i - 1], e);
+    for (const Entry::Applied& f : e.fixes) {
+      if (f.reanchor)
+        slipAwareReanchor(f.fix, e.smean, e.scov);
+      else
+        slipAwareUpdate(f.fix, e.smean, e.scov, true, nullptr, slippingAt(e) == SLIP_BOTH);
+      settle(e);
+    }
+  }
+}
+
+FixOutcome Ekf::fuseSlipAware(const EkfFix& fix, std::size_t k) {
+  Entry& at = history_[k];
+  double along = 0.0;
+  const double d2 = slipAwareUpdate(fix, at.smean, at.scov, false, &along);
+  bool anchor = false;
+  if (params_.gate > 0.0 && d2 > params_.gate) {
+    // Outside the gate: the wheels' slips are not what the filter thinks (both, from the fix's stamp on).
+    detector_->gatedFix();
+    reacquire(k, SLIP_BOTH, params_.slip.max_ground_speed * params_.slip.max_ground_speed);
+    repropagateSlipAware(k);
+    if (params_.reanchor_after <= 0 || gated_in_a_row_ < params_.reanchor_after) {
+      ++gated_in_a_row_;
+      ++counts_.gated;
+      return FixOutcome::REFUSED_GATE;
+    }
+    anchor = true;
+  } else if (const double evidence = detector_->fix(fix.stamp, along)) {
+    // The CUSUM's alarm: the slips may have drifted unseen as far as the speed's random walk allows.
+    reacquire(k, SLIP_BOTH,
+              std::min(params_.slip.speed_walk * params_.slip.speed_walk * evidence,
+                       params_.slip.max_ground_speed * params_.slip.max_ground_speed));
+  }
+  gated_in_a_row_ = 0;
+  const bool keep_heading = slippingAt(at) == SLIP_BOTH;
+  if (anchor)
+    slipAwareReanchor(fix, at.smean, at.scov);
+  else
+    slipAwareUpdate(fix, at.smean, at.scov, true, nullptr, keep_heading);
+  settle(at);
+  at.fixes.push_back({fix, anchor});
+  repropagateSlipAware(k);
   ++counts_.applied;
   if (!anchor) return FixOutcome::APPLIED;
   ++counts_.reanchored;

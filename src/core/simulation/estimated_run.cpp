@@ -73,7 +73,7 @@ class SensorFeed {
         // state_estimator's increment_covariance_: the encoders' quantisation per step, nominal half track.
         increment_covariance_(encoderIncrementCovariance(cfg.estimator.increment_sigma, sc.robot.L)),
         queue_(cfg.estimator.fix_delay) {
-    if (cfg.feedback == Feedback::fused) ekf_ = std::make_unique<Ekf>(cfg.estimator);
+    if (cfg.feedback == Feedback::fused) ekf_ = std::make_unique<Ekf>(cfg.estimator, L_);
   }
 
   /// plant_sim's sensors at the start state (PlantSensors' constructor): encoders and gyro reset, the first

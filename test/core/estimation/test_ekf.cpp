@@ -554,7 +554,8 @@ SensorRun runWithSensors(std::uint64_t seed, double seconds, double dropout_star
 // What it caught: with the slip's covariance computed from the step's quantised increments (2 or 3
 // ticks per wheel) the gyro update shortened the distance by 7.4 um per step on average, the estimate
 // lagged the truth by 7 mm along the track, and the mean NEES was 5.7 against [3.05, 5.07] over 30 runs
-// (x 1.9, y 2.1); see wheelTravelCovariance.
+// (x 1.9, y 2.1); see wheelTravelCovariance. Its slip case (one wheel, then both wheels spinning, with the
+// slip-aware filter of estimator/slip/detect) is test_ekf_slip's EkfSlipWithSensors.
 TEST(EkfWithSensors, NeesWithinChiSquareBounds) {
   std::vector<NeesRun> runs;
   Ekf::Vector ratio = Ekf::Vector::Zero();

@@ -316,8 +316,10 @@ TEST(ScenarioLoader, AProfileGoesOnTopOfTheScenariosBlocks) {
   EXPECT_TRUE(wet.realism->motor.enabled);
   EXPECT_TRUE(wet.realism->traction_control.enabled);
   EXPECT_TRUE(wet.realism->speed_governor.enabled);
-  EXPECT_FALSE(wet.realism->patches.empty());  // the field file's patches, with traction on
+  EXPECT_TRUE(wet.realism->estimator.slip.detect);  // the slip-aware estimator (used with feedback fused)
+  EXPECT_FALSE(wet.realism->patches.empty());       // the field file's patches, with traction on
   EXPECT_FALSE(bench::loadScenario("wet_soil", kSuite).realism->motor.enabled);
+  EXPECT_FALSE(bench::loadScenario("wet_soil", kSuite).realism->estimator.slip.detect);
   const BenchScenario line = bench::loadScenario("thesis_line", kSuite, field);  // no blocks of its own
   ASSERT_TRUE(line.realism);
   EXPECT_TRUE(line.realism->traction);

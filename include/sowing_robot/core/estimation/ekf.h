@@ -41,16 +41,29 @@
 // the prediction within the fix's own noise (squared distance against the fix's covariance below 1). The
 // inflation is stored with the step's inputs, so a late fix re-propagates through the same steps.
 // Without any gated fix nothing changes. Counted (slip_onsets).
+//
+// The slip-aware filter (slip/detect true; off by default, and then everything above is unchanged to the
+// bit): the state gains the ground speed and each drive wheel's slip speed, each wheel's encoder measures
+// its contact point's ground speed plus its slip, the gyro the heading change, the fixes the position
+// (slip_aware_step.h); a detector finds a wheel breaking loose or gripping again faster than the slip's
+// random walk can follow, and slow common slip from the fixes (slip_detector.h; a gated fix counts too,
+// in place of slip/inflation). A loose wheel's encoder is left out, from slip/window x 4 before the test
+// fired (the history is propagated again); when it is plausible again its slip is re-acquired (its
+// variance opened). The verdicts are stored with the steps, so a late fix re-propagates through the same
+// ones. Re-anchoring works as above. docs/estimator.md has the design, the bound and the recovery time.
 #pragma once
 
 #include <Eigen/Core>
 #include <cstddef>
 #include <deque>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "sowing_robot/core/common/param_table.h"
 #include "sowing_robot/core/common/types.h"
+#include "sowing_robot/core/estimation/slip_aware_step.h"
+#include "sowing_robot/core/estimation/slip_detector.h"
 
 namespace sowing_robot {
 namespace core {
@@ -72,13 +85,14 @@ struct EkfParams {
   int reanchor_after;          ///< gated fixes in a row after which the next gated one re-anchors x, y; 0: never
   double slip_inflation;       ///< after a gated fix, the distance noise variance times this until fixes agree
   double fix_delay;            ///< [s] the ROS node applies a fix once its state is this much newer (determinism)
+  SlipParams slip;             ///< estimator/slip/...: the slip-aware filter (slip.detect; off by default)
 
   /// checkRanges(): the first bad value as one line naming its key ("" when all are good).
   std::string validate() const;
 };
 /// estimator/{odometry/distance_noise, odometry/heading_noise, odometry/increment_sigma, bias/walk, bias/estimate,
 /// initial/sigma_xy, initial/sigma_theta, initial/sigma_bias, history/length, fix/gate, fix/reanchor_after,
-/// fix/delay}.
+/// slip/inflation, fix/delay, slip/... of slipParamsTable()}.
 const ParamTable<EkfParams>& ekfTable();
 
 /// One plant step's measurements.
@@ -141,8 +155,9 @@ class Ekf {
   using Matrix = Eigen::Matrix<double, 4, 4>;
   enum Index { X = 0, Y = 1, THETA = 2, BIAS = 3 };
 
-  /// Throws std::invalid_argument when the parameters do not validate.
-  explicit Ekf(const EkfParams& params);
+  /// Throws std::invalid_argument when the parameters do not validate, or with slip/detect when half_track
+  /// (the nominal L [m], which turns the encoders' increments into the wheels' travels) is not > 0.
+  explicit Ekf(const EkfParams& params, double half_track = 0.0);
 
   /// Start at time t from a pose (and bias) with the table's initial covariance; clears the history
   /// (the counts stay). Throws std::invalid_argument for a non-finite value.
@@ -166,8 +181,18 @@ class Ekf {
   double oldestTime() const { return history_.front().t; }
   std::size_t historySize() const { return history_.size(); }
   const FixCounts& counts() const { return counts_; }
-  /// The slip inflation is on (a gated fix, no agreeing fix since).
-  bool slipping() const { return slipping_; }
+  /// The slip inflation is on (a gated fix, no agreeing fix since); slip-aware: a wheel slips.
+  bool slipping() const { return slipping_ || slippingWheels() != SLIP_NONE; }
+  /// Slip-aware filter: the wheels loose or slipping beyond slip/speed_tolerance now (SlipWheel bits);
+  /// SLIP_NONE otherwise.
+  unsigned slippingWheels() const { return detector_ ? slippingAt(history_.back()) : SLIP_NONE; }
+  /// Slip-aware filter: the state with the ground speed [m/s] and the wheels' slip speeds (kSpeed,
+  /// kSlipRight, kSlipLeft), and its covariance; zero otherwise.
+  const SlipVector& slipState() const { return history_.back().smean; }
+  const SlipMatrix& slipCovariance() const { return history_.back().scov; }
+  double groundSpeed() const { return slipState()(kSpeed); }
+  /// Slip-aware filter: what the detector found, and how long a wheel slipped.
+  SlipCounts slipCounts() const { return detector_ ? detector_->counts() : SlipCounts{}; }
   const EkfParams& params() const { return params_; }
 
   // The pieces of one step, public for the tests (Jacobians against finite differences).
@@ -194,14 +219,39 @@ class Ekf {
       bool reanchor;
     };
     std::vector<Applied> fixes;  ///< applied here, in the order they came
+    // The slip-aware filter only: its state (mean, cov above are its first four), the wheels left out
+    // over the step that led here, and what was added to the variances of (v, sigma_R, sigma_L) before it.
+    SlipVector smean = SlipVector::Zero();
+    SlipMatrix scov = SlipMatrix::Zero();
+    unsigned loose = SLIP_NONE;
+    Eigen::Vector3d inflation = Eigen::Vector3d::Zero();
   };
   void pinBias(Vector& mean, Matrix& cov) const;
+  // The slip-aware filter's pieces.
+  bool predictSlipAware(double t, const EkfStepInput& in);
+  FixOutcome fuseSlipAware(const EkfFix& fix, std::size_t k);
+  /// mean, cov := the first four of smean, scov (after pinning the bias).
+  void settle(Entry& e) const;
+  /// One step from `before` into e with e's stored input, verdict and inflation (no fixes).
+  void stepSlipAware(const Entry& before, Entry& e) const;
+  /// Entries after k propagated again from k with their stored inputs, verdicts and fixes.
+  void repropagateSlipAware(std::size_t k);
+  /// The entries after k take `wheels` as loose too.
+  void markLoose(std::size_t k, unsigned wheels);
+  /// The slips of `wheels` re-opened from entry k on: `open` [(m/s)²] added to their variance before the
+  /// step after k.
+  void reacquire(std::size_t k, unsigned wheels, double open);
+  /// The wheels loose or slipping beyond slip/speed_tolerance at e.
+  unsigned slippingAt(const Entry& e) const;
 
   EkfParams params_;
   std::deque<Entry> history_;
   FixCounts counts_;
   int gated_in_a_row_ = 0;  // for fix/reanchor_after
   bool slipping_ = false;   // slip/inflation in force
+  double half_track_;
+  std::optional<SlipDetector> detector_;                         // slip/detect
+  Eigen::Vector3d pending_inflation_ = Eigen::Vector3d::Zero();  // for the next step (re-acquired at the newest)
 };
 
 /// Holds fixes until the filter's time has passed stamp + delay, so that which fixes an estimate
