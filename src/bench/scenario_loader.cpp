@@ -178,22 +178,73 @@ const std::vector<std::string>& pendingModels() {
   return pending;
 }
 
-/// The profile's blocks merged into the scenario's root (see loadScenarioFile).
+/// A profile's keys are the nodes' (it is a rosparam file too: sim.launch profile:= loads it as it stands):
+/// each node's block that it may set, and the scenario block it goes to.
+struct ProfileBlock {
+  const char* node;
+  const char* block;
+};
+constexpr ProfileBlock kProfileBlocks[] = {{"plant_sim", "traction"},
+                                           {"plant_sim", "motor"},
+                                           {"plant_sim", "sensors"},
+                                           {"plant_sim", "hitch_control"},
+                                           {"torque_controller", "traction_control"},
+                                           {"reference_generator", "speed_governor"},
+                                           {"state_estimator", "estimator"}};
+
+/// The profile's blocks merged into the scenario's root (see loadScenarioFile): each node's block key by key
+/// into the scenario's block of that name (the profile's value wins), profile/feedback over the feedback.
 void applyProfile(YAML::Node& root, const std::string& profile) {
   const YAML::Node prof = loadYaml(profile);
-  onlyKeys(prof,
-           {"name", "description", "traction", "motor", "traction_control", "speed_governor", "hitch_control",
-            "sensors", "estimator", "feedback"},
-           profile, "");
-  for (const char* block :
-       {"traction", "motor", "traction_control", "speed_governor", "hitch_control", "sensors", "estimator"}) {
-    const YAML::Node from = prof[block];
-    if (!from) continue;
-    if (!from.IsMap()) fail(profile, std::string(block) + " must be a mapping");
-    if (!root[block]) root[block] = YAML::Node(YAML::NodeType::Map);
-    for (const auto& kv : from) root[block][kv.first.as<std::string>()] = YAML::Clone(kv.second);
+  onlyKeys(prof, {"profile", "plant_sim", "torque_controller", "reference_generator", "state_estimator"}, profile, "");
+  const YAML::Node own = required(prof, "profile", profile, "");
+  onlyKeys(own, {"name", "description", "feedback"}, profile, "profile/");
+  for (const char* node : {"plant_sim", "torque_controller", "reference_generator", "state_estimator"}) {
+    const YAML::Node blocks = prof[node];
+    if (!blocks) continue;
+    std::set<std::string> allowed;
+    for (const ProfileBlock& b : kProfileBlocks)
+      if (std::string(b.node) == node) allowed.insert(b.block);
+    onlyKeys(blocks, allowed, profile, std::string(node) + "/");
+    for (const std::string& block : allowed) {
+      const YAML::Node from = blocks[block];
+      if (!from) continue;
+      if (!from.IsMap()) fail(profile, std::string(node) + "/" + block + " must be a mapping");
+      if (!root[block]) root[block] = YAML::Node(YAML::NodeType::Map);
+      for (const auto& kv : from) root[block][kv.first.as<std::string>()] = YAML::Clone(kv.second);
+    }
   }
-  if (prof["feedback"]) root["feedback"] = YAML::Clone(prof["feedback"]);
+  if (own["feedback"]) root["feedback"] = YAML::Clone(own["feedback"]);
+}
+
+/// The blocks that put a scenario on the estimated loop (traction:, sensors:, estimator:, feedback:, motor:,
+/// traction_control:, speed_governor:, hitch_control:), each through the nodes' parameter table, onto `traction` and `cfg`
+/// (what they do not set stays).
+void applyLoopBlocks(const YAML::Node& root, const std::string& path, core::TractionParams& traction,
+                     core::EstimatedRunConfig& cfg) {
+  const YAML::Node sensors = root["sensors"], feedback = root["feedback"];
+  if (const YAML::Node block = root["traction"])
+    applyTableBlock(core::tractionTable(), block, traction, path, "traction");
+  if (sensors) {
+    if (!sensors.IsMap()) fail(path, "sensors must be a mapping");
+    if (sensors["seed"])
+      fail(path, "sensors/seed is drawn per run (draw 8 of the run's counter-based draws); leave it out");
+    applyTableBlock(core::sensorsTable(), sensors, cfg.sensors, path, "sensors");
+  }
+  if (const YAML::Node block = root["estimator"])
+    applyTableBlock(core::ekfTable(), block, cfg.estimator, path, "estimator");
+  if (const YAML::Node block = root["motor"]) applyTableBlock(core::motorTable(), block, cfg.motor, path, "motor");
+  if (const YAML::Node block = root["traction_control"])
+    applyTableBlock(core::tractionControlTable(), block, cfg.traction_control, path, "traction_control");
+  if (const YAML::Node block = root["speed_governor"])
+    applyTableBlock(core::speedGovernorTable(), block, cfg.speed_governor, path, "speed_governor");
+  if (const YAML::Node block = root["hitch_control"])
+    applyTableBlock(core::hitchControlTable(), block, cfg.hitch_control, path, "hitch_control");
+  if (feedback) {
+    if (!feedback.IsScalar()) fail(path, "feedback must be one of ground_truth, odometry, fused");
+    const std::string e = core::parseFeedback(feedback.Scalar(), cfg.feedback);
+    if (!e.empty()) fail(path, e);
+  }
 }
 
 core::BenchScenario loadScenarioFileImpl(const std::string& path, const std::string& profile) {
@@ -322,29 +373,10 @@ core::BenchScenario loadScenarioFileImpl(const std::string& path, const std::str
   if (traction || sensors || estimator || feedback || motor || traction_control || speed_governor || hitch_control) {
     core::EstimatedRunConfig cfg;
     core::TractionParams t;
-    if (traction) applyTableBlock(core::tractionTable(), traction, t, path, "traction");
+    applyLoopBlocks(root, path, t, cfg);
     if (t.enabled) {
       cfg.traction = t;
       cfg.patches = resolvePatches(patch_specs, t, path);
-    }
-    if (sensors) {
-      if (!sensors.IsMap()) fail(path, "sensors must be a mapping");
-      if (sensors["seed"])
-        fail(path, "sensors/seed is drawn per run (draw 8 of the run's counter-based draws); leave it out");
-      applyTableBlock(core::sensorsTable(), sensors, cfg.sensors, path, "sensors");
-    }
-    if (estimator) applyTableBlock(core::ekfTable(), estimator, cfg.estimator, path, "estimator");
-    if (motor) applyTableBlock(core::motorTable(), motor, cfg.motor, path, "motor");
-    if (traction_control)
-      applyTableBlock(core::tractionControlTable(), traction_control, cfg.traction_control, path, "traction_control");
-    if (speed_governor)
-      applyTableBlock(core::speedGovernorTable(), speed_governor, cfg.speed_governor, path, "speed_governor");
-    if (hitch_control)
-      applyTableBlock(core::hitchControlTable(), hitch_control, cfg.hitch_control, path, "hitch_control");
-    if (feedback) {
-      if (!feedback.IsScalar()) fail(path, "feedback must be one of ground_truth, odometry, fused");
-      const std::string e = core::parseFeedback(feedback.Scalar(), cfg.feedback);
-      if (!e.empty()) fail(path, e);
     }
     b.realism = cfg;
   }  // (soil patches without traction are read and unused, as in the nodes)
@@ -369,6 +401,35 @@ core::BenchScenario loadScenarioFileImpl(const std::string& path, const std::str
   const std::string e = b.validate();
   if (!e.empty()) fail(path, e);
   return b;
+}
+
+std::string profilePath(const std::string& name_or_path, const std::string& dir) {
+  const bool is_path = name_or_path.find('/') != std::string::npos ||
+                       (name_or_path.size() > 5 && name_or_path.compare(name_or_path.size() - 5, 5, ".yaml") == 0);
+  if (is_path) return name_or_path;
+  const std::string path = dir + "/" + name_or_path + ".yaml";
+  if (!fileExists(path)) {
+    std::string list;
+    for (const auto& n : scenarioNames(dir)) list += (list.empty() ? "" : ", ") + n;
+    throw std::invalid_argument("unknown profile '" + name_or_path + "' (known in " + dir + ": " + list + ")");
+  }
+  return path;
+}
+
+void applyProfileTo(const std::string& profile, core::EstimatedRunConfig& cfg) {
+  try {
+    YAML::Node root(YAML::NodeType::Map);
+    applyProfile(root, profile);  // exactly as on a scenario's blocks: here on none
+    core::TractionParams t = cfg.traction.value_or(core::TractionParams());
+    t.enabled = cfg.traction.has_value();
+    applyLoopBlocks(root, profile, t, cfg);
+    if (t.enabled)
+      cfg.traction = t;
+    else
+      cfg.traction.reset();
+  } catch (const YAML::Exception& e) {
+    fail(profile, e.what());
+  }
 }
 
 // yaml-cpp's own exceptions (a list where a word was expected, ...) become the one-line error too.

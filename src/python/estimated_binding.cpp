@@ -1,12 +1,15 @@
 // sowing_robot.core.run_estimated: core::runEstimatedLoop (core/simulation/estimated_run.h) from Python: the closed
 // loop with the traction plant, the seeded sensors and the controllers fed the truth, the encoder odometry or the EKF's
 // estimate, scored on the truth. Its blocks take the nodes' keys (plant_sim's traction/ and sensors/, state_estimator's
-// estimator/), checked by the same tables, so a key or a range reads as the node's.
+// estimator/), checked by the same tables, so a key or a range reads as the node's. profile= applies a profile file
+// (config/profiles/NAME.yaml) through the benchmark's own reading of it (bench::applyProfileTo), on top of the
+// call's blocks.
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "core_bindings.h"
+#include "sowing_robot/bench/scenario_loader.h"
 #include "sowing_robot/core/simulation/estimated_run.h"
 
 namespace py_core {
@@ -108,9 +111,10 @@ py::dict fixCounts(const FixCounts& c, long lost_from_queue) {
 
 py::dict runEstimatedPy(const std::string& controller, const py::object& params, const py::object& gains,
                         const std::string& feedback, const py::object& traction, const py::object& patches,
-                        const py::object& sensors, const py::object& estimator, double duration,
-                        std::int64_t control_period_ns, bool disturbance, double mass_scale, double inertia_scale,
-                        double noise_std, std::uint64_t seed, const std::array<double, 3>& start,
+                        const py::object& sensors, const py::object& estimator, const py::object& motor,
+                        const py::object& traction_control, const py::object& speed_governor, const py::object& profile,
+                        double duration, std::int64_t control_period_ns, bool disturbance, double mass_scale,
+                        double inertia_scale, double noise_std, std::uint64_t seed, const std::array<double, 3>& start,
                         double disturbance_phase, const std::optional<std::array<double, 3>>& line, bool keep_samples,
                         bool trace) {
   const Scenario sc = buildScenario(
@@ -127,13 +131,29 @@ py::dict runEstimatedPy(const std::string& controller, const py::object& params,
       throw py::value_error("traction: None (or leave it out) for the no-slip plant, True or a dict for traction");
     cfg.traction = t;
   }
-  if (!patches.is_none()) {
-    if (!cfg.traction) throw py::value_error("patches need traction (True or a dict)");
+  if (!sensors.is_none()) applyTableDict(sensorsTable(), cfg.sensors, "sensors/", sensors, "sensors");
+  if (!estimator.is_none()) applyTableDict(ekfTable(), cfg.estimator, "estimator/", estimator, "estimator");
+  if (!motor.is_none()) applyTableDict(motorTable(), cfg.motor, "motor/", motor, "motor");
+  if (!traction_control.is_none())
+    applyTableDict(tractionControlTable(), cfg.traction_control, "traction_control/", traction_control,
+                   "traction_control");
+  if (!speed_governor.is_none())
+    applyTableDict(speedGovernorTable(), cfg.speed_governor, "speed_governor/", speed_governor, "speed_governor");
+  std::string profile_name;
+  if (!profile.is_none()) {
+    if (!py::isinstance<py::str>(profile)) throw py::type_error("profile must be a name (\"field\") or a file path");
+    profile_name = profile.cast<std::string>();
+    try {  // the benchmark's reading of the file: its keys win over the call's
+      sowing_robot::bench::applyProfileTo(sowing_robot::bench::profilePath(profile_name, SOWING_PROFILE_DIR), cfg);
+    } catch (const std::invalid_argument& ex) {
+      throw py::value_error(ex.what());
+    }
+  }
+  if (!patches.is_none()) {  // after the profile: a coefficient left out takes the traction in force
+    if (!cfg.traction) throw py::value_error("patches need traction (True, a dict, or a profile that turns it on)");
     std::size_t i = 0;
     for (const auto& item : patches) cfg.patches.push_back(patchOf(item, *cfg.traction, i++));
   }
-  if (!sensors.is_none()) applyTableDict(sensorsTable(), cfg.sensors, "sensors/", sensors, "sensors");
-  if (!estimator.is_none()) applyTableDict(ekfTable(), cfg.estimator, "estimator/", estimator, "estimator");
   e = cfg.validate();
   if (!e.empty()) throw py::value_error(e);
 
@@ -166,6 +186,12 @@ py::dict runEstimatedPy(const std::string& controller, const py::object& params,
   d["odometry_error_final"] = r.odometry_error_final;
   d["odometry_error_max"] = r.odometry_error_max;
   d["fixes"] = fixCounts(r.fixes, r.fixes_lost_from_queue);
+  d["profile"] = profile_name;
+  d["motor"] = cfg.motor.enabled;
+  d["traction_control"] = cfg.traction_control.enabled;
+  d["speed_governor"] = cfg.speed_governor.enabled;
+  d["traction_control_time"] = r.traction_control_time;
+  d["governor_min_rate"] = r.governor_min_rate;
   if (trace) d["trace"] = columns.toDict();
   return d;
 }
@@ -177,7 +203,9 @@ void bindEstimated(py::module& m) {
     m.def("run_estimated", &runEstimatedPy, py::kw_only(), py::arg("controller") = std::string("kanayama+atsmc"),
           py::arg("params") = py::none(), py::arg("gains") = py::none(), py::arg("feedback") = std::string("fused"),
           py::arg("traction") = py::none(), py::arg("patches") = py::none(), py::arg("sensors") = py::none(),
-          py::arg("estimator") = py::none(), plant..., py::arg("keep_samples") = true, py::arg("trace") = false,
+          py::arg("estimator") = py::none(), py::arg("motor") = py::none(), py::arg("traction_control") = py::none(),
+          py::arg("speed_governor") = py::none(), py::arg("profile") = py::none(), plant...,
+          py::arg("keep_samples") = true, py::arg("trace") = false,
           R"doc(core::runEstimatedLoop: run() with an estimate in the loop, scored on the truth (as run_monitor).
 
 feedback: what the controllers are fed: "ground_truth" (then equal to run(), bit for bit), "odometry" (the
@@ -186,11 +214,17 @@ traction: None = the no-slip plant; True = the traction plant with config/tracti
 plant_sim's traction/ keys ({"mu_peak": 0.35, "draft_force": 10.0}). patches: soil patches (traction only):
 [{"polygon": [[x, y], ...], "mu_peak": 0.2, "mu_slide": 0.15, "rolling_resistance": 0.08}], a coefficient
 left out taking the traction block's. sensors: plant_sim's sensors/ keys ({"seed": 3, "fix": {"sigma":
-0.05}}); estimator: state_estimator's estimator/ keys ({"fix": {"gate": 0}}). Other arguments as run()'s.
+0.05}}); estimator: state_estimator's estimator/ keys ({"fix": {"gate": 0}}). The drive train (docs/drive_train.md):
+motor: plant_sim's motor/ keys ({"enabled": True}), traction_control: torque_controller's traction_control/ keys,
+speed_governor: reference_generator's speed_governor/ keys. profile: a profile's name ("field":
+config/profiles/field.yaml, what sim.launch profile:=field and benchmark --profile apply) or a file path, read as
+the benchmark reads it and applied on top of the blocks above (its keys win; its feedback replaces feedback=);
+patches then take the traction in force. Other arguments as run()'s.
 Returns run()'s dict plus "feedback", "traction", "max_abs_slip", "tool_down_time", "fed_error_rms",
 "fed_error_max", "fed_heading_error_max" (the fed pose against the truth), "odometry_error_final",
 "odometry_error_max", "fixes" ({"applied", "reanchored", "slip_onsets", "gated", "too_old", "future",
-"invalid", "lost_from_queue"}); with trace=True run()'s columns plus fed_x, fed_y, fed_theta, fed_v, fed_omega,
+"invalid", "lost_from_queue"}), "profile" (its name, "" for none), "motor", "traction_control", "speed_governor" (on
+or off), "traction_control_time" (s a wheel slipped beyond the target), "governor_min_rate"; with trace=True run()'s columns plus fed_x, fed_y, fed_theta, fed_v, fed_omega,
 slip_right, slip_left, tool_down. Raises ValueError for a bad name, key or value (naming the key).)doc");
   });
 }

@@ -20,7 +20,17 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
   const core::RunSettings run = loadRunSettings(nh, p);
   core::ReferenceGeneratorSettings settings;
   loadTable(p, core::ReferenceGeneratorSettings::table(), settings);
-  std::string error = settings.validate();
+  core::SpeedGovernorParams governor;  // speed_governor/...: off by default
+  loadTable(p, core::speedGovernorTable(), governor);
+  std::string error = core::firstError({settings.validate(), governor.validate()});
+  // The governor acts on the traction control's verdicts: without it none would come (in lockstep the loop
+  // would wait for them), so it is refused, as the in-process loop refuses it (EstimatedRunConfig::validate).
+  bool traction_control = false;
+  nh.param("torque_controller/traction_control/enabled", traction_control, false);
+  if (error.empty() && governor.enabled && !traction_control)
+    error = pnh.resolveName("speed_governor/enabled") + " needs " +
+            nh.resolveName("torque_controller/traction_control/enabled") +
+            " (the governor acts on the traction control's slip verdicts)";
   // The field and its obstacles are read only with type field: with type line they are refused like
   // unknown keys (a field file without `type: field` must not quietly run the line).
   core::FieldParams field;
@@ -55,7 +65,9 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
   lookahead_ = settings.lookahead;
   path_spacing_ = settings.path_spacing;
   window_ns_ = std::llround(lookahead_ * 1e9);
+  lockstep_ = run.lockstep;
   logSettings("reference_generator", core::ReferenceGeneratorSettings::table(), settings);
+  logSettings("reference_generator", core::speedGovernorTable(), governor);
   if (!settings.field) {
     source_ = std::make_unique<core::LineReference>(settings.line_v_r, settings.line_y, settings.line_x0);
   } else {
@@ -78,6 +90,11 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
     for (std::size_t i = 0; i < obstacles_.size(); ++i)
       ROS_INFO("reference_generator: obstacle %zu at (%.3f, %.3f), radius %.3f m", i, obstacles_[i].x, obstacles_[i].y,
                obstacles_[i].radius);
+  }
+  if (governor.enabled) {  // validated above: the constructor does not throw
+    auto governed = std::make_unique<core::GovernedReference>(std::move(source_), governor);
+    governor_ = governed.get();
+    source_ = std::move(governed);
   }
   if (field_) {
     ros::NodeHandle potential(pnh, "potential");
@@ -104,6 +121,12 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
   }
   publishPlan();
   clock_sub_ = nh.subscribe("/clock", 10, &ReferenceGenerator::clockCallback, this, ros::TransportHints().tcpNoDelay());
+  if (governor_) {
+    traction_sub_ = nh.subscribe("traction_control/state", kLockstepQueue, &ReferenceGenerator::tractionCallback, this,
+                                 ros::TransportHints().tcpNoDelay());
+    ROS_INFO("reference_generator: speed governor on %s%s", traction_sub_.getTopic().c_str(),
+             lockstep_ ? ": each reference waits for the verdict of the period before it" : "");
+  }
   ROS_INFO(
       "reference_generator: references on a %.6f s grid (run/control_rate), sent %.3f s ahead of /clock "
       "(lookahead)",
@@ -304,7 +327,26 @@ void ReferenceGenerator::clockCallback(const rosgraph_msgs::Clock::ConstPtr& msg
   // Forget what is behind simulated time (a late subscriber needs only the references still ahead).
   while (!sent_.empty() && static_cast<std::int64_t>(sent_.front().header.stamp.toNSec()) < now) sent_.pop_front();
   if (next_ns_ < 0 || next_ns_ < now - now % period_ns_) next_ns_ = now - now % period_ns_;  // start or jump
-  for (const std::int64_t end = now + window_ns_; next_ns_ <= end; next_ns_ += period_ns_) {
+  sendUpTo(now + window_ns_);
+}
+
+void ReferenceGenerator::tractionCallback(const TractionControlState::ConstPtr& msg) {
+  const std::int64_t stamp = static_cast<std::int64_t>(msg->header.stamp.toNSec());
+  if (stamp <= verdict_ns_) return;  // a repeat (the latched one again) or older: already reported
+  if (lockstep_ && verdict_ns_ >= 0 && stamp != verdict_ns_ + period_ns_)
+    ROS_ERROR(
+        "reference_generator: traction-control verdicts missing between t = %.6f s and %.6f s: the governed "
+        "reference no longer repeats the in-process loop's",
+        1e-9 * verdict_ns_, 1e-9 * stamp);
+  governor_->report(msg->slipping, msg->limiting, core::secondsFromNanos(period_ns_));
+  verdict_ns_ = stamp;
+  if (clock_seen_) sendUpTo(last_clock_ns_ + window_ns_);
+}
+
+void ReferenceGenerator::sendUpTo(std::int64_t end) {
+  // The governed reference at t_{k+1} needs the verdict of period k (lockstep: wait for it, never guess).
+  if (governor_ && lockstep_) end = std::min(end, verdict_ns_ < 0 ? 0 : verdict_ns_ + period_ns_);
+  for (; next_ns_ <= end; next_ns_ += period_ns_) {
     ros::Time stamp;
     stamp.fromNSec(static_cast<std::uint64_t>(next_ns_));
     sent_.emplace_back();

@@ -15,7 +15,9 @@ TorqueController::TorqueController(ros::NodeHandle nh, ros::NodeHandle pnh) {
   const core::RunSettings run = loadRunSettings(nh, p, {"mode"});  // our mode is atsmc | tsmc
   core::TorqueControllerSettings settings;
   loadTable(p, core::TorqueControllerSettings::table(), settings);
-  requireValid(p, robot_error.empty() ? settings.validate() : robot_error);
+  core::TractionControlParams traction;  // traction_control/...: off by default
+  loadTable(p, core::tractionControlTable(), traction);
+  requireValid(p, robot_error.empty() ? core::firstError({settings.validate(), traction.validate()}) : robot_error);
   const core::SlidingModeParams& params = settings.sliding;
   input_timeout_ = settings.input_timeout;
   lockstep_ = run.lockstep;  // lockstep: wait for the paired desired velocity, never time out
@@ -34,6 +36,11 @@ TorqueController::TorqueController(ros::NodeHandle nh, ros::NodeHandle pnh) {
   // The brake at a stop (validated above), at the motor's limit.
   hold_ = std::make_unique<core::StandstillHold>(settings.hold, robot, params.max_torque);
   logSettings("torque_controller", core::TorqueControllerSettings::table(), settings);
+  logSettings("torque_controller", core::tractionControlTable(), traction);
+  if (traction.enabled) {
+    traction_control_.emplace(traction, robot.L);  // validated above
+    L_ = robot.L;
+  }
   ROS_INFO("torque_controller: inner controller %s; m0_hat starts at %.4f kg, I0_hat at %.5f kg m^2; %.0f Hz",
            settings.innerName().c_str(), inner_->m0Hat(), inner_->i0Hat(), 1.0 / dt_);
   state_.mode = settings.innerName();
@@ -54,6 +61,16 @@ TorqueController::TorqueController(ros::NodeHandle nh, ros::NodeHandle pnh) {
   const auto hints = ros::TransportHints().tcpNoDelay();
   // `feedback`: the state the loop closes on, remapped by the launch (feedback:= ground_truth | odometry).
   odom_sub_ = nh.subscribe("feedback", kLockstepQueue, &TorqueController::odomCallback, this, hints);
+  if (traction_control_) {
+    // Latched: the generator's governor needs every verdict, and the first may go out before its link is up (the
+    // loop cannot pass that period without it, so the latched one is the one it waits for).
+    traction_pub_ = nh.advertise<TractionControlState>("traction_control/state", kLockstepQueue, true);
+    fed_is_odom_ = nh.resolveName("feedback") == nh.resolveName("odom");
+    if (!fed_is_odom_)
+      encoder_sub_ = nh.subscribe("odom", kLockstepQueue, &TorqueController::encoderCallback, this, hints);
+    ROS_INFO("torque_controller: traction control on: wheel speeds from %s, ground speed from %s",
+             nh.resolveName("odom").c_str(), nh.resolveName("feedback").c_str());
+  }
   desired_sub_ = nh.subscribe("desired_velocity", kLockstepQueue, &TorqueController::desiredCallback, this, hints);
   ready_ = ReadyAnnouncer(nh, pnh);  // last: everything is subscribed (ready_roster.h)
 }
@@ -63,10 +80,34 @@ void TorqueController::odomCallback(const nav_msgs::Odometry::ConstPtr& msg) {
     ROS_WARN_THROTTLE(1.0, "torque_controller: rejected non-finite odom (%ld so far)", ++rejected_);
     return;
   }
-  if (inputs_.setFirst(*msg)) {
-    compute();
+  if (!traction_control_ || fed_is_odom_) {
+    feed(*msg, *msg);
+  } else if (fed_encoders_.setFirst(*msg)) {
+    feed(fed_encoders_.first(), fed_encoders_.second());
   } else {
     holdZeroIfStale(*msg);
+  }
+}
+
+void TorqueController::encoderCallback(const nav_msgs::Odometry::ConstPtr& msg) {
+  if (!odomIsFinite(*msg)) {
+    ROS_WARN_THROTTLE(1.0, "torque_controller: rejected non-finite odom (%ld so far)", ++rejected_);
+    return;
+  }
+  if (fed_encoders_.setSecond(*msg)) feed(fed_encoders_.first(), fed_encoders_.second());
+}
+
+void TorqueController::feed(const nav_msgs::Odometry& fed, const nav_msgs::Odometry& encoders) {
+  if (traction_control_) {
+    // R W of each wheel as the in-process loop forms it from the encoders' odometry (estimated_run.cpp).
+    const double v = encoders.twist.twist.linear.x, w = encoders.twist.twist.angular.z;
+    wheel_speeds_.push_back({fed.header.stamp, v + L_ * w, v - L_ * w});
+    if (wheel_speeds_.size() > 32) wheel_speeds_.pop_front();
+  }
+  if (inputs_.setFirst(fed)) {
+    compute();
+  } else {
+    holdZeroIfStale(fed);
   }
 }
 
@@ -122,9 +163,15 @@ void TorqueController::compute() {
     out.saturated = h.saturated;
   }
   holding_ = out.holding;
+  core::WheelTorques sent = out.torques;
+  if (traction_control_) {
+    sent = limitTraction(out.torques, odom);
+    // As the in-process loop (closed_loop.h, step 4): the inner loop learns which torques were held back.
+    if (traction_control_->params().anti_windup) inner_->heldBack(sent);
+  }
   torque_.header.stamp = odom.header.stamp;
-  torque_.right = out.torques.right;
-  torque_.left = out.torques.left;
+  torque_.right = sent.right;
+  torque_.left = sent.left;
   publishShared(torque_pub_, torque_);
   if (out.saturated)
     ROS_WARN_THROTTLE(2.0, "torque_controller: wheel torque saturated at %.4g N m (%ld periods so far)",
@@ -142,6 +189,30 @@ void TorqueController::compute() {
   state_.saturated = out.saturated;
   state_.holding = out.holding;
   publishShared(state_pub_, state_);
+}
+
+core::WheelTorques TorqueController::limitTraction(const core::WheelTorques& requested, const nav_msgs::Odometry& fed) {
+  while (!wheel_speeds_.empty() && wheel_speeds_.front().stamp < fed.header.stamp) wheel_speeds_.pop_front();
+  if (wheel_speeds_.empty() || wheel_speeds_.front().stamp != fed.header.stamp) {
+    // Cannot happen: a fed state reaches the pair only with its encoders' message (feed()).
+    ROS_ERROR_THROTTLE(1.0, "torque_controller: no wheel speeds for t = %.6f s: traction control skipped",
+                       fed.header.stamp.toSec());
+    return requested;
+  }
+  const WheelSpeeds& w = wheel_speeds_.front();
+  const core::WheelGroundSpeeds m{w.right, w.left, fed.twist.twist.linear.x, fed.twist.twist.angular.z};
+  const core::WheelTorques sent = traction_control_->limit(requested, m, dt_);
+  traction_state_.header.stamp = fed.header.stamp;
+  traction_state_.slip_right = traction_control_->slip(0);
+  traction_state_.slip_left = traction_control_->slip(1);
+  traction_state_.ceiling_right = traction_control_->ceiling(0);
+  traction_state_.ceiling_left = traction_control_->ceiling(1);
+  traction_state_.requested_right = requested.right;
+  traction_state_.requested_left = requested.left;
+  traction_state_.slipping = traction_control_->slipping();
+  traction_state_.limiting = traction_control_->limiting();
+  publishShared(traction_pub_, traction_state_);  // before the torque: the governor's input for the next reference
+  return sent;
 }
 
 }  // namespace sowing_robot

@@ -57,6 +57,18 @@ CASES = [
     # a run-wide setting is set once (run/): a node's own copy that disagrees names both values
     ("torque_controller", {"control_rate": 500.0}, "disagrees with /run/control_rate = 1000.0"),
     ("plant_sim", {"duration": 60.0}, "disagrees with /run/duration = 25.0"),
+    # the drive train (issue 26): a bad value or a typo of each layer, motors that cannot move the robot, and
+    # the speed governor without the traction control whose verdicts it needs
+    ("plant_sim", {"motor/stall_torque": -1.0}, "/bad_%d/motor/stall_torque = -1"),
+    ("plant_sim", {"motor/enabld": True}, "motor/enabld"),
+    ("plant_sim", {"traction/enabled": True, "traction/rolling_resistance": 0.15, "motor/enabled": True,
+                   "motor/current_limit": 0.5}, "motor/current_limit 0.5 N"),
+    ("torque_controller", {"traction_control/cut_rate": 0.0}, "/bad_%d/traction_control/cut_rate = 0"),
+    ("torque_controller", {"traction_control/min_torque": 5.0, "traction_control/max_torque": 2.0},
+     "must not exceed traction_control/max_torque 2 N"),
+    ("reference_generator", {"speed_governor/min_rate": 1.5}, "/bad_%d/speed_governor/min_rate = 1.5"),
+    ("reference_generator", {"speed_governor/enabled": True},
+     "/bad_%d/speed_governor/enabled needs /torque_controller/traction_control/enabled"),
 ]
 
 

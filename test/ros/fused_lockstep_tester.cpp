@@ -6,6 +6,10 @@
 // bit for bit. Fails without what it protects: an in-process loop that fed the controllers at another step,
 // formed the EKF's inputs otherwise (e.g. without the quaternion round trip or the increment covariance) or
 // applied the fixes at another time gives other numbers (the printed differences say how far).
+// The drive train (issue 26) comes from the nodes' namespaces too: plant_sim's traction/ (+ field/patches) and
+// motor/, torque_controller's traction_control/, reference_generator's speed_governor/ (fused_field_lockstep.test:
+// sim.launch profile:=field on a wet stretch of the line). ~expect_drive_train: the in-process run must show the
+// traction control cutting and the governor slowing the target, so the comparison covers them at work.
 #include <gtest/gtest.h>
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
@@ -19,6 +23,7 @@
 #include "sowing_robot/ros/common/component_params.h"
 #include "sowing_robot/ros/common/msg_checks.h"
 #include "sowing_robot/ros/common/param_reader.h"
+#include "sowing_robot/ros/plant_sim/traction.h"
 
 using namespace sowing_robot;
 
@@ -41,16 +46,37 @@ TEST(FusedLockstep, NodePipelineEqualsTheInProcessEstimatedLoop) {
   ASSERT_TRUE(err.empty()) << err;
   core::EstimatedRunConfig cfg;
   cfg.feedback = core::Feedback::fused;
-  ParamReader plant(ros::NodeHandle("/plant_sim")), estimator(ros::NodeHandle("/state_estimator"));
+  ParamReader plant(ros::NodeHandle("/plant_sim")), estimator(ros::NodeHandle("/state_estimator")),
+      torque(ros::NodeHandle("/torque_controller")), reference(ros::NodeHandle("/reference_generator"));
   loadTable(plant, core::sensorsTable(), cfg.sensors);
   loadTable(estimator, core::ekfTable(), cfg.estimator);
-  ASSERT_EQ(core::firstError({plant.error(), estimator.error(), cfg.validate()}), "");
+  core::TractionParams traction;
+  loadTable(plant, core::tractionTable(), traction);
+  std::string patch_error;
+  if (traction.enabled) {
+    cfg.traction = traction;
+    patch_error = loadSoilPatches(plant, "field/patches", traction, cfg.patches);
+  }
+  loadTable(plant, core::motorTable(), cfg.motor);
+  loadTable(torque, core::tractionControlTable(), cfg.traction_control);
+  loadTable(reference, core::speedGovernorTable(), cfg.speed_governor);
+  ASSERT_EQ(core::firstError(
+                {plant.error(), estimator.error(), torque.error(), reference.error(), patch_error, cfg.validate()}),
+            "");
+  // The tool's draft needs the plan's rows and the URDF's tool point here too: not set up by this tester.
+  ASSERT_EQ(traction.draft_force, 0.0) << "this tester compares runs without the tool's draft";
   bool slip_aware = false;  // what the .test expects of state_estimator's estimator/slip/detect
   pnh.getParam("slip_aware", slip_aware);
   ASSERT_EQ(cfg.estimator.slip.detect, slip_aware);
-  std::printf("fused lockstep: pair %s, %g s, sensors seed %llu, bias state %s, slip-aware %s\n",
-              sc.controllerName().c_str(), duration, static_cast<unsigned long long>(cfg.sensors.seed),
-              cfg.estimator.estimate_bias ? "on" : "off", slip_aware ? "on" : "off");
+  bool expect_drive_train = false;
+  pnh.getParam("expect_drive_train", expect_drive_train);
+  std::printf(
+      "fused lockstep: pair %s, %g s, sensors seed %llu, bias state %s, slip-aware %s; traction %s (%zu patch(es)), motors %s, "
+      "traction control %s, speed governor %s\n",
+      sc.controllerName().c_str(), duration, static_cast<unsigned long long>(cfg.sensors.seed),
+      cfg.estimator.estimate_bias ? "on" : "off", slip_aware ? "on" : "off", cfg.traction ? "on" : "off", cfg.patches.size(),
+      cfg.motor.enabled ? "on" : "off", cfg.traction_control.enabled ? "on" : "off",
+      cfg.speed_governor.enabled ? "on" : "off");
 
   Recorded rec;
   const auto hints = ros::TransportHints().tcpNoDelay();
@@ -69,30 +95,39 @@ TEST(FusedLockstep, NodePipelineEqualsTheInProcessEstimatedLoop) {
   core::LineReference ref(1.0, 3.0, 0.0);
   double truth_diff = 0.0, estimate_diff = 0.0, fed_max = 0.0;
   std::int64_t compared = 0, unequal = 0, missing = 0;
-  core::runEstimatedLoop(sc, cfg, ref, false, [&](const core::EstimatedSample& s) {
-    const std::uint64_t k = static_cast<std::uint64_t>(std::llround(s.loop->t * 1e9));
-    const auto t = rec.truth.find(k);
-    const auto e = rec.estimate.find(k);
-    if (t == rec.truth.end() || e == rec.estimate.end()) {
-      ++missing;
-      return;
-    }
-    const core::State& x = *s.loop->state;
-    const double dt = std::max({std::fabs(t->second.x - x[core::X]), std::fabs(t->second.y - x[core::Y]),
-                                std::fabs(t->second.theta - core::yawThroughQuaternion(x[core::THETA]))});
-    const double de = std::max(
-        {std::fabs(e->second.x - s.fed.x), std::fabs(e->second.y - s.fed.y), std::fabs(e->second.theta - s.fed.theta)});
-    truth_diff = std::max(truth_diff, dt);
-    estimate_diff = std::max(estimate_diff, de);
-    fed_max = std::max(fed_max, std::hypot(s.fed.x - x[core::X], s.fed.y - x[core::Y]));
-    unequal += (dt != 0.0 || de != 0.0);
-    ++compared;
-  });
+  const core::EstimatedRunResult in_process =
+      core::runEstimatedLoop(sc, cfg, ref, false, [&](const core::EstimatedSample& s) {
+        const std::uint64_t k = static_cast<std::uint64_t>(std::llround(s.loop->t * 1e9));
+        const auto t = rec.truth.find(k);
+        const auto e = rec.estimate.find(k);
+        if (t == rec.truth.end() || e == rec.estimate.end()) {
+          ++missing;
+          return;
+        }
+        const core::State& x = *s.loop->state;
+        const double dt = std::max({std::fabs(t->second.x - x[core::X]), std::fabs(t->second.y - x[core::Y]),
+                                    std::fabs(t->second.theta - core::yawThroughQuaternion(x[core::THETA]))});
+        const double de = std::max({std::fabs(e->second.x - s.fed.x), std::fabs(e->second.y - s.fed.y),
+                                    std::fabs(e->second.theta - s.fed.theta)});
+        truth_diff = std::max(truth_diff, dt);
+        estimate_diff = std::max(estimate_diff, de);
+        fed_max = std::max(fed_max, std::hypot(s.fed.x - x[core::X], s.fed.y - x[core::Y]));
+        unequal += (dt != 0.0 || de != 0.0);
+        ++compared;
+      });
   std::printf(
       "fused lockstep: %lld periods compared (%lld missing), %lld unequal; largest difference node - in-process: "
       "truth %.3g, estimate %.3g; estimate error %.4f m\n",
       static_cast<long long>(compared), static_cast<long long>(missing), static_cast<long long>(unequal), truth_diff,
       estimate_diff, fed_max);
+  std::printf(
+      "fused lockstep: in-process max |slip| %.3f, traction control cutting %.3f s, slowest governed rate %.3f\n",
+      in_process.max_abs_slip, in_process.traction_control_time, in_process.governor_min_rate);
+  if (expect_drive_train) {
+    EXPECT_TRUE(cfg.traction && cfg.motor.enabled && cfg.traction_control.enabled && cfg.speed_governor.enabled);
+    EXPECT_GT(in_process.traction_control_time, 0.0) << "the traction control never cut: the comparison misses it";
+    EXPECT_LT(in_process.governor_min_rate, 1.0) << "the governor never slowed the target";
+  }
   EXPECT_EQ(compared, sc.steps() + 1);
   EXPECT_EQ(unequal, 0);
   EXPECT_EQ(truth_diff, 0.0);

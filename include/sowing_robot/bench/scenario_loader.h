@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "sowing_robot/core/evaluation/benchmark.h"
+#include "sowing_robot/core/simulation/estimated_run.h"
 #include "sowing_robot/core/simulation/runner.h"
 
 namespace sowing_robot {
@@ -21,10 +22,22 @@ namespace bench {
 /// Blocks traction:, sensors: (sensors/seed refused: drawn per run), estimator: and feedback: set
 /// BenchScenario::realism (docs/benchmark.md).
 /// `profile` (a file path, "" for none): a set-up applied on top of the scenario's own blocks
-/// (config/profiles/field.yaml: the recommended drive train): its blocks traction:, motor:,
-/// traction_control:, speed_governor:, sensors:, estimator: are merged key by key into the scenario's (the
-/// profile's value wins), its feedback: replaces the scenario's; the scenario's description names it.
+/// (config/profiles/field.yaml: the recommended drive train). A profile is a rosparam file (sim.launch
+/// profile:= loads it as it stands): its node blocks plant_sim/{traction, motor, sensors},
+/// torque_controller/traction_control, reference_generator/speed_governor and state_estimator/estimator are
+/// merged key by key into the scenario's blocks of those names (the profile's value wins), its
+/// profile/feedback replaces the scenario's feedback:; profile/{name, description} are its own.
 core::BenchScenario loadScenarioFile(const std::string& path, const std::string& profile = "");
+
+/// The same profile applied onto an in-process loop's configuration (the Python module's run_estimated(profile=)):
+/// each block key by key through its table over what `cfg` holds (plant_sim/traction/enabled true puts the
+/// traction plant in, with cfg's traction parameters if it had them), profile/feedback over cfg.feedback.
+/// Throws std::invalid_argument "FILE: what is wrong".
+void applyProfileTo(const std::string& profile, core::EstimatedRunConfig& cfg);
+
+/// A profile's file: `name_or_path` as it is when it is a path (contains '/' or ends with .yaml), else
+/// DIR/NAME.yaml (config/profiles: "field"); an unknown name lists the known ones (std::invalid_argument).
+std::string profilePath(const std::string& name_or_path, const std::string& dir);
 
 /// `name_or_path`: a file path (contains '/' or ends with .yaml) or a scenario name looked up as
 /// DIR/NAME.yaml; an unknown name lists the known ones.

@@ -8,6 +8,12 @@
 //   type field: core::FieldReference (rows + headland turns through the potential field) with the
 //               obstacles from the `obstacles` parameter; `obstacles` (MarkerArray) replaces them at
 //               run time, and `field_markers` (latched) shows obstacles, influence zones and rows.
+// Speed governor (speed_governor/..., core/planning/speed_governor.h; off by default): the source's time runs
+// at a rate that falls while the torque controller's traction control reports slip (`traction_control/state`)
+// and rises while the wheels grip. The reference for t_{k+1} then depends on the verdict of period k, so in
+// lockstep it is sent only once that verdict is in: the window ends one period after the last verdict (the
+// in-process loop's order, closed_loop.h). In realtime the verdicts are applied as they come, to the
+// references not yet sent.
 #pragma once
 
 #include <dynamic_reconfigure/server.h>
@@ -26,8 +32,10 @@
 #include "sowing_robot/FieldPlan.h"
 #include "sowing_robot/ReferenceGeneratorConfig.h"
 #include "sowing_robot/ReferenceState.h"
+#include "sowing_robot/TractionControlState.h"
 #include "sowing_robot/core/common/reference.h"
 #include "sowing_robot/core/planning/field.h"
+#include "sowing_robot/core/planning/speed_governor.h"
 #include "sowing_robot/ros/common/path_buffer.h"
 #include "sowing_robot/ros/common/ready_roster.h"
 
@@ -40,6 +48,11 @@ class ReferenceGenerator {
  private:
   /// Sends every reference up to the new simulated time + the window.
   void clockCallback(const rosgraph_msgs::Clock::ConstPtr& msg);
+  /// Sends the references from next_ns_ up to `end` [ns] (lockstep with the governor: up to one period after
+  /// the last verdict).
+  void sendUpTo(std::int64_t end);
+  /// The governor: the traction control's verdict of one period, for the references after it.
+  void tractionCallback(const TractionControlState::ConstPtr& msg);
   /// A late subscriber gets the references already sent for times still ahead.
   void replayTo(const ros::SingleSubscriberPublisher& sub);
   /// The source's reference at stamp into out.
@@ -56,10 +69,13 @@ class ReferenceGenerator {
   /// type field: live avoidance gains, validated like the start-up values (a rejected change keeps them).
   void reconfigure(ReferenceGeneratorConfig& config, uint32_t level);
 
-  std::unique_ptr<core::ReferenceSource> source_;
-  core::FieldReference* field_ = nullptr;  ///< source_ when type is field, else null
-  std::vector<core::Obstacle> obstacles_;  ///< the obstacles in force (type field)
-  ros::Subscriber clock_sub_, obstacles_sub_;
+  std::unique_ptr<core::ReferenceSource> source_;  ///< the reference sent (governed, with the governor)
+  core::GovernedReference* governor_ = nullptr;    ///< source_ when the speed governor is on, else null
+  bool lockstep_ = false;                          ///< run/mode
+  std::int64_t verdict_ns_ = -1;                   ///< stamp of the last traction-control verdict [ns]; -1: none
+  core::FieldReference* field_ = nullptr;          ///< source_ when type is field, else null
+  std::vector<core::Obstacle> obstacles_;          ///< the obstacles in force (type field)
+  ros::Subscriber clock_sub_, obstacles_sub_, traction_sub_;
   ros::Publisher ref_pub_, path_pub_, marker_pub_, plan_pub_;
   std::string odom_frame_ = "odom";    ///< run/odom_frame
   Eigen::Vector2d line_{0.0, 3.0};     ///< type line: (x0, y), where the open-ended row starts

@@ -4,6 +4,14 @@
 // cfg/WheelPid.cfg: the server of the controller in use). Publishes its state on ~state: the
 // sliding variables and adaptive estimates, or for the PID the same record with s_v = s_omega = 0 and
 // the nominal m0, I0 (core/control/controllers.h, InnerOutput).
+//
+// Traction control (traction_control/..., core/control/traction_control.h; off by default: today's torques)
+// caps each wheel's torque while it slips, after the inner loop, exactly as the in-process loop does
+// (core/simulation/closed_loop.h). Its slip estimate takes each wheel's speed from the encoders (`odom`, the
+// plant's encoder odometry: R W = v ± L w of its twist) and the ground speed from the fed state (`feedback`:
+// the truth, the odometry or the estimate), never the plant's hidden state; with feedback other than odom it
+// pairs the two by stamp. Each period's verdict goes out on `traction_control/state` (latched, before the
+// torque) for the reference generator's speed governor.
 #pragma once
 
 #include <dynamic_reconfigure/server.h>
@@ -12,16 +20,20 @@
 #include <ros/ros.h>
 #include "sowing_robot/ros/common/reconfigure_bridge.h"
 
+#include <deque>
 #include <memory>
+#include <optional>
 
 #include "sowing_robot/DesiredVelocity.h"
 #include "sowing_robot/TorqueControllerConfig.h"
 #include "sowing_robot/TorqueControllerState.h"
+#include "sowing_robot/TractionControlState.h"
 #include "sowing_robot/WheelPidConfig.h"
 #include "sowing_robot/WheelTorque.h"
 #include "sowing_robot/core/control/controllers.h"
 #include "sowing_robot/core/control/sliding_mode.h"
 #include "sowing_robot/core/control/standstill_hold.h"
+#include "sowing_robot/core/control/traction_control.h"
 #include "sowing_robot/ros/common/ready_roster.h"
 #include "sowing_robot/ros/common/stamp_pair.h"
 
@@ -33,8 +45,16 @@ class TorqueController {
 
  private:
   void odomCallback(const nav_msgs::Odometry::ConstPtr& msg);
+  /// Traction control with feedback other than odom: the encoders' odometry, paired with the fed state.
+  void encoderCallback(const nav_msgs::Odometry::ConstPtr& msg);
+  /// The fed state `fed` on to the pair with the desired velocity; `encoders`: the odom message of its stamp
+  /// (the traction control's wheel speeds), kept until that stamp is computed.
+  void feed(const nav_msgs::Odometry& fed, const nav_msgs::Odometry& encoders);
   void desiredCallback(const DesiredVelocity::ConstPtr& msg);
   void compute();
+  /// The traction control on the inner loop's torques for the fed state `fed` (its wheel speeds from
+  /// wheel_speeds_); publishes its state; returns the torques to send.
+  core::WheelTorques limitTraction(const core::WheelTorques& requested, const nav_msgs::Odometry& fed);
   /// Realtime only: zero torque for this odom stamp when the desired velocity is older than input_timeout.
   bool holdZeroIfStale(const nav_msgs::Odometry& odom);
 
@@ -50,8 +70,19 @@ class TorqueController {
   // Live gains (reconfigure_bridge.h): validated like the start-up values, a rejected change keeps the old.
   std::unique_ptr<ReconfigureServer<TorqueControllerConfig>> smc_reconfigure_;
   std::unique_ptr<ReconfigureServer<WheelPidConfig>> pid_reconfigure_;
-  ros::Subscriber odom_sub_, desired_sub_;
-  ros::Publisher torque_pub_, state_pub_;
+  ros::Subscriber odom_sub_, desired_sub_, encoder_sub_;
+  ros::Publisher torque_pub_, state_pub_, traction_pub_;
+  // Traction control (unset: off).
+  std::optional<core::TractionControl> traction_control_;
+  double L_ = 0.0;            // nominal half track [m] (URDF): R W = v ± L w of the encoders' twist
+  bool fed_is_odom_ = false;  // the feedback topic is odom itself: no pairing needed
+  StampPair<nav_msgs::Odometry, nav_msgs::Odometry, 16, 16> fed_encoders_;  // (feedback, odom) by stamp
+  struct WheelSpeeds {
+    ros::Time stamp;
+    double right, left;  // R W [m/s]
+  };
+  std::deque<WheelSpeeds> wheel_speeds_;  // of the fed states on their way to a pair, oldest first
+  TractionControlState traction_state_;
   StampPair<nav_msgs::Odometry, DesiredVelocity> inputs_;
   WheelTorque torque_;
   TorqueControllerState state_;

@@ -7,10 +7,13 @@
 #include <sstream>
 
 #include "sowing_robot/core/control/cmd_vel_input.h"
+#include "sowing_robot/core/control/traction_control.h"
 #include "sowing_robot/core/estimation/ekf.h"
+#include "sowing_robot/core/model/motor.h"
 #include "sowing_robot/core/model/sensors.h"
 #include "sowing_robot/core/model/traction.h"
 #include "sowing_robot/core/planning/field.h"
+#include "sowing_robot/core/planning/speed_governor.h"
 #include "sowing_robot/core/settings/node_settings.h"
 
 namespace sowing_robot {
@@ -32,17 +35,11 @@ std::vector<ParamInfo> infos(const ParamTable<S>& table) {
   return out;
 }
 
-template <typename A, typename B>
-std::vector<ParamInfo> concat(const ParamTable<A>& a, const ParamTable<B>& b) {
-  std::vector<ParamInfo> out = infos(a), more = infos(b);
-  out.insert(out.end(), more.begin(), more.end());
-  return out;
-}
-
-template <typename A, typename B, typename C>
-std::vector<ParamInfo> concat(const ParamTable<A>& a, const ParamTable<B>& b, const ParamTable<C>& c) {
-  std::vector<ParamInfo> out = concat(a, b), more = infos(c);
-  out.insert(out.end(), more.begin(), more.end());
+/// The tables' parameters one after the other.
+template <typename... Tables>
+std::vector<ParamInfo> concat(const Tables&... tables) {
+  std::vector<ParamInfo> out;
+  for (const std::vector<ParamInfo>& part : {infos(tables)...}) out.insert(out.end(), part.begin(), part.end());
   return out;
 }
 
@@ -102,9 +99,11 @@ const std::vector<CatalogSection>& parameterCatalog() {
        {}},
       {"plant_sim",
        "the plant: its two drivers' timing, the start pose, the disturbance and the mismatch, the opt-in "
-       "wheel-soil traction (traction/, config/traction.yaml) with the field's soil patches (field/patches), and "
-       "sensors/: what the robot measures of itself; the geometry and inertia come from the URDF (robot_description)",
-       concat(PlantSimSettings::table(), tractionTable(), sensorsTable()),
+       "wheel-soil traction (traction/, config/traction.yaml) with the field's soil patches (field/patches), "
+       "sensors/: what the robot measures of itself, and the opt-in drive motors (motor/, core/model/motor.h: "
+       "their data-sheet figures; the torque they apply goes out on applied_torque); the geometry and inertia "
+       "come from the URDF (robot_description)",
+       concat(PlantSimSettings::table(), tractionTable(), sensorsTable(), motorTable()),
        {"field/patches"}},
       {"kinematic_controller",
        "the outer loop, chosen by `outer`: Kanayama (eqs 4.1-4.2; kx, ky, ktheta live-tunable), pure pursuit or "
@@ -118,8 +117,10 @@ const std::vector<CatalogSection>& parameterCatalog() {
        "atsmc or tsmc; gains live-tunable) or the wheel-velocity PID (gains live-tunable, cfg/WheelPid.cfg). "
        "Unmarked parameters are the "
        "sliding-mode controller's, [pid] ones the PID's; max_torque (the motor's limit) is both's; the parameters "
-       "of the controller not selected are checked but inert",
-       infos(TorqueControllerSettings::table()),
+       "of the controller not selected are checked but inert. traction_control/ (opt-in, "
+       "core/control/traction_control.h) caps a slipping wheel's torque after either of them; its state goes out "
+       "on traction_control/state",
+       concat(TorqueControllerSettings::table(), tractionControlTable()),
        {}},
       {"cmd_vel_limiter",
        "velocity mode (sim.launch input:=cmd_vel, config/cmd_vel.yaml, docs/interfaces.md): cmd_vel through the "
@@ -129,8 +130,10 @@ const std::vector<CatalogSection>& parameterCatalog() {
        {}},
       {"reference_generator",
        "the reference: the thesis line, or a field of rows through the potential field "
-       "(field/ and potential/ keys and obstacles are read only with type field)",
-       concat(ReferenceGeneratorSettings::table(), fieldTable()),
+       "(field/ and potential/ keys and obstacles are read only with type field); speed_governor/ (opt-in, "
+       "core/planning/speed_governor.h; needs torque_controller/traction_control/enabled) slows either while the "
+       "wheels slip",
+       concat(ReferenceGeneratorSettings::table(), fieldTable(), speedGovernorTable()),
        {"obstacles"}},
       {"seed_drill",
        "the seed drill: spacing and scoring of the seeds against the plan",

@@ -1,5 +1,6 @@
 #include "sowing_robot/ros/plant_sim/plant_sim.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "sowing_robot/core/common/validation.h"
@@ -47,6 +48,9 @@ PlantSim::PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh) {
   const std::string patch_error = loadSoilPatches(p, "field/patches", traction.traction, patches);
   core::SensorParams sensors;
   loadTable(p, core::sensorsTable(), sensors);
+  // The drive motors (motor/...): between the torques commanded and the wheels, off by default (today's plant).
+  core::MotorParams motor;
+  loadTable(p, core::motorTable(), motor);
   // The body checked for contacts is the URDF's collision footprint (the one source of the robot's shape).
   core::Footprint footprint;
   std::string key, xml, footprint_error;
@@ -55,9 +59,18 @@ PlantSim::PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh) {
   const std::string tool_error = traction.traction.enabled && traction.traction.draft_force > 0.0 && robot_error.empty()
                                      ? loadToolSettings(nh, xml, traction)
                                      : "";
-  requireValid(p, core::firstError({robot_error, robot_error.empty() ? robot.validate() : "", footprint_error,
-                                    settings.validate(), traction.traction.validate(), patch_error, tool_error,
-                                    sensors.validate()}));
+  std::string error =
+      core::firstError({robot_error, robot_error.empty() ? robot.validate() : "", footprint_error, settings.validate(),
+                        traction.traction.validate(), patch_error, tool_error, sensors.validate(), motor.validate()});
+  if (error.empty() && p.error().empty() && traction.traction.enabled) {
+    // Motors that cannot move the robot against the worst soil's rolling resistance and the draft are refused,
+    // as the in-process loop refuses them (core::runEstimatedLoop).
+    double rolling = traction.traction.rolling_resistance;
+    for (const core::SoilPatch& patch : patches) rolling = std::max(rolling, patch.rolling_resistance);
+    error =
+        core::checkMotorsCanMove(motor, robot, settings.disturbance.mass_scale, rolling, traction.traction.draft_force);
+  }
+  requireValid(p, error);
   cfg_.lockstep = run.lockstep;
   cfg_.period_ns = run.periodNs();
   cfg_.duration = run.duration;
@@ -98,6 +111,7 @@ PlantSim::PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh) {
              patches.size());
   }
   plant_ = std::make_unique<SimulatedPlant>(nh, robot, disturbance, start, rates, footprint, std::move(model), sensors);
+  plant_->setMotor(motor);  // validated above
   const PlantModel& plant = plant_->model();
   logSettings("plant_sim", core::RunSettings::table(), run, "run/");
   logSettings("plant_sim", core::PlantSimSettings::table(), settings);
@@ -107,6 +121,7 @@ PlantSim::PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh) {
     ROS_INFO("plant_sim: traction plant with %zu soil patch(es); tool point (%.3f, %.3f) m", patches.size(),
              traction.tool.x(), traction.tool.y());
   }
+  logSettings("plant_sim", core::motorTable(), motor);
   ROS_INFO("plant_sim: m0 %.4f kg (true %.4f), I0 %.5f kg m^2 (true %.5f)", robot.m0(), plant.trueM0(), robot.I0(),
            plant.trueI0());
 

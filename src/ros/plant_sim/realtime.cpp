@@ -63,7 +63,7 @@ void RealtimeDriver::run() {
       ROS_WARN_THROTTLE(2.0, "plant_sim: no wheel_torque for %.3f s (timeout %.3f s): applying zero torque",
                         (stamp - torque_stamp_).toSec(), cfg_.torque_timeout);
     }
-    if (!plant_.step(u)) throw NodeFailure(ExitCode::kDiverged, plant_.divergence());
+    if (!plant_.step(u, stamp)) throw NodeFailure(ExitCode::kDiverged, plant_.divergence());
   }
 }
 

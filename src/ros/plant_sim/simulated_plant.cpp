@@ -32,6 +32,7 @@ SimulatedPlant::SimulatedPlant(ros::NodeHandle nh, const core::RobotParams& robo
   clock_pub_ = nh.advertise<rosgraph_msgs::Clock>("/clock", 10);
   truth_pub_ = nh.advertise<nav_msgs::Odometry>("ground_truth", kLockstepQueue);
   joint_pub_ = nh.advertise<sensor_msgs::JointState>("joint_states", 10);
+  applied_pub_ = nh.advertise<WheelTorque>("applied_torque", kLockstepQueue);
   path_pub_ = nh.advertise<nav_msgs::Path>("travelled_path", 1, true);
 
   truth_msg_.header.frame_id = rates.odom_frame;
@@ -40,6 +41,7 @@ SimulatedPlant::SimulatedPlant(ros::NodeHandle nh, const core::RobotParams& robo
   joint_msg_.name = {"right_wheel_joint", "left_wheel_joint"};
   joint_msg_.position.resize(2);
   joint_msg_.velocity.resize(2);
+  joint_msg_.effort.resize(2);
   contacts_ = std::make_unique<PlantContacts>(nh, footprint, rates.odom_frame, rates.base_frame);
 }
 
@@ -49,6 +51,8 @@ SimulatedPlant::~SimulatedPlant() {
   std::printf("plant_sim: %s", contacts_->finish().c_str());  // the report ends with a newline
   const std::string model = model_->report();
   if (!model.empty()) std::printf("plant_sim: %s\n", model.c_str());
+  const std::string motors = motorReport();
+  if (!motors.empty()) std::printf("plant_sim: %s\n", motors.c_str());
   std::fflush(stdout);
 }
 
@@ -60,6 +64,22 @@ void SimulatedPlant::reportContacts() {
   ROS_INFO("plant_sim: %s", report.c_str());
   const std::string model = model_->report();
   if (!model.empty()) ROS_INFO("plant_sim: %s", model.c_str());
+  const std::string motors = motorReport();
+  if (!motors.empty()) ROS_INFO("plant_sim: %s", motors.c_str());
+}
+
+void SimulatedPlant::setMotor(const core::MotorParams& motor) {
+  model_->setMotor(motor);
+  motors_ = motor.enabled;
+}
+
+std::string SimulatedPlant::motorReport() const {
+  if (!motors_) return "";
+  char text[160];
+  std::snprintf(text, sizeof text,
+                "motors: the applied torque differed from the command (band or lag) in %lld of %lld steps",
+                static_cast<long long>(motor_limited_steps_), static_cast<long long>(steps_));
+  return text;
 }
 
 ros::Time SimulatedPlant::stampOf(std::int64_t k) const {
@@ -68,9 +88,14 @@ ros::Time SimulatedPlant::stampOf(std::int64_t k) const {
   return t;
 }
 
-bool SimulatedPlant::step(const core::WheelTorques& torque) {
+bool SimulatedPlant::step(const core::WheelTorques& torque, const ros::Time& stamp) {
   model_->step(torque.right, torque.left, dt());
   if (!healthy()) return false;
+  applied_msg_.header.stamp = stamp;
+  model_->appliedTorques(applied_msg_.right, applied_msg_.left);
+  publishShared(applied_pub_, applied_msg_);
+  ++steps_;
+  if (applied_msg_.right != torque.right || applied_msg_.left != torque.left) ++motor_limited_steps_;
   const core::State& s = model_->state();
   contacts_->update(model_->time(), {s[core::X], s[core::Y], s[core::THETA]});
   // The sensors on the stamp grid (the fix's rate and latency are counted in stamps, not summed dt).
@@ -120,6 +145,8 @@ void SimulatedPlant::publish(std::int64_t k, bool visuals, bool clock) {
   joint_msg_.position[0] = s[core::PHI_R];
   joint_msg_.position[1] = s[core::PHI_L];
   model_->wheelRates(joint_msg_.velocity[0], joint_msg_.velocity[1]);
+  joint_msg_.effort[0] = applied_msg_.right;  // the motors' torque over the step that led here
+  joint_msg_.effort[1] = applied_msg_.left;
   joint_pub_.publish(joint_msg_);
   model_->publishVisuals(stamp);
 

@@ -316,8 +316,10 @@ TEST(ScenarioLoader, AProfileGoesOnTopOfTheScenariosBlocks) {
   EXPECT_TRUE(wet.realism->motor.enabled);
   EXPECT_TRUE(wet.realism->traction_control.enabled);
   EXPECT_TRUE(wet.realism->speed_governor.enabled);
+  EXPECT_EQ(wet.realism->feedback, core::Feedback::fused);
   EXPECT_TRUE(wet.realism->estimator.slip.detect);  // the slip-aware estimator (used with feedback fused)
-  EXPECT_FALSE(wet.realism->patches.empty());       // the field file's patches, with traction on
+  EXPECT_TRUE(wet.realism->hitch_control.enabled);
+  EXPECT_FALSE(wet.realism->patches.empty());  // the field file's patches, with traction on
   EXPECT_FALSE(bench::loadScenario("wet_soil", kSuite).realism->motor.enabled);
   EXPECT_FALSE(bench::loadScenario("wet_soil", kSuite).realism->estimator.slip.detect);
   const BenchScenario line = bench::loadScenario("thesis_line", kSuite, field);  // no blocks of its own
@@ -326,15 +328,51 @@ TEST(ScenarioLoader, AProfileGoesOnTopOfTheScenariosBlocks) {
   EXPECT_TRUE(line.realism->motor.enabled);
   EXPECT_EQ(line.validate(), "");
   TempDir dir;
-  const std::string bad = dir.write("bad.yaml", "name: bad\nmotor: {enabld: true}\n");
+  const std::string bad = dir.write("bad.yaml", "profile: {name: bad}\nplant_sim:\n  motor: {enabld: true}\n");
   try {
     bench::loadScenario("wet_soil", kSuite, bad);
     ADD_FAILURE() << "not refused";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("motor/enabld"), std::string::npos) << e.what();
   }
-  const std::string stray = dir.write("stray.yaml", "name: stray\nduration: 3\n");
+  const std::string stray = dir.write("stray.yaml", "profile: {name: stray}\nduration: 3\n");
   EXPECT_THROW(bench::loadScenario("wet_soil", kSuite, stray), std::invalid_argument);
+  // A block a node does not own (the plant's motor under the torque controller) is refused by name.
+  const std::string misplaced =
+      dir.write("misplaced.yaml", "profile: {name: misplaced}\ntorque_controller:\n  motor: {enabled: true}\n");
+  try {
+    bench::loadScenario("wet_soil", kSuite, misplaced);
+    ADD_FAILURE() << "not refused";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("torque_controller/motor"), std::string::npos) << e.what();
+  }
+}
+
+// The same profile onto an in-process configuration (Python's run_estimated(profile=)): its blocks over what the
+// configuration holds, through the same reading as the benchmark's.
+TEST(ScenarioLoader, AProfileAppliesToAnInProcessConfiguration) {
+  const std::string field = bench::profilePath("field", kSource + "/config/profiles");
+  EXPECT_EQ(field, kSource + "/config/profiles/field.yaml");
+  core::EstimatedRunConfig cfg;
+  core::TractionParams wet;
+  wet.mu_peak = 0.25;
+  wet.mu_slide = 0.2;
+  cfg.traction = wet;
+  cfg.motor.stall_torque = 30.0;
+  bench::applyProfileTo(field, cfg);
+  ASSERT_TRUE(cfg.traction);
+  EXPECT_EQ(cfg.traction->mu_peak, 0.25);  // the caller's own key stays
+  EXPECT_TRUE(cfg.motor.enabled);
+  EXPECT_EQ(cfg.motor.stall_torque, 30.0);
+  EXPECT_TRUE(cfg.traction_control.enabled);
+  EXPECT_TRUE(cfg.speed_governor.enabled);
+  EXPECT_EQ(cfg.feedback, core::Feedback::fused);
+  EXPECT_EQ(cfg.validate(), "");
+  core::EstimatedRunConfig bare;  // no traction of its own: the profile's with the defaults
+  bench::applyProfileTo(field, bare);
+  ASSERT_TRUE(bare.traction);
+  EXPECT_EQ(bare.traction->mu_peak, core::TractionParams().mu_peak);
+  EXPECT_THROW(bench::profilePath("feild", kSource + "/config/profiles"), std::invalid_argument);
 }
 
 // The hitch control's block in a scenario or a profile, through its table; the field profile turns it on.

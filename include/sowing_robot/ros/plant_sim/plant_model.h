@@ -21,6 +21,12 @@ class PlantModel {
   virtual double time() const = 0;
   /// The wheels' spin rates [rad/s] (joint_states velocity).
   virtual void wheelRates(double& right, double& left) const = 0;
+  /// The drive motors (core/model/motor.h) between the commanded torques and the wheels, from the next step on.
+  /// Throws std::invalid_argument when the parameters do not validate.
+  virtual void setMotor(const core::MotorParams& motor) = 0;
+  /// The torques [N·m] the motors applied over the last step (the traction plant: its last sub-step), before
+  /// the disturbance and the noise; with the motors off, the commanded ones.
+  virtual void appliedTorques(double& right, double& left) const = 0;
   /// The plant's true m0 [kg] and I0 [kg m^2] (the controllers' model times the mismatch), for the log.
   virtual double trueM0() const = 0;
   virtual double trueI0() const = 0;
@@ -48,6 +54,11 @@ class NoSlipModel : public PlantModel {
     const core::State ds = plant_.derivative(plant_.state(), 0.0, 0.0);  // wheel rates do not depend on torque
     right = ds[core::PHI_R];
     left = ds[core::PHI_L];
+  }
+  void setMotor(const core::MotorParams& motor) override { plant_.setMotor(motor); }
+  void appliedTorques(double& right, double& left) const override {
+    right = plant_.appliedTorque(0);
+    left = plant_.appliedTorque(1);
   }
   double trueM0() const override { return plant_.trueM0(); }
   double trueI0() const override { return plant_.trueI0(); }

@@ -3,6 +3,11 @@
 // state (ground_truth, /clock, tf, joint_states, the travelled path) and what its sensors read of it (odom,
 // imu, fix: plant_sensors.h). Which step
 // comes when, and with which torque, is the drivers' business (plant_sim_realtime.h, plant_sim_lockstep.h).
+//
+// The drive motors (motor/..., core/model/motor.h) sit in the model between the commanded torques and the
+// wheels. What they applied goes out beside the command: `applied_torque` (sowing_robot/WheelTorque, every
+// step, stamped with the command's stamp: the torque of the step from that state on; with the motors off,
+// the command itself) and joint_states' effort (at publish_rate: the torque of the step that led to the state).
 #pragma once
 
 #include <nav_msgs/Odometry.h>
@@ -14,6 +19,7 @@
 #include <memory>
 #include <string>
 
+#include "sowing_robot/WheelTorque.h"
 #include "sowing_robot/core/common/types.h"
 #include "sowing_robot/core/model/plant.h"
 #include "sowing_robot/core/model/robot_params.h"
@@ -44,12 +50,17 @@ class SimulatedPlant {
   static core::State restAt(const core::Pose2D& start);
   /// Prints the contact report if the run did not (a realtime run, or one stopped early).
   ~SimulatedPlant();
-  /// The contact report (contacts of the body, minimum clearance) as one log line, once.
+  /// The contact report (contacts of the body, minimum clearance) as one log line, once; the model's and
+  /// the motors' lines after it.
   void reportContacts();
+  /// The drive motors between the commands and the wheels (before the first step). Throws
+  /// std::invalid_argument when the parameters do not validate.
+  void setMotor(const core::MotorParams& motor);
 
-  /// One control period with `torque`; false when the state is then non-finite or faster than max_speed
-  /// (it must not be published: divergence() says what went wrong).
-  bool step(const core::WheelTorques& torque);
+  /// One control period with `torque` (the command answering the state stamped `stamp`); publishes what the
+  /// motors applied on applied_torque, stamped `stamp`. False when the state is then non-finite or faster than
+  /// max_speed (it must not be published: divergence() says what went wrong).
+  bool step(const core::WheelTorques& torque, const ros::Time& stamp);
   /// The state as step k (stamped stampOf(k)): ground_truth and the sensors' odom, imu and due fixes; tf
   /// (odom -> base_link from the encoders' odom), joint_states and the true path too with `visuals`;
   /// /clock every clock_rate, with visuals, or when `clock` is set.
@@ -70,19 +81,24 @@ class SimulatedPlant {
 
  private:
   bool healthy() const;
+  /// "motors: ..." for the end-of-run report ("" with the motors off).
+  std::string motorReport() const;
 
   Rates rates_;
   std::unique_ptr<PlantModel> model_;
   std::int64_t visual_every_ = 20;  // publish visuals every n steps
   std::int64_t clock_every_ = 1;    // publish /clock every n steps
-  ros::Publisher clock_pub_, truth_pub_, joint_pub_, path_pub_;
+  ros::Publisher clock_pub_, truth_pub_, joint_pub_, path_pub_, applied_pub_;
   std::unique_ptr<PlantSensors> sensors_;    // encoders, gyro, fix: read every step()
   std::unique_ptr<PlantContacts> contacts_;  // the body against the plan's obstacles, every step
   bool contacts_reported_ = false;
   tf2_ros::TransformBroadcaster tf_;
   nav_msgs::Odometry truth_msg_;
   sensor_msgs::JointState joint_msg_;
-  PathBuffer path_{"odom", 0.05, 10};  // a point every 5 cm, re-sent every 10th point
+  WheelTorque applied_msg_;
+  bool motors_ = false;                               // motor/enabled
+  std::int64_t steps_ = 0, motor_limited_steps_ = 0;  // steps, and those where a motor applied less than commanded
+  PathBuffer path_{"odom", 0.05, 10};                 // a point every 5 cm, re-sent every 10th point
 };
 
 }  // namespace sowing_robot

@@ -52,6 +52,11 @@ class TractionModel : public PlantModel {
     right = plant_.wheelRate(core::RIGHT);
     left = plant_.wheelRate(core::LEFT);
   }
+  void setMotor(const core::MotorParams& motor) override { plant_.setMotor(motor); }
+  void appliedTorques(double& right, double& left) const override {
+    right = plant_.appliedTorque(core::RIGHT);
+    left = plant_.appliedTorque(core::LEFT);
+  }
   double trueM0() const override { return m0_; }
   double trueI0() const override { return i0_; }
   bool ready() const override;
