@@ -383,11 +383,11 @@ TEST(ScenarioLoader, TheHitchControlBlockIsRead) {
   EXPECT_FALSE(bench::loadScenario("wet_soil", kSuite).realism->hitch_control.enabled);
   TempDir dir;
   const std::string prof = dir.write("p.yaml",
-                                     "name: p\ntraction_control: {enabled: true}\n"
-                                     "hitch_control: {enabled: true, lower_after: 7.5}\n");
+                                     "profile: {name: p}\ntorque_controller: {traction_control: {enabled: true}}\n"
+                                     "plant_sim: {hitch_control: {enabled: true, lower_after: 7.5}}\n");
   const BenchScenario b = bench::loadScenario("wet_soil", kSuite, prof);
   EXPECT_EQ(b.realism->hitch_control.lower_after, 7.5);
-  const std::string bad = dir.write("bad.yaml", "name: bad\nhitch_control: {lower_after: -1}\n");
+  const std::string bad = dir.write("bad.yaml", "profile: {name: bad}\nplant_sim: {hitch_control: {lower_after: -1}}\n");
   try {
     bench::loadScenario("wet_soil", kSuite, bad);
     ADD_FAILURE() << "not refused";
