@@ -232,9 +232,11 @@ void StateEstimator::publish(const nav_msgs::Odometry& odom, const sensor_msgs::
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) pc[6 * idx[i] + idx[j]] = p(i, j);
   pc[6 * 2 + 2] = pc[6 * 3 + 3] = pc[6 * 4 + 4] = 1e6;
-  // Twist: the encoders' speed (slip biases it, as it does the odometry) and the gyro's rate less the
-  // estimated bias.
+  // Twist: the encoders' speed (slip biases it, as it does the odometry), or the slip-aware filter's ground
+  // speed and its variance (Ekf::fedSpeed), and the gyro's rate less the estimated bias.
   filtered_.twist = odom.twist;
+  filtered_.twist.twist.linear.x = ekf_.fedSpeed(odom.twist.twist.linear.x);
+  if (ekf_.params().slip.detect) filtered_.twist.covariance[0] = ekf_.slipCovariance()(core::kSpeed, core::kSpeed);
   filtered_.twist.twist.angular.z = rate - m(core::Ekf::BIAS);
   filtered_.twist.covariance[35] =
       p(core::Ekf::BIAS, core::Ekf::BIAS) + knownVariance(imu.angular_velocity_covariance[8]);

@@ -100,11 +100,8 @@ class SensorFeed {
     } else if (ekf_) {
       fuse(t, odom_pose);
       const Ekf::Vector& m = ekf_->mean();
-      const double omega = yaw_rate_ - m(Ekf::BIAS);
-      fed = {{m(Ekf::X), m(Ekf::Y), yawThroughQuaternion(m(Ekf::THETA))},
-             odom.v,
-             omega,
-             {wheel_r, wheel_l, odom.v, omega}};
+      const double omega = yaw_rate_ - m(Ekf::BIAS), v = ekf_->fedSpeed(odom.v);
+      fed = {{m(Ekf::X), m(Ekf::Y), yawThroughQuaternion(m(Ekf::THETA))}, v, omega, {wheel_r, wheel_l, v, omega}};
     }
     const double error = std::hypot(fed.pose.x - s[X], fed.pose.y - s[Y]);
     fed_sq_ += error * error;
