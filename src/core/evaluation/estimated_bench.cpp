@@ -91,6 +91,8 @@ RunRow estimatedBenchRow(const BenchScenario& bench, std::int64_t index) {
   // runField with traction).
   cfg.tool_rows = rowsOf(bench.field);
   cfg.tool_rows_open_ended = false;
+  // The finish check reads the path's time: a robot the governor slowed for grip gets that time back.
+  cfg.governed_time_back = true;
   return fieldRow(bench, sc, extras,
                   [&cfg, &spec, &draw](const Scenario& s, ReferenceSource& reference, const RunExtras& e) {
                     return measureEstimated(s, cfg, reference, spec, draw, e);

@@ -229,6 +229,7 @@ EstimatedRunResult run(const Scenario& sc, const EstimatedRunConfig& cfg, PlantT
   if (cfg.speed_governor.enabled) {
     governed.emplace(reference, cfg.speed_governor);
     layers.governor = &*governed;
+    layers.governed_time_back = cfg.governed_time_back;
   }
   EstimatedRunResult out = closedLoop(sc, plant, feed, *outer, *inner, governed ? *governed : reference, keep_samples,
                                       trace, RunStop{}, layers);

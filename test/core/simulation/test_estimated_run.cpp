@@ -349,6 +349,36 @@ TEST(EstimatedRun, TractionControlKeepsTheWheelsNearThePeak) {
   EXPECT_THROW(runEstimatedLoop(sc, cfg, ref, false), std::invalid_argument);  // a governor needs the control
 }
 
+// governed_time_back (the benchmark's field runs): a run the governor slowed lasts until the governed path
+// time has run the scenario's duration, so the path is judged at the same point as an ungoverned one; without
+// it the run ends at the duration with the target short of it. Never longer than twice the duration.
+TEST(EstimatedRun, AGovernedRunGetsTheTimeTheGovernorTookBack) {
+  Scenario sc = line(OuterKind::kanayama, InnerKind::sliding_mode, true);
+  sc.duration = 8.0;
+  EstimatedRunConfig cfg;
+  TractionParams wet;
+  wet.mu_peak = 0.2;
+  wet.mu_slide = 0.15;
+  cfg.traction = wet;
+  cfg.motor.enabled = true;
+  cfg.traction_control.enabled = true;
+  cfg.speed_governor.enabled = true;
+  LineReference plain_ref, back_ref;
+  const EstimatedRunResult plain = runEstimatedLoop(sc, cfg, plain_ref, false);
+  cfg.governed_time_back = true;
+  const EstimatedRunResult back = runEstimatedLoop(sc, cfg, back_ref, false);
+  std::printf("governed: slowest rate %.2f; periods %ld without, %ld with the time back (duration %ld); path time "
+              "%.3f s / %.3f s\n",
+              plain.governor_min_rate, static_cast<long>(plain.run.periods), static_cast<long>(back.run.periods),
+              static_cast<long>(sc.steps()), plain_ref.lastTime(), back_ref.lastTime());
+  ASSERT_LT(plain.governor_min_rate, 1.0);  // the governor did slow the target
+  EXPECT_EQ(plain.run.periods, sc.steps());
+  EXPECT_LT(plain_ref.lastTime(), sc.duration - 0.1);  // the target short of the path's time
+  EXPECT_GT(back.run.periods, plain.run.periods);
+  EXPECT_LE(back.run.periods, 2 * sc.steps());
+  EXPECT_GE(back_ref.lastTime(), sc.duration - 0.01);  // the path has run its duration (to within a period)
+}
+
 // Slip-limit hitch control in the loop (FIELD.md's grip budget): on a patch where the wheels' peak grip
 // cannot pull the tool's draft (mu 0.2 at mass 1.3: 38.7 N against 18.4 N of rolling resistance plus a 25 N
 // draft) the robot with the tool kept down stalls behind its target; with the hitch the traction control's

@@ -18,7 +18,7 @@
 //      traction: from the next period on the robot is held (a stop hold whatever the reference), and
 //      the run ends traction_control/no_traction_hold later;
 //   6. the trace sees the period; the caller's stop() may end the run here (every kStopCheckEvery);
-//   7. the plant steps (k < n; its motors, if on, between the torques sent and the wheels), then the
+//   7. the plant steps (k < n, n grown by the time a speed governor took back with governed_time_back; its motors, if on, between the torques sent and the wheels), then the
 //      sensors see the new state at t_{k+1}.
 //
 // The parts are template parameters, so the per-period calls are direct:
@@ -114,6 +114,9 @@ struct LoopLayers {
   GovernedReference* governor = nullptr;        ///< the reference the loop is given, governed
   HitchControl* hitch = nullptr;                ///< raises the tool on the traction control's grip verdict
   TractionMonitor* monitor = nullptr;           ///< the traction control's progress check (needs it)
+  /// With the governor: the run lasts until the governed time has run the scenario's duration, at most twice
+  /// its duration (EstimatedRunConfig::governed_time_back).
+  bool governed_time_back = false;
   /// Traction plant: a period after which either wheel's |slip ratio| exceeds this counts to high_slip_time.
   double high_slip = std::numeric_limits<double>::infinity();
 };
@@ -164,7 +167,8 @@ EstimatedRunResult closedLoop(const Scenario& sc, PlantT& plant, Feed& feed, Out
   StandstillHold hold(sc.hold, sc.robot, sc.inner == InnerKind::pid ? sc.pid.max_torque : sc.sliding.max_torque);
   bool holding = false;
 
-  for (std::int64_t k = 0; k <= n; ++k) {
+  std::int64_t last = n;  // the last period: n, or later by the time a governor took back (governed_time_back)
+  for (std::int64_t k = 0; k <= last; ++k) {
     const double t = secondsFromNanos(k * sc.control_period_ns);
     const State& s = plant.state();
     if (!finiteSum(s)) {
@@ -198,6 +202,10 @@ EstimatedRunResult closedLoop(const Scenario& sc, PlantT& plant, Feed& feed, Out
       if (layers.governor) {
         layers.governor->report(tc->slipping(), tc->limiting(), dt);
         out.governor_min_rate = std::min(out.governor_min_rate, layers.governor->rate());
+        if (layers.governed_time_back) {  // the path time lost so far, in whole periods (it never shrinks)
+          const double lost = t - layers.governor->governedTime();
+          last = std::min(2 * n, n + static_cast<std::int64_t>(std::ceil(lost / dt - 1e-9)));
+        }
       }
       if (layers.monitor && !no_traction && layers.monitor->update(t, fed.pose, !cmd.hold, tc->slipping(), dt)) {
         out.no_traction = layers.monitor->report();
@@ -207,7 +215,7 @@ EstimatedRunResult closedLoop(const Scenario& sc, PlantT& plant, Feed& feed, Out
     bool tool_down = false;
     if constexpr (PlantT::kTraction) {
       ToolRule* tool = layers.tool;
-      if (tool != nullptr && tool->active && k < n) {
+      if (tool != nullptr && tool->active && k < last) {
         tool_down = tool->update(s);
         if (HitchControl* hitch = layers.hitch) {
           const bool raised = hitch->update(layers.traction_control->limiting(), std::fabs(fed.v) * dt, dt);
@@ -226,11 +234,11 @@ EstimatedRunResult closedLoop(const Scenario& sc, PlantT& plant, Feed& feed, Out
                         plant.slip(RIGHT), plant.slip(LEFT), tool_down, sent, layers);
     result.periods = k;
     if (no_traction && t >= end_at) break;  // held since the verdict: the run ends with its report
-    if (stop && k % kStopCheckEvery == kStopCheckEvery - 1 && k < n && stop(metrics)) {
+    if (stop && k % kStopCheckEvery == kStopCheckEvery - 1 && k < last && stop(metrics)) {
       result.stopped = true;
       break;
     }
-    if (k == n) break;
+    if (k == last) break;
     plant.step(sent.right, sent.left, dt);
     if constexpr (PlantT::kTraction) {
       const double slip = std::max(std::fabs(plant.slip(RIGHT)), std::fabs(plant.slip(LEFT)));

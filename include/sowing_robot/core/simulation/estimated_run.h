@@ -72,6 +72,11 @@ struct EstimatedRunConfig {
   /// The tool raised while the traction control holds the wheels at their grip limit (needs
   /// traction_control; off: the seed drill's rule alone).
   HitchControlParams hitch_control;
+  /// With the speed governor: the run gets back the time the governor took from the path, i.e. it lasts
+  /// until the governed path time has run the scenario's duration (at most twice the duration), so that a
+  /// robot slowed for grip is judged at the same point of its path as one that was not. The benchmark's
+  /// field runs set it (their finish check reads the path's time); false: the scenario's duration.
+  bool governed_time_back = false;
 
   /// "" or the first bad parameter as one line naming its key.
   std::string validate() const;
