@@ -218,8 +218,8 @@ void applyProfile(YAML::Node& root, const std::string& profile) {
 }
 
 /// The blocks that put a scenario on the estimated loop (traction:, sensors:, estimator:, feedback:, motor:,
-/// traction_control:, speed_governor:, hitch_control:), each through the nodes' parameter table, onto `traction` and `cfg`
-/// (what they do not set stays).
+/// traction_control:, speed_governor:, hitch_control:), each through the nodes' parameter table, onto `traction` and
+/// `cfg` (what they do not set stays).
 void applyLoopBlocks(const YAML::Node& root, const std::string& path, core::TractionParams& traction,
                      core::EstimatedRunConfig& cfg) {
   const YAML::Node sensors = root["sensors"], feedback = root["feedback"];

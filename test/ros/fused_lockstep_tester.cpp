@@ -71,11 +71,12 @@ TEST(FusedLockstep, NodePipelineEqualsTheInProcessEstimatedLoop) {
   bool expect_drive_train = false;
   pnh.getParam("expect_drive_train", expect_drive_train);
   std::printf(
-      "fused lockstep: pair %s, %g s, sensors seed %llu, bias state %s, slip-aware %s; traction %s (%zu patch(es)), motors %s, "
+      "fused lockstep: pair %s, %g s, sensors seed %llu, bias state %s, slip-aware %s; traction %s (%zu patch(es)), "
+      "motors %s, "
       "traction control %s, speed governor %s\n",
       sc.controllerName().c_str(), duration, static_cast<unsigned long long>(cfg.sensors.seed),
-      cfg.estimator.estimate_bias ? "on" : "off", slip_aware ? "on" : "off", cfg.traction ? "on" : "off", cfg.patches.size(),
-      cfg.motor.enabled ? "on" : "off", cfg.traction_control.enabled ? "on" : "off",
+      cfg.estimator.estimate_bias ? "on" : "off", slip_aware ? "on" : "off", cfg.traction ? "on" : "off",
+      cfg.patches.size(), cfg.motor.enabled ? "on" : "off", cfg.traction_control.enabled ? "on" : "off",
       cfg.speed_governor.enabled ? "on" : "off");
 
   Recorded rec;

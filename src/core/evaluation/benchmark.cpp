@@ -311,12 +311,27 @@ std::vector<double> packRow(const RunRow& r) {
                      d.start_y, d.start_theta, bits(d.sensor_seed)});
   for (const AxisMetrics& m : r.metrics)
     p.insert(p.end(), {m.ise, m.itse, m.iae, m.itae, m.rise_time, m.settling_time, m.overshoot, m.peak});
-  p.insert(p.end(),
-           {r.effort, r.chattering, r.time_at_limit, r.worst_cross_track, r.final_cross_track,
-            bits(static_cast<std::uint64_t>(r.contacts)), r.min_clearance, r.end_distance, r.diverged ? 1.0 : 0.0,
-            r.success ? 1.0 : 0.0, r.realism ? 1.0 : 0.0, r.max_slip, r.tool_down_time, r.fed_error_rms,
-            r.fed_error_max, r.odometry_error_max, bits(static_cast<std::int64_t>(r.fixes_applied)),
-            bits(static_cast<std::int64_t>(r.fixes_refused)), r.high_slip_share, r.unsown_distance, r.seeds_unsown});
+  p.insert(p.end(), {r.effort,
+                     r.chattering,
+                     r.time_at_limit,
+                     r.worst_cross_track,
+                     r.final_cross_track,
+                     bits(static_cast<std::uint64_t>(r.contacts)),
+                     r.min_clearance,
+                     r.end_distance,
+                     r.diverged ? 1.0 : 0.0,
+                     r.success ? 1.0 : 0.0,
+                     r.realism ? 1.0 : 0.0,
+                     r.max_slip,
+                     r.tool_down_time,
+                     r.fed_error_rms,
+                     r.fed_error_max,
+                     r.odometry_error_max,
+                     bits(static_cast<std::int64_t>(r.fixes_applied)),
+                     bits(static_cast<std::int64_t>(r.fixes_refused)),
+                     r.high_slip_share,
+                     r.unsown_distance,
+                     r.seeds_unsown});
   p.push_back(static_cast<double>(r.failure.size()));
   for (char c : r.failure) p.push_back(static_cast<double>(static_cast<unsigned char>(c)));
   p.push_back(static_cast<double>(r.cross_track_series.size()));

@@ -387,7 +387,8 @@ TEST(ScenarioLoader, TheHitchControlBlockIsRead) {
                                      "plant_sim: {hitch_control: {enabled: true, lower_after: 7.5}}\n");
   const BenchScenario b = bench::loadScenario("wet_soil", kSuite, prof);
   EXPECT_EQ(b.realism->hitch_control.lower_after, 7.5);
-  const std::string bad = dir.write("bad.yaml", "profile: {name: bad}\nplant_sim: {hitch_control: {lower_after: -1}}\n");
+  const std::string bad =
+      dir.write("bad.yaml", "profile: {name: bad}\nplant_sim: {hitch_control: {lower_after: -1}}\n");
   try {
     bench::loadScenario("wet_soil", kSuite, bad);
     ADD_FAILURE() << "not refused";

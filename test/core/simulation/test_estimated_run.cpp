@@ -367,10 +367,11 @@ TEST(EstimatedRun, AGovernedRunGetsTheTimeTheGovernorTookBack) {
   const EstimatedRunResult plain = runEstimatedLoop(sc, cfg, plain_ref, false);
   cfg.governed_time_back = true;
   const EstimatedRunResult back = runEstimatedLoop(sc, cfg, back_ref, false);
-  std::printf("governed: slowest rate %.2f; periods %ld without, %ld with the time back (duration %ld); path time "
-              "%.3f s / %.3f s\n",
-              plain.governor_min_rate, static_cast<long>(plain.run.periods), static_cast<long>(back.run.periods),
-              static_cast<long>(sc.steps()), plain_ref.lastTime(), back_ref.lastTime());
+  std::printf(
+      "governed: slowest rate %.2f; periods %ld without, %ld with the time back (duration %ld); path time "
+      "%.3f s / %.3f s\n",
+      plain.governor_min_rate, static_cast<long>(plain.run.periods), static_cast<long>(back.run.periods),
+      static_cast<long>(sc.steps()), plain_ref.lastTime(), back_ref.lastTime());
   ASSERT_LT(plain.governor_min_rate, 1.0);  // the governor did slow the target
   EXPECT_EQ(plain.run.periods, sc.steps());
   EXPECT_LT(plain_ref.lastTime(), sc.duration - 0.1);  // the target short of the path's time

@@ -18,8 +18,8 @@
 //      traction: from the next period on the robot is held (a stop hold whatever the reference), and
 //      the run ends traction_control/no_traction_hold later;
 //   6. the trace sees the period; the caller's stop() may end the run here (every kStopCheckEvery);
-//   7. the plant steps (k < n, n grown by the time a speed governor took back with governed_time_back; its motors, if on, between the torques sent and the wheels), then the
-//      sensors see the new state at t_{k+1}.
+//   7. the plant steps (k < n; n grows by the time a speed governor took, with governed_time_back; its motors,
+//      if on, between the torques sent and the wheels), then the sensors see the new state at t_{k+1}.
 //
 // The parts are template parameters, so the per-period calls are direct:
 //   Plant: NoSlipPlant or SlipPlant (below); Feed: StateFeed (the plant's state, no sensors) or the
