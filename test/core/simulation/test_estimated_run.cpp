@@ -318,6 +318,17 @@ TEST(EstimatedBench, ARobotThatStallsOnThePatchIsNotFinished) {
   EXPECT_GT(stall[0].tool_down_time, 0.0);
 }
 
+// The thesis line's soil made wet (mu 0.2 / 0.15) on the traction plant, with the motors on.
+EstimatedRunConfig wetLineWithMotors() {
+  EstimatedRunConfig cfg;
+  TractionParams wet;
+  wet.mu_peak = 0.2;
+  wet.mu_slide = 0.15;
+  cfg.traction = wet;
+  cfg.motor.enabled = true;
+  return cfg;
+}
+
 // The drive-train layers in the loop, on the thesis line over wet soil (mu 0.2) with the motors on: the
 // traction control keeps the wheels near the friction peak where the bare loop spins them, and the speed
 // governor slows the target while it does. With every layer off the run is the run without them (the
@@ -325,12 +336,7 @@ TEST(EstimatedBench, ARobotThatStallsOnThePatchIsNotFinished) {
 TEST(EstimatedRun, TractionControlKeepsTheWheelsNearThePeak) {
   Scenario sc = line(OuterKind::kanayama, InnerKind::sliding_mode, true);
   sc.duration = 8.0;
-  EstimatedRunConfig cfg;
-  TractionParams wet;
-  wet.mu_peak = 0.2;
-  wet.mu_slide = 0.15;
-  cfg.traction = wet;
-  cfg.motor.enabled = true;
+  EstimatedRunConfig cfg = wetLineWithMotors();
   LineReference ref;
   const EstimatedRunResult bare = runEstimatedLoop(sc, cfg, ref, false);
   cfg.traction_control.enabled = true;
@@ -355,12 +361,7 @@ TEST(EstimatedRun, TractionControlKeepsTheWheelsNearThePeak) {
 TEST(EstimatedRun, AGovernedRunGetsTheTimeTheGovernorTookBack) {
   Scenario sc = line(OuterKind::kanayama, InnerKind::sliding_mode, true);
   sc.duration = 8.0;
-  EstimatedRunConfig cfg;
-  TractionParams wet;
-  wet.mu_peak = 0.2;
-  wet.mu_slide = 0.15;
-  cfg.traction = wet;
-  cfg.motor.enabled = true;
+  EstimatedRunConfig cfg = wetLineWithMotors();
   cfg.traction_control.enabled = true;
   cfg.speed_governor.enabled = true;
   LineReference plain_ref, back_ref;
