@@ -187,8 +187,8 @@ struct ProfileBlock {
 constexpr ProfileBlock kProfileBlocks[] = {{"plant_sim", "traction"},
                                            {"plant_sim", "motor"},
                                            {"plant_sim", "sensors"},
-                                           {"plant_sim", "hitch_control"},
                                            {"torque_controller", "traction_control"},
+                                           {"torque_controller", "hitch_control"},
                                            {"reference_generator", "speed_governor"},
                                            {"state_estimator", "estimator"}};
 

@@ -112,8 +112,8 @@ py::dict fixCounts(const FixCounts& c, long lost_from_queue) {
 py::dict runEstimatedPy(const std::string& controller, const py::object& params, const py::object& gains,
                         const std::string& feedback, const py::object& traction, const py::object& patches,
                         const py::object& sensors, const py::object& estimator, const py::object& motor,
-                        const py::object& traction_control, const py::object& speed_governor, const py::object& profile,
-                        double duration, std::int64_t control_period_ns, bool disturbance, double mass_scale,
+                        const py::object& traction_control, const py::object& speed_governor, const py::object& hitch_control,
+                        const py::object& profile, double duration, std::int64_t control_period_ns, bool disturbance, double mass_scale,
                         double inertia_scale, double noise_std, std::uint64_t seed, const std::array<double, 3>& start,
                         double disturbance_phase, const std::optional<std::array<double, 3>>& line, bool keep_samples,
                         bool trace) {
@@ -139,6 +139,8 @@ py::dict runEstimatedPy(const std::string& controller, const py::object& params,
                    "traction_control");
   if (!speed_governor.is_none())
     applyTableDict(speedGovernorTable(), cfg.speed_governor, "speed_governor/", speed_governor, "speed_governor");
+  if (!hitch_control.is_none())
+    applyTableDict(hitchControlTable(), cfg.hitch_control, "hitch_control/", hitch_control, "hitch_control");
   std::string profile_name;
   if (!profile.is_none()) {
     if (!py::isinstance<py::str>(profile)) throw py::type_error("profile must be a name (\"field\") or a file path");
@@ -190,6 +192,9 @@ py::dict runEstimatedPy(const std::string& controller, const py::object& params,
   d["motor"] = cfg.motor.enabled;
   d["traction_control"] = cfg.traction_control.enabled;
   d["speed_governor"] = cfg.speed_governor.enabled;
+  d["hitch_control"] = cfg.hitch_control.enabled;
+  d["hitch_raises"] = r.hitch_raises;
+  d["unsown_distance"] = r.unsown_distance;
   d["traction_control_time"] = r.traction_control_time;
   d["governor_min_rate"] = r.governor_min_rate;
   if (trace) d["trace"] = columns.toDict();
@@ -204,7 +209,7 @@ void bindEstimated(py::module& m) {
           py::arg("params") = py::none(), py::arg("gains") = py::none(), py::arg("feedback") = std::string("fused"),
           py::arg("traction") = py::none(), py::arg("patches") = py::none(), py::arg("sensors") = py::none(),
           py::arg("estimator") = py::none(), py::arg("motor") = py::none(), py::arg("traction_control") = py::none(),
-          py::arg("speed_governor") = py::none(), py::arg("profile") = py::none(), plant...,
+          py::arg("speed_governor") = py::none(), py::arg("hitch_control") = py::none(), py::arg("profile") = py::none(), plant...,
           py::arg("keep_samples") = true, py::arg("trace") = false,
           R"doc(core::runEstimatedLoop: run() with an estimate in the loop, scored on the truth (as run_monitor).
 
@@ -216,15 +221,16 @@ plant_sim's traction/ keys ({"mu_peak": 0.35, "draft_force": 10.0}). patches: so
 left out taking the traction block's. sensors: plant_sim's sensors/ keys ({"seed": 3, "fix": {"sigma":
 0.05}}); estimator: state_estimator's estimator/ keys ({"fix": {"gate": 0}}). The drive train (docs/drive_train.md):
 motor: plant_sim's motor/ keys ({"enabled": True}), traction_control: torque_controller's traction_control/ keys,
-speed_governor: reference_generator's speed_governor/ keys. profile: a profile's name ("field":
+speed_governor: reference_generator's speed_governor/ keys, hitch_control: plant_sim's hitch_control/ keys. profile: a profile's name ("field":
 config/profiles/field.yaml, what sim.launch profile:=field and benchmark --profile apply) or a file path, read as
 the benchmark reads it and applied on top of the blocks above (its keys win; its feedback replaces feedback=);
 patches then take the traction in force. Other arguments as run()'s.
 Returns run()'s dict plus "feedback", "traction", "max_abs_slip", "tool_down_time", "fed_error_rms",
 "fed_error_max", "fed_heading_error_max" (the fed pose against the truth), "odometry_error_final",
 "odometry_error_max", "fixes" ({"applied", "reanchored", "slip_onsets", "gated", "too_old", "future",
-"invalid", "lost_from_queue"}), "profile" (its name, "" for none), "motor", "traction_control", "speed_governor" (on
-or off), "traction_control_time" (s a wheel slipped beyond the target), "governor_min_rate"; with trace=True run()'s columns plus fed_x, fed_y, fed_theta, fed_v, fed_omega,
+"invalid", "lost_from_queue"}), "profile" (its name, "" for none), "motor", "traction_control", "speed_governor", "hitch_control" (on
+or off), "traction_control_time" (s a wheel slipped beyond the target), "governor_min_rate", "hitch_raises",
+"unsown_distance" (m of row the raised tool missed); with trace=True run()'s columns plus fed_x, fed_y, fed_theta, fed_v, fed_omega,
 slip_right, slip_left, tool_down. Raises ValueError for a bad name, key or value (naming the key).)doc");
   });
 }

@@ -17,7 +17,13 @@ TorqueController::TorqueController(ros::NodeHandle nh, ros::NodeHandle pnh) {
   loadTable(p, core::TorqueControllerSettings::table(), settings);
   core::TractionControlParams traction;  // traction_control/...: off by default
   loadTable(p, core::tractionControlTable(), traction);
-  requireValid(p, robot_error.empty() ? core::firstError({settings.validate(), traction.validate()}) : robot_error);
+  core::HitchControlParams hitch;  // hitch_control/...: off by default
+  loadTable(p, core::hitchControlTable(), hitch);
+  std::string hitch_error = hitch.validate();
+  if (hitch_error.empty() && hitch.enabled && !traction.enabled)  // as EstimatedRunConfig::validate()
+    hitch_error = "hitch_control/enabled needs traction_control/enabled (the hitch acts on its grip verdict)";
+  requireValid(p, robot_error.empty() ? core::firstError({settings.validate(), traction.validate(), hitch_error})
+                                      : robot_error);
   const core::SlidingModeParams& params = settings.sliding;
   input_timeout_ = settings.input_timeout;
   lockstep_ = run.lockstep;  // lockstep: wait for the paired desired velocity, never time out
@@ -40,6 +46,10 @@ TorqueController::TorqueController(ros::NodeHandle nh, ros::NodeHandle pnh) {
   if (traction.enabled) {
     traction_control_.emplace(traction, robot.L);  // validated above
     L_ = robot.L;
+  }
+  if (hitch.enabled) {
+    logSettings("torque_controller", core::hitchControlTable(), hitch);
+    hitch_.emplace(hitch);  // validated above
   }
   ROS_INFO("torque_controller: inner controller %s; m0_hat starts at %.4f kg, I0_hat at %.5f kg m^2; %.0f Hz",
            settings.innerName().c_str(), inner_->m0Hat(), inner_->i0Hat(), 1.0 / dt_);
@@ -168,6 +178,9 @@ void TorqueController::compute() {
     sent = limitTraction(out.torques, odom);
     // As the in-process loop (closed_loop.h, step 4): the inner loop learns which torques were held back.
     if (traction_control_->params().anti_windup) inner_->heldBack(sent);
+    // As the in-process loop (closed_loop.h): this period's verdict and the fed speed's travel decide the
+    // tool for the step this torque drives.
+    if (hitch_) torque_.tool_raised = hitch_->update(traction_control_->limiting(), std::fabs(v) * dt_, dt_);
   }
   torque_.header.stamp = odom.header.stamp;
   torque_.right = sent.right;

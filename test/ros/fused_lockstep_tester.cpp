@@ -59,6 +59,7 @@ TEST(FusedLockstep, NodePipelineEqualsTheInProcessEstimatedLoop) {
   }
   loadTable(plant, core::motorTable(), cfg.motor);
   loadTable(torque, core::tractionControlTable(), cfg.traction_control);
+  loadTable(torque, core::hitchControlTable(), cfg.hitch_control);  // inert here: no draft, no tool
   loadTable(reference, core::speedGovernorTable(), cfg.speed_governor);
   ASSERT_EQ(core::firstError(
                 {plant.error(), estimator.error(), torque.error(), reference.error(), patch_error, cfg.validate()}),

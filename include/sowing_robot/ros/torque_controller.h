@@ -33,6 +33,7 @@
 #include "sowing_robot/core/control/controllers.h"
 #include "sowing_robot/core/control/sliding_mode.h"
 #include "sowing_robot/core/control/standstill_hold.h"
+#include "sowing_robot/core/control/hitch_control.h"
 #include "sowing_robot/core/control/traction_control.h"
 #include "sowing_robot/ros/common/ready_roster.h"
 #include "sowing_robot/ros/common/stamp_pair.h"
@@ -74,6 +75,9 @@ class TorqueController {
   ros::Publisher torque_pub_, state_pub_, traction_pub_;
   // Traction control (unset: off).
   std::optional<core::TractionControl> traction_control_;
+  // Slip-limit hitch control (hitch_control/...; unset: off): on the traction control's grip verdict, its
+  // command goes to plant_sim with the torque (WheelTorque/tool_raised).
+  std::optional<core::HitchControl> hitch_;
   double L_ = 0.0;            // nominal half track [m] (URDF): R W = v ± L w of the encoders' twist
   bool fed_is_odom_ = false;  // the feedback topic is odom itself: no pairing needed
   StampPair<nav_msgs::Odometry, nav_msgs::Odometry, 16, 16> fed_encoders_;  // (feedback, odom) by stamp

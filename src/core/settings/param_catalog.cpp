@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "sowing_robot/core/control/cmd_vel_input.h"
+#include "sowing_robot/core/control/hitch_control.h"
 #include "sowing_robot/core/control/traction_control.h"
 #include "sowing_robot/core/estimation/ekf.h"
 #include "sowing_robot/core/model/motor.h"
@@ -119,8 +120,9 @@ const std::vector<CatalogSection>& parameterCatalog() {
        "sliding-mode controller's, [pid] ones the PID's; max_torque (the motor's limit) is both's; the parameters "
        "of the controller not selected are checked but inert. traction_control/ (opt-in, "
        "core/control/traction_control.h) caps a slipping wheel's torque after either of them; its state goes out "
-       "on traction_control/state",
-       concat(TorqueControllerSettings::table(), tractionControlTable()),
+       "on traction_control/state; hitch_control/ (opt-in, core/control/hitch_control.h, needs traction_control) "
+       "raises the seed drill's tool on its grip verdict, sent with the torque (wheel_torque's tool_raised)",
+       concat(TorqueControllerSettings::table(), tractionControlTable(), hitchControlTable()),
        {}},
       {"cmd_vel_limiter",
        "velocity mode (sim.launch input:=cmd_vel, config/cmd_vel.yaml, docs/interfaces.md): cmd_vel through the "

@@ -38,6 +38,7 @@ void LockstepDriver::torqueCallback(const WheelTorque::ConstPtr& msg) {
   const std::int64_t stamp = static_cast<std::int64_t>(msg->header.stamp.toNSec());
   switch (protocol_.onTorque(stamp, {msg->right, msg->left})) {
     case Answer::kStep:
+      plant_.setToolRaised(msg->tool_raised);  // the answer to this state: its torque and its hitch command
       if (!plant_.step(protocol_.torque(), msg->header.stamp)) {
         protocol_.diverged();  // run() reports it; the bad state is never published
         return;

@@ -101,7 +101,11 @@ void TractionModel::step(double tau_right, double tau_left, double dt) {
     const Eigen::Vector2d p(s[core::X] + c * cfg_.tool.x() - sn * cfg_.tool.y(),
                             s[core::Y] + sn * cfg_.tool.x() + c * cfg_.tool.y());
     std::lock_guard<std::mutex> lock(mutex_);
-    plant_.setToolDown(tool_.update(p));
+    // The rule runs every step (its state must not depend on the hitch), as the in-process loop's
+    // (closed_loop.h): the hitch only holds up a tool the rule would lower.
+    const bool down = tool_.update(p);
+    plant_.setToolDown(down && !tool_raised_);
+    if (down && tool_raised_) tool_held_up_time_ += dt;
   }
   plant_.step(tau_right, tau_left, dt);
   ++steps_;
@@ -128,12 +132,12 @@ void TractionModel::publishVisuals(const ros::Time& /*stamp*/) {
 }
 
 std::string TractionModel::report() const {
-  char text[300];
+  char text[360];
   std::snprintf(text, sizeof text,
-                "traction: max |slip ratio| %.4f over %ld steps; %zu soil patch(es); tool down %.2f s, max draft "
-                "%.1f N (traction/draft_force %g N)",
-                max_slip_, static_cast<long>(steps_), cfg_.soil.patches().size(), tool_down_time_, max_draft_,
-                cfg_.traction.draft_force);
+                "traction: max |slip ratio| %.4f over %ld steps; %zu soil patch(es); tool down %.2f s, held up by "
+                "the hitch control %.2f s, max draft %.1f N (traction/draft_force %g N)",
+                max_slip_, static_cast<long>(steps_), cfg_.soil.patches().size(), tool_down_time_, tool_held_up_time_,
+                max_draft_, cfg_.traction.draft_force);
   return text;
 }
 

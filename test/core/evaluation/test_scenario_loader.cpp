@@ -384,11 +384,11 @@ TEST(ScenarioLoader, TheHitchControlBlockIsRead) {
   TempDir dir;
   const std::string prof = dir.write("p.yaml",
                                      "profile: {name: p}\ntorque_controller: {traction_control: {enabled: true}}\n"
-                                     "plant_sim: {hitch_control: {enabled: true, lower_after: 7.5}}\n");
+                                     "torque_controller: {hitch_control: {enabled: true, lower_after: 7.5}}\n");
   const BenchScenario b = bench::loadScenario("wet_soil", kSuite, prof);
   EXPECT_EQ(b.realism->hitch_control.lower_after, 7.5);
   const std::string bad =
-      dir.write("bad.yaml", "profile: {name: bad}\nplant_sim: {hitch_control: {lower_after: -1}}\n");
+      dir.write("bad.yaml", "profile: {name: bad}\ntorque_controller: {hitch_control: {lower_after: -1}}\n");
   try {
     bench::loadScenario("wet_soil", kSuite, bad);
     ADD_FAILURE() << "not refused";

@@ -191,10 +191,15 @@ class Ekf {
   const SlipVector& slipState() const { return history_.back().smean; }
   const SlipMatrix& slipCovariance() const { return history_.back().scov; }
   double groundSpeed() const { return slipState()(kSpeed); }
-  /// The speed the loop is fed: the slip-aware filter's ground speed; otherwise the encoders' speed as given
-  /// (slip biases it, as it does the odometry). The traction control divides by it, so with the encoders' speed
-  /// it sees no slip of both wheels at once: the reason the field profile turns the slip-aware filter on.
-  double fedSpeed(double encoder_speed) const { return detector_ ? groundSpeed() : encoder_speed; }
+  /// The speed the loop is fed: while the slip-aware filter finds a wheel slipping, its ground speed; otherwise
+  /// the encoders' speed as given (slip biases it, as it does the odometry). The traction control divides by it,
+  /// so with the encoders' speed it sees no slip of both wheels at once: the reason the field profile turns the
+  /// slip-aware filter on. Not the ground speed always: its acceleration is bounded (slip/max_acceleration), and a
+  /// robot without the motors' limit accelerates faster on dry soil; fed the lagging speed, the inner loop pushed
+  /// harder until the state diverged (fused_lockstep_slip.test, the thesis plant).
+  double fedSpeed(double encoder_speed) const {
+    return slippingWheels() != SLIP_NONE ? groundSpeed() : encoder_speed;
+  }
   /// Slip-aware filter: what the detector found, and how long a wheel slipped.
   SlipCounts slipCounts() const { return detector_ ? detector_->counts() : SlipCounts{}; }
   const EkfParams& params() const { return params_; }

@@ -36,6 +36,9 @@ class PlantModel {
   virtual std::string waitingFor() const { return ""; }
   /// Extra messages with the visuals (publish_rate): the traction model's wheel_slip.
   virtual void publishVisuals(const ros::Time& /*stamp*/) {}
+  /// The hitch control's command for the next step (WheelTorque/tool_raised): the tool held up whatever the
+  /// seed drill's rule says. Only the traction plant has a tool.
+  virtual void setToolRaised(bool /*raised*/) {}
   /// One line for the end-of-run report ("" for none).
   virtual std::string report() const { return ""; }
 };

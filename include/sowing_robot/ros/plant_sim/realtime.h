@@ -39,6 +39,7 @@ class RealtimeDriver : public PlantSimDriver {
   core::WheelTorques torque_;  // last accepted torque
   ros::Time torque_stamp_;     // its stamp
   bool torque_valid_ = false;
+  bool tool_raised_ = false;  // its hitch command (WheelTorque/tool_raised)
   long rejected_ = 0;
 };
 

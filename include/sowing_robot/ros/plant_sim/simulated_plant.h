@@ -61,6 +61,8 @@ class SimulatedPlant {
   /// motors applied on applied_torque, stamped `stamp`. False when the state is then non-finite or faster than
   /// max_speed (it must not be published: divergence() says what went wrong).
   bool step(const core::WheelTorques& torque, const ros::Time& stamp);
+  /// The hitch control's command (WheelTorque/tool_raised) for the steps from now on.
+  void setToolRaised(bool raised) { model_->setToolRaised(raised); }
   /// The state as step k (stamped stampOf(k)): ground_truth and the sensors' odom, imu and due fixes; tf
   /// (odom -> base_link from the encoders' odom), joint_states and the true path too with `visuals`;
   /// /clock every clock_rate, with visuals, or when `clock` is set.

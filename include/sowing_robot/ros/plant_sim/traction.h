@@ -46,6 +46,7 @@ class TractionModel : public PlantModel {
                 const core::State& x0, const Config& config);
 
   void step(double tau_right, double tau_left, double dt) override;
+  void setToolRaised(bool raised) override { tool_raised_ = raised; }
   const core::State& state() const override { return plant_.state(); }
   double time() const override { return plant_.time(); }
   void wheelRates(double& right, double& left) const override {
@@ -75,7 +76,8 @@ class TractionModel : public PlantModel {
   mutable std::mutex mutex_;  // the plan comes on another thread than the steps
   core::ToolEngagement tool_;
   bool has_plan_ = false;
-  double max_slip_ = 0.0, tool_down_time_ = 0.0;
+  bool tool_raised_ = false;  // the hitch control's command for the next step
+  double max_slip_ = 0.0, tool_down_time_ = 0.0, tool_held_up_time_ = 0.0;
   double max_draft_ = 0.0;
   std::int64_t steps_ = 0;
   ros::Publisher slip_pub_, soil_pub_;
