@@ -112,9 +112,10 @@ py::dict fixCounts(const FixCounts& c, long lost_from_queue) {
 py::dict runEstimatedPy(const std::string& controller, const py::object& params, const py::object& gains,
                         const std::string& feedback, const py::object& traction, const py::object& patches,
                         const py::object& sensors, const py::object& estimator, const py::object& motor,
-                        const py::object& traction_control, const py::object& speed_governor, const py::object& hitch_control,
-                        const py::object& profile, double duration, std::int64_t control_period_ns, bool disturbance, double mass_scale,
-                        double inertia_scale, double noise_std, std::uint64_t seed, const std::array<double, 3>& start,
+                        const py::object& traction_control, const py::object& speed_governor,
+                        const py::object& hitch_control, const py::object& profile, double duration,
+                        std::int64_t control_period_ns, bool disturbance, double mass_scale, double inertia_scale,
+                        double noise_std, std::uint64_t seed, const std::array<double, 3>& start,
                         double disturbance_phase, const std::optional<std::array<double, 3>>& line, bool keep_samples,
                         bool trace) {
   const Scenario sc = buildScenario(
@@ -209,8 +210,8 @@ void bindEstimated(py::module& m) {
           py::arg("params") = py::none(), py::arg("gains") = py::none(), py::arg("feedback") = std::string("fused"),
           py::arg("traction") = py::none(), py::arg("patches") = py::none(), py::arg("sensors") = py::none(),
           py::arg("estimator") = py::none(), py::arg("motor") = py::none(), py::arg("traction_control") = py::none(),
-          py::arg("speed_governor") = py::none(), py::arg("hitch_control") = py::none(), py::arg("profile") = py::none(), plant...,
-          py::arg("keep_samples") = true, py::arg("trace") = false,
+          py::arg("speed_governor") = py::none(), py::arg("hitch_control") = py::none(),
+          py::arg("profile") = py::none(), plant..., py::arg("keep_samples") = true, py::arg("trace") = false,
           R"doc(core::runEstimatedLoop: run() with an estimate in the loop, scored on the truth (as run_monitor).
 
 feedback: what the controllers are fed: "ground_truth" (then equal to run(), bit for bit), "odometry" (the

@@ -22,8 +22,8 @@ TorqueController::TorqueController(ros::NodeHandle nh, ros::NodeHandle pnh) {
   std::string hitch_error = hitch.validate();
   if (hitch_error.empty() && hitch.enabled && !traction.enabled)  // as EstimatedRunConfig::validate()
     hitch_error = "hitch_control/enabled needs traction_control/enabled (the hitch acts on its grip verdict)";
-  requireValid(p, robot_error.empty() ? core::firstError({settings.validate(), traction.validate(), hitch_error})
-                                      : robot_error);
+  requireValid(
+      p, robot_error.empty() ? core::firstError({settings.validate(), traction.validate(), hitch_error}) : robot_error);
   const core::SlidingModeParams& params = settings.sliding;
   input_timeout_ = settings.input_timeout;
   lockstep_ = run.lockstep;  // lockstep: wait for the paired desired velocity, never time out

@@ -41,7 +41,8 @@ const std::vector<std::string> kScripts{"run",
                                         "dev/format",
                                         "dev/tune_wide_bounds",
                                         "dev/field_evidence",
-                                        "dev/drive_train_evidence", "dev/field_evidence_figure",
+                                        "dev/drive_train_evidence",
+                                        "dev/field_evidence_figure",
                                         "dev/reproduce",
                                         "dev/benchmark_report"};
 

@@ -197,9 +197,7 @@ class Ekf {
   /// slip-aware filter on. Not the ground speed always: its acceleration is bounded (slip/max_acceleration), and a
   /// robot without the motors' limit accelerates faster on dry soil; fed the lagging speed, the inner loop pushed
   /// harder until the state diverged (fused_lockstep_slip.test, the thesis plant).
-  double fedSpeed(double encoder_speed) const {
-    return slippingWheels() != SLIP_NONE ? groundSpeed() : encoder_speed;
-  }
+  double fedSpeed(double encoder_speed) const { return slippingWheels() != SLIP_NONE ? groundSpeed() : encoder_speed; }
   /// Slip-aware filter: what the detector found, and how long a wheel slipped.
   SlipCounts slipCounts() const { return detector_ ? detector_->counts() : SlipCounts{}; }
   const EkfParams& params() const { return params_; }
