@@ -383,8 +383,8 @@ TEST(ScenarioLoader, TheHitchControlBlockIsRead) {
   EXPECT_FALSE(bench::loadScenario("wet_soil", kSuite).realism->hitch_control.enabled);
   TempDir dir;
   const std::string prof = dir.write("p.yaml",
-                                     "profile: {name: p}\ntorque_controller: {traction_control: {enabled: true}}\n"
-                                     "torque_controller: {hitch_control: {enabled: true, lower_after: 7.5}}\n");
+                                     "profile: {name: p}\ntorque_controller: {traction_control: {enabled: true}, "
+                                     "hitch_control: {enabled: true, lower_after: 7.5}}\n");
   const BenchScenario b = bench::loadScenario("wet_soil", kSuite, prof);
   EXPECT_EQ(b.realism->hitch_control.lower_after, 7.5);
   const std::string bad =
