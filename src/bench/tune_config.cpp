@@ -120,6 +120,7 @@ TuneConfig loadTuneConfig(const std::string& path, const std::string& controller
   } catch (const YAML::Exception& e) {
     fail(path, std::string("not valid YAML: ") + e.what());
   }
+  refuseRepeatedKeys(root, path);
   if (!root.IsMap()) fail(path, "must be a mapping with pso_tuner: (and optionally scenario:)");
   onlyKeys(root, {"pso_tuner", "scenario", "robust"}, path, "");
   const YAML::Node pt = root["pso_tuner"];

@@ -27,14 +27,34 @@ using core::ParamValue;
   throw std::invalid_argument(file + ": " + what);
 }
 
+/// Refuses a key that appears twice in one mapping, anywhere in `node`: yaml-cpp keeps both and a lookup
+/// finds the first, so the second block would be dropped without a word.
+inline void refuseRepeatedKeys(const YAML::Node& node, const std::string& file, const std::string& where = "") {
+  if (node.IsSequence()) {
+    for (const auto& item : node) refuseRepeatedKeys(item, file, where);
+  } else if (node.IsMap()) {
+    std::set<std::string> seen;
+    for (const auto& kv : node) {
+      const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : std::string("?");
+      if (!seen.insert(key).second)
+        fail(file, "key '" + where + key + "' appears twice (line " + std::to_string(kv.first.Mark().line + 1) +
+                       "): merge the two blocks");
+      refuseRepeatedKeys(kv.second, file, where + key + "/");
+    }
+  }
+}
+
 inline YAML::Node loadYaml(const std::string& path) {
+  YAML::Node root;
   try {
-    return YAML::LoadFile(path);
+    root = YAML::LoadFile(path);
   } catch (const YAML::BadFile&) {
     fail(path, "cannot read the file");
   } catch (const YAML::Exception& e) {
     fail(path, std::string("not valid YAML: ") + e.what());
   }
+  refuseRepeatedKeys(root, path);
+  return root;
 }
 
 /// Refuses a key of `map` not in `known` (the typo check), naming the allowed ones.

@@ -387,6 +387,17 @@ TEST(ScenarioLoader, TheHitchControlBlockIsRead) {
                                      "hitch_control: {enabled: true, lower_after: 7.5}}\n");
   const BenchScenario b = bench::loadScenario("wet_soil", kSuite, prof);
   EXPECT_EQ(b.realism->hitch_control.lower_after, 7.5);
+  // A block given twice is refused, not half taken (yaml-cpp's lookup finds the first).
+  const std::string twice = dir.write("twice.yaml",
+                                      "profile: {name: twice}\ntorque_controller: {traction_control: {enabled: true}}\n"
+                                      "torque_controller: {hitch_control: {enabled: true}}\n");
+  try {
+    bench::loadScenario("wet_soil", kSuite, twice);
+    ADD_FAILURE() << "a repeated key taken";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("key 'torque_controller' appears twice (line 3)"), std::string::npos)
+        << e.what();
+  }
   const std::string bad =
       dir.write("bad.yaml", "profile: {name: bad}\ntorque_controller: {hitch_control: {lower_after: -1}}\n");
   try {
