@@ -186,7 +186,13 @@ int record(ros::NodeHandle& nh, ros::NodeHandle& pnh, const Options& o) {
     if (o.receive_delay > 0.0) so.callback_queue = &delaying;
     subs.push_back(nh.subscribe(so));
   }
-  const sowing_robot::ReadyAnnouncer ready(nh, pnh);  // plant_sim's wait_for may name the recorder
+  // plant_sim's wait_for may name the recorder: announced once the per-period topics are linked, so none of
+  // their first messages is lost
+  std::vector<ros::Subscriber> period_subs;
+  for (std::size_t i = 0; i < o.topics.size(); ++i)
+    if (std::find(o.period_topics.begin(), o.period_topics.end(), o.topics[i]) != o.period_topics.end())
+      period_subs.push_back(subs[i]);
+  const sowing_robot::ReadyAnnouncer ready(nh, pnh, true, period_subs);
   ROS_INFO(
       "bag_recorder: recording %zu topics to %s%s", o.topics.size(), o.output.c_str(),
       o.receive_delay > 0.0 ? (" (receive_delay " + std::to_string(o.receive_delay) + " s per message)").c_str() : "");

@@ -26,7 +26,7 @@ CmdVelLimiter::CmdVelLimiter(ros::NodeHandle nh, ros::NodeHandle pnh) {
   // `feedback`: the states the inner loop closes on (remapped by the launch); their stamps are the
   // instants the inner loop needs a desired velocity for.
   state_sub_ = nh.subscribe("feedback", kLockstepQueue, &CmdVelLimiter::stateCallback, this, hints);
-  ready_ = ReadyAnnouncer(nh, pnh);  // last: everything is subscribed (ready_roster.h)
+  ready_ = ReadyAnnouncer(nh, pnh, lockstep_, {state_sub_});  // last: all subscribed (ready_roster.h)
 }
 
 bool CmdVelLimiter::throttle(ros::WallTime& last) {

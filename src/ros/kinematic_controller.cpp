@@ -45,7 +45,7 @@ KinematicController::KinematicController(ros::NodeHandle nh, ros::NodeHandle pnh
   // `feedback`: the state the loop closes on, remapped by the launch (feedback:= ground_truth | odometry).
   odom_sub_ = nh.subscribe("feedback", kLockstepQueue, &KinematicController::odomCallback, this, hints);
   ref_sub_ = nh.subscribe("reference", kLockstepQueue, &KinematicController::referenceCallback, this, hints);
-  ready_ = ReadyAnnouncer(nh, pnh);  // last: everything is subscribed (ready_roster.h)
+  ready_ = ReadyAnnouncer(nh, pnh, lockstep_, {odom_sub_, ref_sub_});  // last: all subscribed (ready_roster.h)
 }
 
 void KinematicController::odomCallback(const nav_msgs::Odometry::ConstPtr& msg) {

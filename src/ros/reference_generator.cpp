@@ -131,7 +131,9 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
       "reference_generator: references on a %.6f s grid (run/control_rate), sent %.3f s ahead of /clock "
       "(lookahead)",
       core::secondsFromNanos(period_ns_), lookahead_);
-  ready_ = ReadyAnnouncer(nh, pnh);  // last: everything is subscribed (ready_roster.h)
+  // last: all subscribed (ready_roster.h). The references replay to late subscribers and the verdicts are latched:
+  // only /clock's link is awaited.
+  ready_ = ReadyAnnouncer(nh, pnh, lockstep_, {clock_sub_});
 }
 
 void ReferenceGenerator::obstaclesCallback(const visualization_msgs::MarkerArray::ConstPtr& msg) {

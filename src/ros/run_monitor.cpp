@@ -36,7 +36,7 @@ RunMonitor::RunMonitor(ros::NodeHandle nh, ros::NodeHandle pnh) : pnh_(pnh) {
   const auto hints = ros::TransportHints().tcpNoDelay();
   truth_sub_ = nh.subscribe("ground_truth", kLockstepQueue, &RunMonitor::truthCallback, this, hints);
   ref_sub_ = nh.subscribe("reference", kLockstepQueue, &RunMonitor::referenceCallback, this, hints);
-  ready_ = ReadyAnnouncer(nh, pnh);  // last: everything is subscribed (ready_roster.h)
+  ready_ = ReadyAnnouncer(nh, pnh, run.lockstep, {truth_sub_, ref_sub_});  // last: all subscribed (ready_roster.h)
 }
 
 void RunMonitor::truthCallback(const nav_msgs::Odometry::ConstPtr& msg) {

@@ -54,7 +54,7 @@ SeedDrillNode::SeedDrillNode(ros::NodeHandle nh, ros::NodeHandle pnh) {
   // The true pose (the seeds fall where the robot really is, whatever the controllers believe).
   odom_sub_ = nh.subscribe("ground_truth", kLockstepQueue, &SeedDrillNode::odomCallback, this, hints);
   ref_sub_ = nh.subscribe("reference", kLockstepQueue, &SeedDrillNode::referenceCallback, this, hints);
-  ready_ = ReadyAnnouncer(nh, pnh);  // last: everything is subscribed (ready_roster.h)
+  ready_ = ReadyAnnouncer(nh, pnh, run.lockstep, {odom_sub_, ref_sub_});  // last: all subscribed (ready_roster.h)
 }
 
 void SeedDrillNode::planCallback(const FieldPlan::ConstPtr& msg) {

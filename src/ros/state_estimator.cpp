@@ -22,6 +22,7 @@ struct StateEstimator::Loaded {
   core::EkfParams params;
   double half_track = 0.0;  // [m] the URDF's nominal L: turns the wheels' increments into a heading change
   std::unique_ptr<core::FixParams> fix_schedule;  // lockstep with fix_source: when the plant measures fixes
+  bool lockstep = false;
 };
 
 StateEstimator::Loaded StateEstimator::loadParams(ros::NodeHandle nh, ros::NodeHandle pnh) {
@@ -29,6 +30,7 @@ StateEstimator::Loaded StateEstimator::loadParams(ros::NodeHandle nh, ros::NodeH
   p.allow("robot_description");
   const core::RunSettings run = loadRunSettings(nh, p);
   Loaded out;
+  out.lockstep = run.lockstep;
   core::RobotParams robot;
   const std::string robot_error = loadRobotParams(pnh, robot);
   core::StateEstimatorSettings settings;
@@ -70,7 +72,10 @@ StateEstimator::StateEstimator(ros::NodeHandle nh, ros::NodeHandle pnh, const Lo
   odom_sub_ = nh.subscribe("odom", kLockstepQueue, &StateEstimator::odomCallback, this, hints);
   imu_sub_ = nh.subscribe("imu", kLockstepQueue, &StateEstimator::imuCallback, this, hints);
   fix_sub_ = nh.subscribe("fix", 1000, &StateEstimator::fixCallback, this, hints);
-  ready_ = ReadyAnnouncer(nh, pnh);  // last: everything is subscribed (ready_roster.h)
+  // last: everything is subscribed (ready_roster.h); the fixes are awaited in lockstep, so their link too
+  ready_ = ReadyAnnouncer(nh, pnh, loaded.lockstep,
+                          await_ ? std::vector<ros::Subscriber>{odom_sub_, imu_sub_, fix_sub_}
+                                 : std::vector<ros::Subscriber>{odom_sub_, imu_sub_});
 }
 
 StateEstimator::~StateEstimator() {

@@ -82,7 +82,7 @@ TorqueController::TorqueController(ros::NodeHandle nh, ros::NodeHandle pnh) {
              nh.resolveName("odom").c_str(), nh.resolveName("feedback").c_str());
   }
   desired_sub_ = nh.subscribe("desired_velocity", kLockstepQueue, &TorqueController::desiredCallback, this, hints);
-  ready_ = ReadyAnnouncer(nh, pnh);  // last: everything is subscribed (ready_roster.h)
+  ready_ = ReadyAnnouncer(nh, pnh, lockstep_, {odom_sub_, desired_sub_, encoder_sub_});  // last: all subscribed
 }
 
 void TorqueController::odomCallback(const nav_msgs::Odometry::ConstPtr& msg) {

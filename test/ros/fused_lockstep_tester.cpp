@@ -23,6 +23,7 @@
 #include "sowing_robot/ros/common/component_params.h"
 #include "sowing_robot/ros/common/msg_checks.h"
 #include "sowing_robot/ros/common/param_reader.h"
+#include "sowing_robot/ros/common/publisher_links.h"
 #include "sowing_robot/ros/plant_sim/traction.h"
 
 using namespace sowing_robot;
@@ -82,10 +83,14 @@ TEST(FusedLockstep, NodePipelineEqualsTheInProcessEstimatedLoop) {
 
   Recorded rec;
   const auto hints = ros::TransportHints().tcpNoDelay();
-  // ground_truth and odom are counted by plant_sim's min_subscribers: the run starts once this tester listens.
+  // The estimate's link first, confirmed by its publisher (publisher_links.h): a subscription merely made lost the
+  // first seconds of estimates under load. Then ground_truth and odom, counted by plant_sim's min_subscribers: the run
+  // starts once this tester listens to both.
+  ros::Subscriber est = nh.subscribe("odometry/filtered", 100000, &Recorded::onEstimate, &rec, hints);
+  std::string unlinked;
+  ASSERT_TRUE(waitUntilLinked({est.getTopic()}, timeout, &unlinked)) << "no publisher linked " << unlinked;
   ros::Subscriber truth = nh.subscribe("ground_truth", 100000, &Recorded::onTruth, &rec, hints);
   ros::Subscriber odom = nh.subscribe("odom", 10, &Recorded::onOdom, &rec, hints);
-  ros::Subscriber est = nh.subscribe("odometry/filtered", 100000, &Recorded::onEstimate, &rec, hints);
   const std::uint64_t last = static_cast<std::uint64_t>(sc.steps() * sc.control_period_ns);
   const ros::WallTime start = ros::WallTime::now();
   while (ros::ok() && !(rec.truth.count(last) && rec.estimate.count(last))) {

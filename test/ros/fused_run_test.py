@@ -20,6 +20,8 @@ import rostest
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Log
 
+import links
+
 WALL_TIMEOUT = 500.0
 
 
@@ -55,10 +57,13 @@ class FusedRun(unittest.TestCase):
             if "lockstep scenario finished" in m.msg:
                 finished.append(m.msg)
 
-        subs = [rospy.Subscriber("ground_truth", Odometry, on_truth, queue_size=100000),
-                rospy.Subscriber("odom", Odometry, on_odom, queue_size=100000),
-                rospy.Subscriber("odometry/filtered", Odometry, on_filtered, queue_size=100000),
+        # The estimate's link first, confirmed by its publisher (links.py): plant_sim counts only ground_truth and
+        # odom, so the run could start before the estimator had linked this node and the first estimates go nowhere.
+        subs = [rospy.Subscriber("odometry/filtered", Odometry, on_filtered, queue_size=100000),
                 rospy.Subscriber("/rosout", Log, on_log, queue_size=1000)]
+        self.assertIsNone(links.wait_until_linked(["odometry/filtered"], WALL_TIMEOUT), "odometry/filtered not linked")
+        subs += [rospy.Subscriber("ground_truth", Odometry, on_truth, queue_size=100000),
+                 rospy.Subscriber("odom", Odometry, on_odom, queue_size=100000)]
         self.assertTrue(done.wait(WALL_TIMEOUT), "the run did not reach t = %g s (last ground_truth %s)"
                         % (duration, max(truth) * 1e-9 if truth else None))
         # The last messages of the final step come on other connections: wait until odom and

@@ -12,6 +12,7 @@
 #include "sowing_robot/TrackingError.h"
 #include "sowing_robot/core/simulation/runner.h"
 #include "sowing_robot/ros/common/component_params.h"
+#include "sowing_robot/ros/common/publisher_links.h"
 
 using namespace sowing_robot;
 
@@ -54,7 +55,10 @@ TEST(Pipeline, LockstepRunTracksTheLineAndEqualsTheInProcessRunner) {
 
   Watch w;
   ros::Subscriber sub = nh.subscribe("tracking_error", 100000, &Watch::onError, &w, ros::TransportHints().tcpNoDelay());
-  // Counted by plant_sim's min_subscribers: the run starts only once this tester is listening.
+  // Linked as its publisher sees it before the run can start (publisher_links.h): a subscription merely made can lose
+  // the first periods. Then ground_truth, counted by plant_sim's min_subscribers: the run starts once this listens.
+  std::string unlinked;
+  ASSERT_TRUE(waitUntilLinked({sub.getTopic()}, timeout, &unlinked)) << "no publisher linked " << unlinked;
   ros::Subscriber odom = nh.subscribe("ground_truth", 10, &Watch::onOdom, &w);
   const ros::WallTime start = ros::WallTime::now();
   while (ros::ok() && !(w.any && w.last_stamp.toSec() >= duration - 1e-9)) {

@@ -6,6 +6,7 @@
 #include <mutex>
 
 #include "sowing_robot/ros/common/node_failure.h"
+#include "sowing_robot/ros/common/publisher_links.h"
 
 namespace sowing_robot {
 
@@ -78,8 +79,9 @@ unsigned LockstepDriver::stateSubscribers() const {
 }
 
 bool LockstepDriver::loopConnected() const {
+  // The torque link asked of its publisher, last (it costs calls to the master): publisher_links.h.
   return static_cast<int>(stateSubscribers()) >= cfg_.min_subscribers && torque_sub_.getNumPublishers() >= 1 &&
-         plant_.inputsReady() && roster_.complete();
+         plant_.inputsReady() && roster_.complete() && firstUnlinkedTopic({torque_sub_.getTopic()}).empty();
 }
 
 std::string LockstepDriver::torqueSources() const {

@@ -1,6 +1,8 @@
 // The start-up handshake of a lockstep run. Every node of the loop announces itself on the latched topic
-// `ready` (std_msgs/String: its base name) once its subscriptions and publishers exist; plant_sim takes
-// step 0 only when every name of its `wait_for` list has announced (and its subscriber counts are met).
+// `ready` (std_msgs/String: its base name) once its publishers exist and each of its per-period inputs is
+// linked at a publisher (publisher_links.h: a subscription merely made can still lose the first messages);
+// plant_sim takes step 0 only when every name of its `wait_for` list has announced (and its subscriber
+// counts are met).
 //
 // Why names and not counts: in a nodelet manager the links of all nodelets to one topic count once, so
 // plant_sim's subscriber count could not tell whether run_monitor or seed_drill had loaded yet. A short
@@ -13,9 +15,12 @@
 #include <ros/ros.h>
 #include <std_msgs/String.h>
 
+#include <atomic>
+#include <memory>
 #include <mutex>
 #include <set>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace sowing_robot {
@@ -27,12 +32,20 @@ std::string announcedName(const ros::NodeHandle& pnh);
 /// Held by a node for its lifetime: its announcement stays latched on `ready` while it lives.
 class ReadyAnnouncer {
  public:
-  ReadyAnnouncer() = default;
-  /// Call when the node's subscriptions and publishers are made (the end of its constructor).
-  ReadyAnnouncer(ros::NodeHandle nh, const ros::NodeHandle& pnh);
+  ReadyAnnouncer();
+  /// Call when the node's subscriptions and publishers are made (the end of its constructor). In
+  /// lockstep it announces from a thread of its own once every one of `inputs` (its per-period
+  /// subscriptions) is linked at a publisher, warning every 5 s, naming the topic, while one is not;
+  /// otherwise (or without inputs) at once.
+  ReadyAnnouncer(ros::NodeHandle nh, const ros::NodeHandle& pnh, bool lockstep = false,
+                 const std::vector<ros::Subscriber>& inputs = {});
+  ReadyAnnouncer(ReadyAnnouncer&&) noexcept;
+  ReadyAnnouncer& operator=(ReadyAnnouncer&&) noexcept;
+  ~ReadyAnnouncer();
 
  private:
-  ros::Publisher pub_;
+  struct Waiting;
+  std::unique_ptr<Waiting> waiting_;  // stops and joins the thread when the node goes
 };
 
 /// plant_sim's side: who has announced, against the names it waits for.

@@ -1,0 +1,88 @@
+#include "sowing_robot/ros/common/publisher_links.h"
+
+#include <ros/master.h>
+#include <ros/network.h>
+#include <ros/this_node.h>
+#include <ros/xmlrpc_manager.h>
+
+#include <algorithm>
+
+namespace sowing_robot {
+namespace {
+
+/// The nodes the master lists as publishers of `topic` (getSystemState).
+std::vector<std::string> publishersOf(const std::string& topic) {
+  XmlRpc::XmlRpcValue request, response, payload;
+  request[0] = ros::this_node::getName();
+  std::vector<std::string> out;
+  if (!ros::master::execute("getSystemState", request, response, payload, false)) return out;
+  XmlRpc::XmlRpcValue& publishers = payload[0];
+  for (int i = 0; i < publishers.size(); ++i) {
+    if (static_cast<std::string>(publishers[i][0]) != topic) continue;
+    for (int j = 0; j < publishers[i][1].size(); ++j) out.push_back(publishers[i][1][j]);
+  }
+  return out;
+}
+
+/// The destinations of node `publisher`'s outgoing links on `topic` (slave API getBusInfo: [id, destination,
+/// direction, transport, topic, connected, ...] per link); none when it does not answer.
+void linksOf(const std::string& publisher, const std::string& topic, std::vector<std::string>& out) {
+  XmlRpc::XmlRpcValue request, response, payload;
+  request[0] = ros::this_node::getName();
+  request[1] = publisher;
+  if (!ros::master::execute("lookupNode", request, response, payload, false)) return;
+  std::string host;
+  std::uint32_t port = 0;
+  const std::string uri = payload;
+  if (!ros::network::splitURI(uri, host, port)) return;
+  const ros::XMLRPCManagerPtr& xmlrpc = ros::XMLRPCManager::instance();
+  XmlRpc::XmlRpcClient* client = xmlrpc->getXMLRPCClient(host, static_cast<int>(port), "/");
+  XmlRpc::XmlRpcValue args, result, info;
+  args[0] = ros::this_node::getName();
+  const bool answered = client->execute("getBusInfo", args, result);
+  xmlrpc->releaseXMLRPCClient(client);
+  if (!answered || !xmlrpc->validateXmlrpcResponse("getBusInfo", result, info)) return;
+  for (int i = 0; i < info.size(); ++i) {
+    XmlRpc::XmlRpcValue& link = info[i];
+    if (link.size() >= 5 && static_cast<std::string>(link[2]) == "o" && static_cast<std::string>(link[4]) == topic)
+      out.push_back(link[1]);
+  }
+}
+
+}  // namespace
+
+std::vector<std::string> linkedSubscribers(const std::string& topic) {
+  std::vector<std::string> out;
+  try {
+    for (const std::string& publisher : publishersOf(topic)) linksOf(publisher, topic, out);
+  } catch (const XmlRpc::XmlRpcException&) {  // an answer of another shape: what was read so far
+  }
+  return out;
+}
+
+std::string firstUnlinkedTopic(const std::vector<std::string>& topics) {
+  for (const std::string& topic : topics) {
+    const std::vector<std::string> linked = linkedSubscribers(topic);
+    if (std::find(linked.begin(), linked.end(), ros::this_node::getName()) == linked.end()) return topic;
+  }
+  return "";
+}
+
+std::vector<std::string> topicsOf(const std::vector<ros::Subscriber>& subscribers) {
+  std::vector<std::string> out;
+  for (const ros::Subscriber& s : subscribers)
+    if (s) out.push_back(s.getTopic());
+  return out;
+}
+
+bool waitUntilLinked(const std::vector<std::string>& topics, double timeout, std::string* unlinked) {
+  const ros::WallTime start = ros::WallTime::now();
+  for (;;) {
+    *unlinked = firstUnlinkedTopic(topics);
+    if (unlinked->empty()) return true;
+    if (!ros::ok() || (ros::WallTime::now() - start).toSec() > timeout) return false;
+    ros::WallDuration(0.01).sleep();
+  }
+}
+
+}  // namespace sowing_robot
