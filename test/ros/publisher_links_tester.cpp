@@ -3,10 +3,16 @@
 // only while a publisher lists this node's link: not when nobody publishes it, not when its publisher (the .test's
 // rostopic talker) has a link to another node (the .test's listener) but not to this one, and no longer once this
 // node has unsubscribed; in one process (a nodelet manager) the intra-process link counts. Fails without what it
-// protects: an answer that ignored the link's destination says "linked" while only the listener is linked.
+// protects: an answer that ignored the link's destination says "linked" while only the listener is linked; a call
+// without a timeout hangs on a publisher that never answers.
+#include <arpa/inet.h>
 #include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <ros/master.h>
 #include <ros/ros.h>
 #include <std_msgs/Int32.h>
+#include <sys/socket.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <string>
@@ -92,6 +98,35 @@ TEST(PublisherLinks, AnIntraProcessLinkCounts) {
       boost::function<void(const std_msgs::Int32::ConstPtr&)>([](const std_msgs::Int32::ConstPtr&) {}));
   std::string unlinked;
   EXPECT_TRUE(waitUntilLinked({sub.getTopic()}, kTimeout, &unlinked)) << unlinked;
+}
+
+// A publisher whose XML-RPC port accepts connections but never answers (a stopped process: the kernel still
+// completes the handshake): the question must come back unlinked, not hang the caller (plant_sim's lockstep thread
+// asks it before step 0). Without the bounded call this test hangs until the .test's time limit.
+TEST(PublisherLinks, APublisherThatNeverAnswersIsUnlinked) {
+  const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  ASSERT_GE(fd, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  socklen_t len = sizeof addr;
+  ASSERT_EQ(bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
+  ASSERT_EQ(listen(fd, 4), 0);
+  ASSERT_EQ(getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len), 0);
+  const std::string api = "http://127.0.0.1:" + std::to_string(ntohs(addr.sin_port)) + "/";
+  XmlRpc::XmlRpcValue request, response, payload;
+  request[0] = "/mute_publisher";
+  request[1] = "/links_mute";
+  request[2] = "std_msgs/Int32";
+  request[3] = api;
+  ASSERT_TRUE(ros::master::execute("registerPublisher", request, response, payload, false));
+  EXPECT_EQ(firstUnlinkedTopic({"/links_mute"}), "/links_mute");
+  XmlRpc::XmlRpcValue unregister;
+  unregister[0] = "/mute_publisher";
+  unregister[1] = "/links_mute";
+  unregister[2] = api;
+  ros::master::execute("unregisterPublisher", unregister, response, payload, false);
+  close(fd);
 }
 
 int main(int argc, char** argv) {

@@ -10,6 +10,23 @@
 namespace sowing_robot {
 namespace {
 
+const double kAnswerTimeout = 1.0;  // [s] a publisher's answer to getBusInfo
+
+/// An XML-RPC client whose call gives up after a timeout (XmlRpcClient::execute waits for ever): a node that
+/// accepts the connection but never answers (a stopped process) must not hang plant_sim's lockstep thread,
+/// which asks before step 0, nor a node's announcer.
+class BoundedClient : public XmlRpc::XmlRpcClient {
+ public:
+  BoundedClient(const std::string& host, int port) : XmlRpcClient(host.c_str(), port, "/") {}
+  ~BoundedClient() override { close(); }
+
+  bool call(const char* method, const XmlRpc::XmlRpcValue& params, XmlRpc::XmlRpcValue& result, double timeout) {
+    if (!setupConnection() || !generateRequest(method, params)) return false;
+    _disp.work(timeout);  // returns once the answer is read (the client leaves the dispatcher) or at the timeout
+    return _connectionState == IDLE && parseResponse(result);
+  }
+};
+
 /// The nodes the master lists as publishers of `topic` (getSystemState).
 std::vector<std::string> publishersOf(const std::string& topic) {
   XmlRpc::XmlRpcValue request, response, payload;
@@ -35,13 +52,12 @@ void linksOf(const std::string& publisher, const std::string& topic, std::vector
   std::uint32_t port = 0;
   const std::string uri = payload;
   if (!ros::network::splitURI(uri, host, port)) return;
-  const ros::XMLRPCManagerPtr& xmlrpc = ros::XMLRPCManager::instance();
-  XmlRpc::XmlRpcClient* client = xmlrpc->getXMLRPCClient(host, static_cast<int>(port), "/");
+  BoundedClient client(host, static_cast<int>(port));
   XmlRpc::XmlRpcValue args, result, info;
   args[0] = ros::this_node::getName();
-  const bool answered = client->execute("getBusInfo", args, result);
-  xmlrpc->releaseXMLRPCClient(client);
-  if (!answered || !xmlrpc->validateXmlrpcResponse("getBusInfo", result, info)) return;
+  if (!client.call("getBusInfo", args, result, kAnswerTimeout) ||
+      !ros::XMLRPCManager::instance()->validateXmlrpcResponse("getBusInfo", result, info))
+    return;
   for (int i = 0; i < info.size(); ++i) {
     XmlRpc::XmlRpcValue& link = info[i];
     if (link.size() >= 5 && static_cast<std::string>(link[2]) == "o" && static_cast<std::string>(link[4]) == topic)
