@@ -54,7 +54,10 @@ SeedDrillNode::SeedDrillNode(ros::NodeHandle nh, ros::NodeHandle pnh) {
   // The true pose (the seeds fall where the robot really is, whatever the controllers believe).
   odom_sub_ = nh.subscribe("ground_truth", kLockstepQueue, &SeedDrillNode::odomCallback, this, hints);
   ref_sub_ = nh.subscribe("reference", kLockstepQueue, &SeedDrillNode::referenceCallback, this, hints);
-  ready_ = ReadyAnnouncer(nh, pnh, run.lockstep, {odom_sub_, ref_sub_});  // last: all subscribed (ready_roster.h)
+  if (settings_.follow_hitch)
+    torque_sub_ = nh.subscribe("wheel_torque", kLockstepQueue, &SeedDrillNode::torqueCallback, this, hints);
+  ready_ = ReadyAnnouncer(nh, pnh, run.lockstep,
+                          {odom_sub_, ref_sub_, torque_sub_});  // last: all subscribed (ready_roster.h)
 }
 
 void SeedDrillNode::planCallback(const FieldPlan::ConstPtr& msg) {
@@ -85,12 +88,27 @@ SeedDrillNode::~SeedDrillNode() {
 
 void SeedDrillNode::odomCallback(const nav_msgs::Odometry::ConstPtr& msg) {
   if (!drill_ || !odomIsFinite(*msg)) return;
-  if (inputs_.setFirst(*msg)) update(inputs_.first(), inputs_.second().tool_down);
+  if (inputs_.setFirst(*msg)) paired(inputs_.first(), inputs_.second().tool_down);
 }
 
 void SeedDrillNode::referenceCallback(const ReferenceState::ConstPtr& msg) {
   if (!drill_) return;
-  if (inputs_.setSecond(*msg)) update(inputs_.first(), inputs_.second().tool_down);
+  if (inputs_.setSecond(*msg)) paired(inputs_.first(), inputs_.second().tool_down);
+}
+
+void SeedDrillNode::paired(const nav_msgs::Odometry& odom, bool tool_down) {
+  if (!settings_.follow_hitch) {
+    update(odom, tool_down);
+    return;
+  }
+  if (hitch_inputs_.setFirst({odom.header, odom, tool_down}))
+    update(hitch_inputs_.first().odom, hitch_inputs_.first().tool_down && !hitch_inputs_.second().tool_raised);
+}
+
+void SeedDrillNode::torqueCallback(const WheelTorque::ConstPtr& msg) {
+  if (!drill_) return;
+  if (hitch_inputs_.setSecond(*msg))
+    update(hitch_inputs_.first().odom, hitch_inputs_.first().tool_down && !hitch_inputs_.second().tool_raised);
 }
 
 void SeedDrillNode::update(const nav_msgs::Odometry& odom, bool tool_down) {

@@ -1,5 +1,6 @@
 // seed_drill: the plant-side seed drill. Follows the tool point (URDF `tool_link`) on odom, drops a seed
-// every `spacing` metres while the tool is down (the reference's tool_down for the same stamp), shows
+// every `spacing` metres while the tool is down (the reference's tool_down for the same stamp, unless
+// torque_controller's hitch control holds it up for that stamp: ~follow_hitch), shows
 // the seeds in rviz and reports the cross-track error of the sown line against the intended rows (away
 // from obstacles and in detours apart).
 #pragma once
@@ -12,6 +13,7 @@
 
 #include "sowing_robot/FieldPlan.h"
 #include "sowing_robot/ReferenceState.h"
+#include "sowing_robot/WheelTorque.h"
 #include "sowing_robot/core/planning/seeding.h"
 #include "sowing_robot/core/settings/node_settings.h"
 #include "sowing_robot/ros/common/ready_roster.h"
@@ -27,6 +29,10 @@ class SeedDrillNode {
  private:
   void odomCallback(const nav_msgs::Odometry::ConstPtr& msg);
   void referenceCallback(const ReferenceState::ConstPtr& msg);
+  /// The hitch command of a stamp (~follow_hitch): comes after that stamp's state (the loop answers it).
+  void torqueCallback(const WheelTorque::ConstPtr& msg);
+  /// The state and the reference's tool_down of one stamp: sown from now, or once its hitch command is here.
+  void paired(const nav_msgs::Odometry& odom, bool tool_down);
   /// The reference generator's plan: the first one starts the drill, later ones replace its rows and
   /// obstacles (run-time obstacle changes).
   void planCallback(const FieldPlan::ConstPtr& msg);
@@ -40,7 +46,13 @@ class SeedDrillNode {
   // The reference is sent ahead of the state, but the plant does not wait for this node: its states can
   // arrive far ahead of their references, so both streams hold a whole lookahead's worth (stamp_pair.h).
   ListenerPair<nav_msgs::Odometry, ReferenceState> inputs_;
-  ros::Subscriber plan_sub_, odom_sub_, ref_sub_;
+  struct Paired {  // what inputs_ paired, waiting for the hitch command of its stamp
+    std_msgs::Header header;
+    nav_msgs::Odometry odom;
+    bool tool_down = false;
+  };
+  ListenerPair<Paired, WheelTorque> hitch_inputs_;
+  ros::Subscriber plan_sub_, odom_sub_, ref_sub_, torque_sub_;
   ros::Publisher seeds_pub_, report_pub_;
   visualization_msgs::Marker chunk_;  // the current SPHERE_LIST of up to kChunk seeds
   int chunk_id_ = 0;

@@ -206,6 +206,10 @@ const ParamTable<SeedDrillSettings>& SeedDrillSettings::table() {
   static const ParamTable<S> table = [] {
     ParamTable<S> t({
         text("tool_link", &S::tool_link, "tool_link", "URDF link of the seed-drop point"),
+        flag("follow_hitch", &S::follow_hitch, false,
+             "sow only while torque_controller's hitch control leaves the tool down (WheelTorque/tool_raised on "
+             "wheel_torque, paired by stamp with the state and the reference; sim.launch sets it); false: the "
+             "reference's tool_down alone (no torque_controller)"),
     });
     return t.nest("", &S::seeding, seedingTable());
   }();

@@ -98,6 +98,7 @@ struct ReferenceGeneratorSettings {
 struct SeedDrillSettings {
   SeedDrillSettings();
   std::string tool_link;
+  bool follow_hitch;
   SeedingParams seeding;
   std::string validate() const { return table().checkRanges(*this); }
   static const ParamTable<SeedDrillSettings>& table();
