@@ -165,7 +165,7 @@ int record(ros::NodeHandle& nh, ros::NodeHandle& pnh, const Options& o) {
   ros::CallbackQueue* q = ros::getGlobalCallbackQueue();
   DelayingQueue delaying(q, o.receive_delay);
   std::size_t written = 0;
-  std::vector<ros::Subscriber> subs;
+  std::vector<ros::Subscriber> subs, period_subs;
   for (const std::string& topic : o.topics) {
     const auto period = std::find(o.period_topics.begin(), o.period_topics.end(), topic);
     const std::size_t index = static_cast<std::size_t>(period - o.period_topics.begin());
@@ -185,13 +185,10 @@ int record(ros::NodeHandle& nh, ros::NodeHandle& pnh, const Options& o) {
     so.transport_hints = ros::TransportHints().tcpNoDelay();
     if (o.receive_delay > 0.0) so.callback_queue = &delaying;
     subs.push_back(nh.subscribe(so));
+    if (is_period) period_subs.push_back(subs.back());
   }
   // plant_sim's wait_for may name the recorder: announced once the per-period topics are linked, so none of
   // their first messages is lost
-  std::vector<ros::Subscriber> period_subs;
-  for (std::size_t i = 0; i < o.topics.size(); ++i)
-    if (std::find(o.period_topics.begin(), o.period_topics.end(), o.topics[i]) != o.period_topics.end())
-      period_subs.push_back(subs[i]);
   const sowing_robot::ReadyAnnouncer ready(nh, pnh, true, period_subs);
   ROS_INFO(
       "bag_recorder: recording %zu topics to %s%s", o.topics.size(), o.output.c_str(),

@@ -222,7 +222,7 @@ plant_sim's traction/ keys ({"mu_peak": 0.35, "draft_force": 10.0}). patches: so
 left out taking the traction block's. sensors: plant_sim's sensors/ keys ({"seed": 3, "fix": {"sigma":
 0.05}}); estimator: state_estimator's estimator/ keys ({"fix": {"gate": 0}}). The drive train (docs/drive_train.md):
 motor: plant_sim's motor/ keys ({"enabled": True}), traction_control: torque_controller's traction_control/ keys,
-speed_governor: reference_generator's speed_governor/ keys, hitch_control: plant_sim's hitch_control/ keys. profile: a profile's name ("field":
+speed_governor: reference_generator's speed_governor/ keys, hitch_control: torque_controller's hitch_control/ keys. profile: a profile's name ("field":
 config/profiles/field.yaml, what sim.launch profile:=field and benchmark --profile apply) or a file path, read as
 the benchmark reads it and applied on top of the blocks above (its keys win; its feedback replaces feedback=);
 patches then take the traction in force. Other arguments as run()'s.

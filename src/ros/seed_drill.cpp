@@ -101,14 +101,16 @@ void SeedDrillNode::paired(const nav_msgs::Odometry& odom, bool tool_down) {
     update(odom, tool_down);
     return;
   }
-  if (hitch_inputs_.setFirst({odom.header, odom, tool_down}))
-    update(hitch_inputs_.first().odom, hitch_inputs_.first().tool_down && !hitch_inputs_.second().tool_raised);
+  if (hitch_inputs_.setFirst({odom.header, odom, tool_down})) updateHitchPair();
 }
 
 void SeedDrillNode::torqueCallback(const WheelTorque::ConstPtr& msg) {
   if (!drill_) return;
-  if (hitch_inputs_.setSecond(*msg))
-    update(hitch_inputs_.first().odom, hitch_inputs_.first().tool_down && !hitch_inputs_.second().tool_raised);
+  if (hitch_inputs_.setSecond(*msg)) updateHitchPair();
+}
+
+void SeedDrillNode::updateHitchPair() {
+  update(hitch_inputs_.first().odom, hitch_inputs_.first().tool_down && !hitch_inputs_.second().tool_raised);
 }
 
 void SeedDrillNode::update(const nav_msgs::Odometry& odom, bool tool_down) {

@@ -33,6 +33,8 @@ class SeedDrillNode {
   void torqueCallback(const WheelTorque::ConstPtr& msg);
   /// The state and the reference's tool_down of one stamp: sown from now, or once its hitch command is here.
   void paired(const nav_msgs::Odometry& odom, bool tool_down);
+  /// hitch_inputs_ has just paired a stamp: the tool is down where the reference sows and the hitch left it.
+  void updateHitchPair();
   /// The reference generator's plan: the first one starts the drill, later ones replace its rows and
   /// obstacles (run-time obstacle changes).
   void planCallback(const FieldPlan::ConstPtr& msg);

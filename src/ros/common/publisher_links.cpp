@@ -6,6 +6,7 @@
 #include <ros/xmlrpc_manager.h>
 
 #include <algorithm>
+#include <map>
 
 namespace sowing_robot {
 namespace {
@@ -27,16 +28,21 @@ class BoundedClient : public XmlRpc::XmlRpcClient {
   }
 };
 
-/// The nodes the master lists as publishers of `topic` (getSystemState).
-std::vector<std::string> publishersOf(const std::string& topic) {
+/// The master's publishers (getSystemState): per topic, the nodes that publish it. Empty when it does not
+/// answer, or answers in another shape.
+std::map<std::string, std::vector<std::string>> publishersByTopic() {
   XmlRpc::XmlRpcValue request, response, payload;
   request[0] = ros::this_node::getName();
-  std::vector<std::string> out;
+  std::map<std::string, std::vector<std::string>> out;
   if (!ros::master::execute("getSystemState", request, response, payload, false)) return out;
-  XmlRpc::XmlRpcValue& publishers = payload[0];
-  for (int i = 0; i < publishers.size(); ++i) {
-    if (static_cast<std::string>(publishers[i][0]) != topic) continue;
-    for (int j = 0; j < publishers[i][1].size(); ++j) out.push_back(publishers[i][1][j]);
+  try {
+    XmlRpc::XmlRpcValue& publishers = payload[0];
+    for (int i = 0; i < publishers.size(); ++i) {
+      std::vector<std::string>& nodes = out[static_cast<std::string>(publishers[i][0])];
+      for (int j = 0; j < publishers[i][1].size(); ++j) nodes.push_back(publishers[i][1][j]);
+    }
+  } catch (const XmlRpc::XmlRpcException&) {
+    out.clear();
   }
   return out;
 }
@@ -65,20 +71,29 @@ void linksOf(const std::string& publisher, const std::string& topic, std::vector
   }
 }
 
-}  // namespace
-
-std::vector<std::string> linkedSubscribers(const std::string& topic) {
+/// linkedSubscribers with the master's publishers asked once by the caller.
+std::vector<std::string> linkedSubscribers(const std::string& topic,
+                                           const std::map<std::string, std::vector<std::string>>& publishers) {
   std::vector<std::string> out;
+  const auto nodes = publishers.find(topic);
+  if (nodes == publishers.end()) return out;
   try {
-    for (const std::string& publisher : publishersOf(topic)) linksOf(publisher, topic, out);
+    for (const std::string& publisher : nodes->second) linksOf(publisher, topic, out);
   } catch (const XmlRpc::XmlRpcException&) {  // an answer of another shape: what was read so far
   }
   return out;
 }
 
+}  // namespace
+
+std::vector<std::string> linkedSubscribers(const std::string& topic) {
+  return linkedSubscribers(topic, publishersByTopic());
+}
+
 std::string firstUnlinkedTopic(const std::vector<std::string>& topics) {
+  const std::map<std::string, std::vector<std::string>> publishers = publishersByTopic();
   for (const std::string& topic : topics) {
-    const std::vector<std::string> linked = linkedSubscribers(topic);
+    const std::vector<std::string> linked = linkedSubscribers(topic, publishers);
     if (std::find(linked.begin(), linked.end(), ros::this_node::getName()) == linked.end()) return topic;
   }
   return "";
