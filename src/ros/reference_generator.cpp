@@ -33,9 +33,17 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
             " (the governor acts on the traction control's slip verdicts)";
   // The field and its obstacles are read only with type field: with type line they are refused like
   // unknown keys (a field file without `type: field` must not quietly run the line).
+  using Type = core::ReferenceGeneratorSettings::Type;
   core::FieldParams field;
   std::vector<core::Obstacle> obstacles;
-  if (settings.field) {
+  core::PathParams path;
+  std::vector<Eigen::Vector2d> path_points;
+  if (settings.type == Type::kPath) {
+    loadTable(p, core::pathTable(), path);
+    if (error.empty()) error = loadPathPoints(p, path_points);
+    if (error.empty() && p.error().empty()) error = path.validate();
+  }
+  if (settings.type == Type::kField) {
     loadTable(p, core::fieldTable(), field);
     if (error.empty()) error = loadObstacles(p, "obstacles", obstacles);
     // The plan keeps the body clear, not the axle point: the obstacles are inflated by the footprint's
@@ -55,10 +63,13 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
     for (const char* key : {"field", "potential", "obstacles"})
       if (pnh.hasParam(key))
         p.fail(pnh.resolveName(key) +
-               " is set but type is 'line': field, potential and obstacles are read only "
+               " is set but type is not 'field': field, potential and obstacles are read only "
                "with type: field (set " +
                pnh.resolveName("type") + ": field, or remove them)");
   }
+  if (settings.type != Type::kPath && pnh.hasParam("path"))
+    p.fail(pnh.resolveName("path") + " is set but type is not 'path': path/ is read only with type: path (set " +
+           pnh.resolveName("type") + ": path, or remove it)");
   requireValid(p, error);
   odom_frame_ = run.odom_frame;
   period_ns_ = run.periodNs();
@@ -68,8 +79,19 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
   lockstep_ = run.lockstep;
   logSettings("reference_generator", core::ReferenceGeneratorSettings::table(), settings);
   logSettings("reference_generator", core::speedGovernorTable(), governor);
-  if (!settings.field) {
+  core::PathReference* path_source = nullptr;
+  if (settings.type == Type::kLine) {
     source_ = std::make_unique<core::LineReference>(settings.line_v_r, settings.line_y, settings.line_x0);
+  } else if (settings.type == Type::kPath) {
+    std::unique_ptr<core::PathReference> f;
+    try {
+      f = std::make_unique<core::PathReference>(path, run.start(), path_points);
+    } catch (const std::invalid_argument& e) {
+      throw badParameter(e.what());
+    }
+    path_source = f.get();
+    source_ = std::move(f);
+    logSettings("reference_generator", core::pathTable(), path);
   } else {
     std::unique_ptr<core::FieldReference> f;
     try {
@@ -116,6 +138,8 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
   if (field_) {
     marker_pub_ = nh.advertise<visualization_msgs::MarkerArray>("field_markers", 1, true);
     obstacles_sub_ = nh.subscribe("obstacles", 10, &ReferenceGenerator::obstaclesCallback, this);
+  } else if (path_source) {
+    path_follower_ = std::make_unique<PathFollower>(nh, pnh, *path_source, odom_frame_);
   } else {
     line_ = {settings.line_x0, settings.line_y};
   }
@@ -205,7 +229,7 @@ void ReferenceGenerator::publishPlan() {
     plan.reason = s.code == core::AvoidanceStatus::Code::kOk ? s.bounds_note : s.reason;
     plan.within_bounds = s.within_bounds;
     plan.detours = static_cast<std::uint32_t>(s.detours);
-  } else {
+  } else if (!path_follower_) {  // type path: no rows, no obstacles
     plan.row_starts.push_back(point(line_));
     plan.row_ends.push_back(point(line_ + Eigen::Vector2d(1e5, 0.0)));  // the thesis line, open-ended
     plan.open_ended = true;
@@ -354,6 +378,7 @@ void ReferenceGenerator::sendUpTo(std::int64_t end) {
     sent_.emplace_back();
     ReferenceState& r = sent_.back();
     fill(r, stamp);
+    if (path_follower_) path_follower_->referenceSent(next_ns_);
     publishShared(ref_pub_, r);
     geometry_msgs::PoseStamped p;
     p.header = r.header;

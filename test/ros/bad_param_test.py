@@ -53,7 +53,13 @@ CASES = [
     ("kinematic_controller", {"ky": float("inf")}, "ky"),
     ("reference_generator", {"line/v_r": -1.0}, "v_r"),
     # a key the configuration does not read is refused like an unknown one: field keys with type line
-    ("reference_generator", {"field/rows": 0}, "is set but type is 'line'"),
+    ("reference_generator", {"field/rows": 0}, "is set but type is not 'field'"),
+    # the path follower (issue 27): path keys with another type, a bad value, a malformed point, a typo
+    ("reference_generator", {"path/v_max": 0.5}, "is set but type is not 'path'"),
+    ("reference_generator", {"type": "path", "path/v_max": -1.0}, "/bad_%d/path/v_max = -1"),
+    ("reference_generator", {"type": "path", "path/points": [[0, 0], [1]]}, "/bad_%d/path/points[1] must be a pair"),
+    ("reference_generator", {"type": "path", "path/points": []}, "is an empty list"),
+    ("reference_generator", {"type": "path", "path/v_maxx": 1.0}, "path/v_maxx"),
     # a run-wide setting is set once (run/): a node's own copy that disagrees names both values
     ("torque_controller", {"control_rate": 500.0}, "disagrees with /run/control_rate = 1000.0"),
     ("plant_sim", {"duration": 60.0}, "disagrees with /run/duration = 25.0"),

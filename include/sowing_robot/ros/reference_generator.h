@@ -8,6 +8,8 @@
 //   type field: core::FieldReference (rows + headland turns through the potential field) with the
 //               obstacles from the `obstacles` parameter; `obstacles` (MarkerArray) replaces them at
 //               run time, and `field_markers` (latched) shows obstacles, influence zones and rows.
+//   type path:  core::PathReference (a given path, rounded and timed: core/planning/path_plan.h), from
+//               path/points or nav_msgs/Path on `path`; ros/path_follower.h says what it reports.
 // Speed governor (speed_governor/..., core/planning/speed_governor.h; off by default): the source's time runs
 // at a rate that falls while the torque controller's traction control reports slip (`traction_control/state`)
 // and rises while the wheels grip. The reference for t_{k+1} then depends on the verdict of period k, so in
@@ -38,6 +40,7 @@
 #include "sowing_robot/core/planning/speed_governor.h"
 #include "sowing_robot/ros/common/path_buffer.h"
 #include "sowing_robot/ros/common/ready_roster.h"
+#include "sowing_robot/ros/path_follower.h"
 
 namespace sowing_robot {
 
@@ -75,6 +78,7 @@ class ReferenceGenerator {
   std::int64_t verdict_ns_ = -1;                   ///< stamp of the last traction-control verdict [ns]; -1: none
   core::FieldReference* field_ = nullptr;          ///< source_ when type is field, else null
   std::vector<core::Obstacle> obstacles_;          ///< the obstacles in force (type field)
+  std::unique_ptr<PathFollower> path_follower_;    ///< type path: its inputs and progress, else null
   ros::Subscriber clock_sub_, obstacles_sub_, traction_sub_;
   ros::Publisher ref_pub_, path_pub_, marker_pub_, plan_pub_;
   std::string odom_frame_ = "odom";    ///< run/odom_frame

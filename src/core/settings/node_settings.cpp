@@ -186,8 +186,10 @@ std::string TorqueControllerSettings::validate() const {
 const ParamTable<ReferenceGeneratorSettings>& ReferenceGeneratorSettings::table() {
   using S = ReferenceGeneratorSettings;
   static const ParamTable<S> table({
-      choice("type", &S::field, false, {{"line", false}, {"field", true}},
-             "line: the thesis's sowing line of Table 5.2; field: rows + potential field (config/field*.yaml)"),
+      choice("type", &S::type, S::Type::kLine,
+             {{"line", S::Type::kLine}, {"field", S::Type::kField}, {"path", S::Type::kPath}},
+             "line: the thesis's sowing line of Table 5.2; field: rows + potential field (config/field*.yaml); "
+             "path: a given path (path/points, or nav_msgs/Path on `path`) with a speed profile (config/path.yaml)"),
       number("line/x0", &S::line_x0, 0.0, Limits::any(), "m", "type line: x_d = x0 + v_r t"),
       number("line/v_r", &S::line_v_r, 1.0, Limits::closed(0.0, 10.0), "m/s", "type line: reference speed v_r"),
       number("line/y", &S::line_y, 3.0, Limits::any(), "m", "type line: y_d"),

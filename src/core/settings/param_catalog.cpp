@@ -14,6 +14,7 @@
 #include "sowing_robot/core/model/sensors.h"
 #include "sowing_robot/core/model/traction.h"
 #include "sowing_robot/core/planning/field.h"
+#include "sowing_robot/core/planning/path_plan.h"
 #include "sowing_robot/core/planning/speed_governor.h"
 #include "sowing_robot/core/settings/node_settings.h"
 
@@ -131,12 +132,13 @@ const std::vector<CatalogSection>& parameterCatalog() {
        infos(CmdVelParams::table()),
        {}},
       {"reference_generator",
-       "the reference: the thesis line, or a field of rows through the potential field "
-       "(field/ and potential/ keys and obstacles are read only with type field); speed_governor/ (opt-in, "
-       "core/planning/speed_governor.h; needs torque_controller/traction_control/enabled) slows either while the "
-       "wheels slip",
-       concat(ReferenceGeneratorSettings::table(), fieldTable(), speedGovernorTable()),
-       {"obstacles"}},
+       "the reference: the thesis line, a field of rows through the potential field "
+       "(field/ and potential/ keys and obstacles are read only with type field), or a given path "
+       "(path/ keys, read only with type path; path/points: [[x, y], ...] in the odom frame [m]); speed_governor/ "
+       "(opt-in, core/planning/speed_governor.h; needs torque_controller/traction_control/enabled) slows any of them "
+       "while the wheels slip",
+       concat(ReferenceGeneratorSettings::table(), fieldTable(), pathTable(), speedGovernorTable()),
+       {"obstacles", "path/points"}},
       {"seed_drill",
        "the seed drill: spacing and scoring of the seeds against the plan",
        infos(SeedDrillSettings::table()),

@@ -84,10 +84,12 @@ struct TorqueControllerSettings {
 };
 
 /// reference_generator: the reference type and its line; the field (FieldParams, fieldTable()) and the
-/// obstacles are read only with type field.
+/// obstacles are read only with type field, the path's keys (PathParams, pathTable(), and path/points) only
+/// with type path.
 struct ReferenceGeneratorSettings {
+  enum class Type { kLine, kField, kPath };
   ReferenceGeneratorSettings();
-  bool field;  ///< type: field (rows + potential field) or line (the thesis line)
+  Type type;  ///< line (the thesis line), field (rows + potential field) or path (a given path, path_plan.h)
   double line_x0, line_v_r, line_y;
   double path_spacing, lookahead;
   std::string validate() const { return table().checkRanges(*this); }
