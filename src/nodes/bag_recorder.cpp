@@ -133,8 +133,11 @@ Options readOptions(const ros::NodeHandle& pnh) {
   sowing_robot::ParamReader p(pnh);
   Options o;
   o.output = p.get("output", "");
+  // Resolved in the node's namespace (a fleet's robot_<i>/ records its own topics), and kept so in the bag.
   o.topics = words(p.get("topics", ""));
   o.period_topics = words(p.get("period_topics", ""));
+  for (auto* list : {&o.topics, &o.period_topics})
+    for (std::string& t : *list) t = ros::names::resolve(t);
   o.queue = p.get("queue", o.queue);
   o.receive_delay = p.get("receive_delay", o.receive_delay);
   if (!p.error().empty()) sowing_robot::refuseToStart(p.error());

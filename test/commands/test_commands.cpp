@@ -27,7 +27,7 @@ const std::vector<std::string> kPrograms{
     "benchmark",   "run_scenario",         "param_docs",        "bag_recorder",
     "plant_sim",   "kinematic_controller", "torque_controller", "reference_generator",
     "run_monitor", "seed_drill",           "state_estimator",   "pso_tuner",
-    "tune",        "cmd_vel_limiter"};
+    "tune",        "cmd_vel_limiter",      "fleet_monitor"};
 const std::vector<std::string> kScripts{"run",
                                         "test",
                                         "sim",
@@ -44,7 +44,8 @@ const std::vector<std::string> kScripts{"run",
                                         "dev/drive_train_evidence",
                                         "dev/field_evidence_figure",
                                         "dev/reproduce",
-                                        "dev/benchmark_report"};
+                                        "dev/benchmark_report",
+                                        "dev/path_evidence"};
 
 struct Outcome {
   int status = -1;

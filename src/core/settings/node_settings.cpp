@@ -252,6 +252,22 @@ const ParamTable<RunMonitorSettings>& RunMonitorSettings::table() {
 
 RunMonitorSettings::RunMonitorSettings() { table().applyDefaults(*this); }
 
+const ParamTable<FleetMonitorSettings>& FleetMonitorSettings::table() {
+  using S = FleetMonitorSettings;
+  static const ParamTable<S> table({
+      integer("robots", &S::robots, 2, Limits::closed(2, 64), "",
+              "robots in the fleet: robot_0 ... robot_<robots-1>, each with its own clock and ground_truth"),
+      number("safety_distance", &S::safety_distance, 0.8, Limits::positive(), "m",
+             "two robots' axle midpoints closer than this at one stamp: an encounter, warned about and counted"),
+      flag("exit_at_end", &S::exit_at_end, false,
+           "end the launch once every robot's clock has reached run/duration and its run_monitor has printed "
+           "(headless)"),
+  });
+  return table;
+}
+
+FleetMonitorSettings::FleetMonitorSettings() { table().applyDefaults(*this); }
+
 const ParamTable<PsoTunerSettings>& PsoTunerSettings::table() {
   using S = PsoTunerSettings;
   static const ParamTable<S> table({

@@ -150,6 +150,11 @@ const std::vector<CatalogSection>& parameterCatalog() {
        concat(StateEstimatorSettings::table(), ekfTable()),
        {}},
       {"run_monitor", "the metric table at the end of a run", infos(RunMonitorSettings::table()), {}},
+      {"fleet_monitor",
+       "fleet.launch: owns /clock (the slowest robot's), compares the robots' positions by stamp and reports "
+       "encounters closer than safety_distance",
+       infos(FleetMonitorSettings::table()),
+       {}},
       {"pso_tuner",
        "offline PSO tuning (eqs 4.26-4.31, Table 5.4); the search box is the gains list",
        infos(PsoTunerSettings::table()),

@@ -12,10 +12,9 @@
 // a backward pass; pivots and the end are at rest. A pivot turns by a cosine-bump yaw rate (peak <= turn_rate,
 // peak yaw acceleration <= turn_accel).
 // The plan starts from a given pose and speed (the robot's start, or the reference in force when a new path
-// replaces the old one): it joins the path on a straight lead along the
-// current heading twice as long as the stop from the current speed, then the point of the path closest to the
-// lead's end, so the reference stays continuous in pose and speed and the part of the path behind is skipped. After the
-// end the reference holds the last point (a stop).
+// replaces the old one): a straight lead along the current heading, twice as long as the stop from the current
+// speed, then the point of the path closest to the lead's end, so the reference stays continuous in pose and
+// speed and the part of the path behind is skipped. After the end the reference holds the last point (a stop).
 #pragma once
 
 #include <string>

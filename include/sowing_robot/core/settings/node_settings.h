@@ -124,6 +124,16 @@ struct RunMonitorSettings {
   static const ParamTable<RunMonitorSettings>& table();
 };
 
+/// fleet_monitor (fleet.launch): the fleet's size, its safety distance, and whether it ends the launch.
+struct FleetMonitorSettings {
+  FleetMonitorSettings();
+  int robots;
+  double safety_distance;
+  bool exit_at_end;
+  std::string validate() const { return table().checkRanges(*this); }
+  static const ParamTable<FleetMonitorSettings>& table();
+};
+
 /// pso_tuner (offline): the swarm, the cost and the simulated run of each evaluation. The base scenario
 /// comes from the run and node settings; the search box is the `gains` list (tuning.h).
 struct PsoTunerSettings {
