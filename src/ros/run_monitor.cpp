@@ -25,7 +25,8 @@ RunMonitor::RunMonitor(ros::NodeHandle nh, ros::NodeHandle pnh) : pnh_(pnh) {
   output_ = settings.output;
   label_ = settings.label;
   exit_at_end_ = settings.exit_at_end;
-  recorder_topic_ = settings.recorder;
+  // resolved in the node's namespace (a fleet robot's recorder is robot_<i>/recorder), and named so in the log
+  recorder_topic_ = settings.recorder.empty() ? "" : nh.resolveName(settings.recorder);
   recorder_timeout_ = settings.recorder_timeout;
   // The time-domain figures (rise, settling, overshoot) need every sample: 32 B per period, ~115 MB per
   // hour at 1 kHz. Long runs (soak) switch them off and keep only the integrals (constant memory).
