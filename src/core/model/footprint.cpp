@@ -14,10 +14,7 @@ double cross(const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Ve
 
 /// Distance from q to the segment a-b.
 double segmentDistance(const Eigen::Vector2d& q, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-  const Eigen::Vector2d ab = b - a;
-  const double len2 = ab.squaredNorm();
-  const double u = len2 > 0.0 ? std::clamp((q - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
-  return (q - (a + u * ab)).norm();
+  return (q - (a + segmentParameter(q, a, b) * (b - a))).norm();
 }
 }  // namespace
 

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "sowing_robot/core/common/validation.h"
+#include "sowing_robot/core/planning/speed_ramp.h"
 
 namespace sowing_robot {
 namespace core {
@@ -13,7 +14,6 @@ namespace core {
 namespace {
 
 /// Distance covered by a half-cosine speed ramp from v0 to v1 with peak |v_dot| = a [m].
-double rampDistance(double v0, double v1, double a) { return M_PI * std::fabs(v1 * v1 - v0 * v0) / (4.0 * a); }
 
 /// Length of a cosine curvature ramp of height dk with peak |dkappa/ds| = rate [m].
 double rampLength(double dk, double rate) { return 0.5 * M_PI * std::fabs(dk) / rate; }
@@ -253,7 +253,7 @@ void FieldPath::addPhase(double distance, double v0, double v1) {
   }
   ph.v0 = v0;
   ph.v1 = v1;
-  ph.duration = v0 == v1 ? distance / v0 : M_PI * std::fabs(v1 - v0) / (2.0 * params_.max_accel);
+  ph.duration = phaseDuration(distance, v0, v1, params_.max_accel);
   phases_.push_back(ph);
   duration_ += ph.duration;
 }
@@ -421,20 +421,11 @@ void FieldPath::arcLength(double t, double& s, double& sd, double& sdd, double& 
   }
   auto it = std::upper_bound(phases_.begin(), phases_.end(), t, [](double v, const Phase& p) { return v < p.t0; });
   const Phase& ph = *(it == phases_.begin() ? it : it - 1);
-  const double tau = t - ph.t0;
-  if (ph.v0 == ph.v1) {
-    s = ph.s0 + ph.v0 * tau;
-    sd = ph.v0;
-    return;
-  }
-  const double dv = ph.v1 - ph.v0, w = M_PI / ph.duration;
-  double sn, c;
-  sn = std::sin(w * tau);
-  c = std::cos(w * tau);
-  s = ph.s0 + ph.v0 * tau + 0.5 * dv * (tau - sn / w);
-  sd = ph.v0 + 0.5 * dv * (1.0 - c);
-  sdd = 0.5 * dv * w * sn;
-  sddd = 0.5 * dv * w * w * c;
+  const RampState r = rampState(ph.s0, ph.v0, ph.v1, ph.duration, t - ph.t0);
+  s = r.s;
+  sd = r.sd;
+  sdd = r.sdd;
+  sddd = r.sddd;
 }
 
 TargetState FieldPath::at(double t) const {

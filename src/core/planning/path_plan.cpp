@@ -5,6 +5,8 @@
 #include <limits>
 #include <stdexcept>
 
+#include "sowing_robot/core/planning/speed_ramp.h"
+
 namespace sowing_robot {
 namespace core {
 
@@ -67,16 +69,6 @@ Eigen::Vector2d unitFilletEnd(double phi, int nodes) {
   return p;
 }
 
-/// Distance a half-cosine ramp needs between speeds v0 and v1 at peak acceleration a.
-double rampLength(double v0, double v1, double a) { return M_PI * std::fabs(v1 * v1 - v0 * v0) / (4.0 * a); }
-
-/// Closest point to p on segment [a, b]: its parameter in [0, 1].
-double segmentParameter(const Eigen::Vector2d& p, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-  const Eigen::Vector2d d = b - a;
-  const double n = d.squaredNorm();
-  return n > 0.0 ? std::clamp((p - a).dot(d) / n, 0.0, 1.0) : 0.0;
-}
-
 void simplifyRange(const std::vector<Eigen::Vector2d>& pts, std::size_t i, std::size_t j, double tol,
                    std::vector<bool>& keep) {
   if (j <= i + 1) return;
@@ -126,7 +118,7 @@ PathPlan::PathPlan(const std::vector<Eigen::Vector2d>& points, const PathStart& 
   std::vector<Eigen::Vector2d> v{p0};
   Eigen::Vector2d from = p0;
   if (start.v > 0.0) {
-    from = p0 + (2.0 * rampLength(start.v, 0.0, params_.a_max) + 0.01) * unitVector(start.pose.theta);
+    from = p0 + (2.0 * rampDistance(start.v, 0.0, params_.a_max) + 0.01) * unitVector(start.pose.theta);
     v.push_back(from);
   }
   std::size_t seg = 0;
@@ -238,7 +230,7 @@ void PathPlan::planSpeeds(double v_start, const std::vector<double>& pivot_after
     } else if (el.length > 0.0) {
       double peak = std::min(el.v_limit, std::sqrt((2.0 * a_e * el.length + v0 * v0 + v1 * v1) / 2.0));
       peak = std::max({peak, v0, v1});
-      const double up = rampLength(v0, peak, params_.a_max), down = rampLength(peak, v1, params_.a_max);
+      const double up = rampDistance(v0, peak, params_.a_max), down = rampDistance(peak, v1, params_.a_max);
       const double cruise = el.length - up - down;
       if (up > 0.0) addMove(up, v0, peak);
       if (cruise > 1e-12 * el.length && peak > 0.0) addMove(cruise, peak, peak);
@@ -255,7 +247,7 @@ void PathPlan::addMove(double distance, double v0, double v1) {
   ph.distance = distance;
   ph.v0 = v0;
   ph.v1 = v1;
-  ph.duration = v0 == v1 ? distance / v0 : M_PI * std::fabs(v1 - v0) / (2.0 * params_.a_max);
+  ph.duration = phaseDuration(distance, v0, v1, params_.a_max);
   duration_ += ph.duration;
   phases_.push_back(ph);
 }
@@ -273,6 +265,11 @@ void PathPlan::addPivot(double theta0, double dtheta) {
   duration_ += ph.duration;
   ++pivots_;
   phases_.push_back(ph);
+}
+
+const PathPlan::Phase& PathPlan::phaseAt(double tau) const {
+  auto it = std::upper_bound(phases_.begin(), phases_.end(), tau, [](double x, const Phase& p) { return x < p.t0; });
+  return *(it == phases_.begin() ? it : it - 1);
 }
 
 const PathPlan::Element& PathPlan::elementAt(double s) const {
@@ -310,8 +307,7 @@ Reference PathPlan::at(double tau) const {
     r.stop = true;
     return r;
   }
-  auto it = std::upper_bound(phases_.begin(), phases_.end(), tau, [](double x, const Phase& p) { return x < p.t0; });
-  const Phase& ph = *(it == phases_.begin() ? it : it - 1);
+  const Phase& ph = phaseAt(tau);
   const double t = tau - ph.t0;
   Eigen::Vector2d p;
   double theta, kappa, dkappa;
@@ -323,19 +319,13 @@ Reference PathPlan::at(double tau) const {
     r.omega_dot = ph.dtheta / ph.duration * w * std::sin(w * t);
     return r;
   }
-  double s = ph.s0 + ph.v0 * t, sd = ph.v0, sdd = 0.0;
-  if (ph.v0 != ph.v1) {
-    const double dv = ph.v1 - ph.v0, w = M_PI / ph.duration;
-    s = ph.s0 + ph.v0 * t + 0.5 * dv * (t - std::sin(w * t) / w);
-    sd = ph.v0 + 0.5 * dv * (1.0 - std::cos(w * t));
-    sdd = 0.5 * dv * w * std::sin(w * t);
-  }
-  geometry(std::min(s, ph.s0 + ph.distance), p, theta, kappa, dkappa);
+  const RampState m = rampState(ph.s0, ph.v0, ph.v1, ph.duration, t);
+  geometry(std::min(m.s, ph.s0 + ph.distance), p, theta, kappa, dkappa);
   r.pose = Pose2D{p.x(), p.y(), wrapAngle(theta)};
-  r.v = sd;
-  r.omega = kappa * sd;
-  r.v_dot = sdd;
-  r.omega_dot = dkappa * sd * sd + kappa * sdd;
+  r.v = m.sd;
+  r.omega = kappa * m.sd;
+  r.v_dot = m.sdd;
+  r.omega_dot = dkappa * m.sd * m.sd + kappa * m.sdd;
   r.tool_down = params_.tool_down;
   return r;
 }
@@ -343,13 +333,9 @@ Reference PathPlan::at(double tau) const {
 double PathPlan::arcLengthAt(double tau) const {
   if (phases_.empty() || tau >= duration_) return length_;
   if (!(tau > 0.0)) return 0.0;
-  auto it = std::upper_bound(phases_.begin(), phases_.end(), tau, [](double x, const Phase& p) { return x < p.t0; });
-  const Phase& ph = *(it == phases_.begin() ? it : it - 1);
-  const double t = tau - ph.t0;
+  const Phase& ph = phaseAt(tau);
   if (ph.pivot) return ph.s0;
-  if (ph.v0 == ph.v1) return ph.s0 + ph.v0 * t;
-  const double w = M_PI / ph.duration;
-  return std::min(ph.s0 + ph.distance, ph.s0 + ph.v0 * t + 0.5 * (ph.v1 - ph.v0) * (t - std::sin(w * t) / w));
+  return std::min(ph.s0 + ph.distance, rampState(ph.s0, ph.v0, ph.v1, ph.duration, tau - ph.t0).s);
 }
 
 double PathPlan::timeAt(double s) const {

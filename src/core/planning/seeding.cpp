@@ -52,10 +52,7 @@ void SeedDrill::setPlan(std::vector<RowSegment> rows, std::vector<Obstacle> obst
 double SeedDrill::crossTrack(const Eigen::Vector2d& p) const {
   double best = std::numeric_limits<double>::infinity();
   for (const RowSegment& r : rows_) {
-    const Eigen::Vector2d ab = r.b - r.a;
-    const double len2 = ab.squaredNorm();
-    const double u = len2 > 0.0 ? std::clamp((p - r.a).dot(ab) / len2, 0.0, 1.0) : 0.0;
-    best = std::min(best, (p - (r.a + u * ab)).norm());
+    best = std::min(best, (p - (r.a + segmentParameter(p, r.a, r.b) * (r.b - r.a))).norm());
   }
   return best;
 }

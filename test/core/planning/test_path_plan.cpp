@@ -19,9 +19,7 @@ Points cornerAndUTurn() { return {{0, 0}, {6, 0}, {6, 2}, {0, 2}, {0, 5}}; }
 double distanceToPolyline(const Eigen::Vector2d& p, const Points& pts) {
   double best = 1e9;
   for (std::size_t k = 0; k + 1 < pts.size(); ++k) {
-    const Eigen::Vector2d d = pts[k + 1] - pts[k];
-    const double u = std::clamp((p - pts[k]).dot(d) / d.squaredNorm(), 0.0, 1.0);
-    best = std::min(best, (p - (pts[k] + u * d)).norm());
+    best = std::min(best, (p - (pts[k] + segmentParameter(p, pts[k], pts[k + 1]) * (pts[k + 1] - pts[k]))).norm());
   }
   return best;
 }

@@ -1,6 +1,7 @@
 // Plain data passed between the core blocks (and mirrored one-to-one by the ROS messages).
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 
@@ -73,6 +74,13 @@ inline double yawThroughQuaternion(double theta) {
 
 /// (cos h, sin h): the unit vector of heading h.
 inline Eigen::Vector2d unitVector(double heading) { return {std::cos(heading), std::sin(heading)}; }
+
+/// The closest point of segment a-b to p, as its parameter u in [0, 1] (the point a + u (b - a)); 0 when a == b.
+inline double segmentParameter(const Eigen::Vector2d& p, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  const Eigen::Vector2d ab = b - a;
+  const double len2 = ab.squaredNorm();
+  return len2 > 0.0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+}
 
 /// True when every argument is a finite number.
 template <typename... T>

@@ -116,6 +116,8 @@ class PathPlan {
   /// Position, heading, curvature and dkappa/ds at arc length s.
   void geometry(double s, Eigen::Vector2d& p, double& theta, double& kappa, double& dkappa) const;
   const Element& elementAt(double s) const;
+  /// The phase in force tau seconds after the start (phases_ not empty).
+  const Phase& phaseAt(double tau) const;
 
   PathParams params_;
   std::vector<Eigen::Vector2d> vertices_;
