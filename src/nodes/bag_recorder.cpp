@@ -9,7 +9,12 @@
 // (a loaded machine) would lose them with their publishers when the launch ends. So it says how far it
 // has got: ~recorded_until (std_msgs/Time, latched) is the oldest of the newest header stamps written on
 // the ~period_topics (those published once per control period), and the node that ends a headless run
-// (run_monitor, `~recorder`) waits for it to reach the run's last period. Usage: kUsage below (--help).
+// (run_monitor, `~recorder`) waits for it to reach the run's last period.
+//
+// ~deterministic (the fleet's bags): each message is recorded at the stamp it carries (message_stamp.h)
+// instead of its receive time, held for ~reorder_window of simulated time behind ~recorded_until and written
+// in stamp order (stamp_order_writer.h), so two lockstep runs with the same seed give the same file bit for
+// bit. What is held is written at the close; a crash loses it. Usage: kUsage below (--help).
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
 #include <ros/serialization.h>
@@ -22,12 +27,14 @@
 #include <csignal>
 #include <cstdint>
 #include <cstdio>
-#include <cstring>
 #include <sstream>
 #include <string>
+#include <unordered_set>
 #include <vector>
 
 #include "sowing_robot/cli/usage.h"
+#include "sowing_robot/ros/bag/message_stamp.h"
+#include "sowing_robot/ros/bag/stamp_order_writer.h"
 #include "sowing_robot/ros/common/failure_log.h"
 #include "sowing_robot/ros/common/param_reader.h"
 #include "sowing_robot/ros/common/ready_roster.h"
@@ -37,8 +44,11 @@ const char* const kUsage = SOWING_NODE_USAGE(
     "bag_recorder",
     "Records the named topics into a bag without losing messages in lockstep runs (sim.launch record:=true):\n"
     "  rosrun sowing_robot bag_recorder _output:=run.bag _topics:=\"/odom /reference ...\" [_queue:=200000]\n"
-    "    [_period_topics:=\"/odom ...\"] [_receive_delay:=0 (s per message, tests: a recorder starved of CPU)]\n"
-    "On SIGINT it drains what it has received, then closes the bag; ~recorded_until says how far it got.\n");
+    "    [_period_topics:=\"/odom ...\"] [_deterministic:=false [_reorder_window:=5]] [_receive_delay:=0 (s per\n"
+    "    message, tests: a recorder starved of CPU)]\n"
+    "On SIGINT it drains what it has received, then closes the bag; ~recorded_until says how far it got.\n"
+    "_deterministic:=true records each message at its own stamp and writes the bag in stamp order (held for\n"
+    "_reorder_window seconds of simulated time): two lockstep runs with the same seed give the same file.\n");
 
 volatile std::sig_atomic_t g_stop = 0;
 void onSignal(int) { g_stop = 1; }
@@ -67,32 +77,28 @@ class DelayingQueue : public ros::CallbackQueueInterface {
   ros::WallDuration delay_;
 };
 
-/// The oldest of the newest header stamps written on the period topics: everything up to it is in the
-/// bag on every one of them (each topic's messages come in stamp order over one connection).
+/// The oldest of the newest header stamps received on the period topics: everything up to it is recorded
+/// on every one of them (each topic's messages come in stamp order over one connection): in the bag, or in
+/// deterministic mode held for the stamp order and written at the close at the latest.
 class RecordedUntil {
  public:
   RecordedUntil(ros::NodeHandle& pnh, std::size_t topics)
       : newest_(topics), checked_(topics, false), pub_(pnh.advertise<std_msgs::Time>("recorded_until", 1, true)) {}
 
-  /// A message of period topic `i` was written. Its header stamp is at bytes 4..11 of the serialised
-  /// message (std_msgs/Header: uint32 seq, then the stamp).
-  void written(std::size_t i, const std::string& topic, const topic_tools::ShapeShifter& msg) {
+  /// A message of period topic `i`, stamped `stamp` if it carries one, was received (and written, or held
+  /// for the stamp order: in the bag at the close either way).
+  void received(std::size_t i, const std::string& topic, const topic_tools::ShapeShifter& msg, bool stamped,
+                const ros::Time& stamp) {
     if (!checked_[i]) {
       checked_[i] = true;
-      if (!startsWithHeader(msg.getMessageDefinition())) {
+      if (!sowing_robot::startsWithHeader(msg.getMessageDefinition())) {
         ROS_ERROR("bag_recorder: period topic %s (%s) has no header first; not counted in recorded_until",
                   topic.c_str(), msg.getDataType().c_str());
         ignored_.push_back(i);
       }
     }
-    if (std::find(ignored_.begin(), ignored_.end(), i) != ignored_.end() || msg.size() < 12) return;
-    buffer_.resize(msg.size());
-    ros::serialization::OStream stream(buffer_.data(), static_cast<std::uint32_t>(buffer_.size()));
-    msg.write(stream);
-    std::uint32_t sec, nsec;
-    std::memcpy(&sec, buffer_.data() + 4, 4);
-    std::memcpy(&nsec, buffer_.data() + 8, 4);
-    newest_[i] = std::max(newest_[i], ros::Time(sec, nsec));
+    if (std::find(ignored_.begin(), ignored_.end(), i) != ignored_.end() || !stamped) return;
+    newest_[i] = std::max(newest_[i], stamp);
     ros::Time oldest = ros::TIME_MAX;
     for (std::size_t k = 0; k < newest_.size(); ++k)
       if (std::find(ignored_.begin(), ignored_.end(), k) == ignored_.end()) oldest = std::min(oldest, newest_[k]);
@@ -101,22 +107,12 @@ class RecordedUntil {
       pub_.publish(published_);
     }
   }
+  const ros::Time& until() const { return published_.data; }
 
  private:
-  static bool startsWithHeader(const std::string& definition) {
-    std::istringstream ss(definition);
-    for (std::string line; std::getline(ss, line);) {
-      const std::size_t first = line.find_first_not_of(" \t");
-      if (first == std::string::npos || line[first] == '#') continue;
-      return line.compare(first, 13, "Header header") == 0;
-    }
-    return false;
-  }
-
   std::vector<ros::Time> newest_;  // zero until the topic's first message
   std::vector<bool> checked_;
   std::vector<std::size_t> ignored_;
-  std::vector<std::uint8_t> buffer_;
   std_msgs::Time published_;
   ros::Publisher pub_;
 };
@@ -126,6 +122,8 @@ struct Options {
   std::vector<std::string> topics, period_topics;
   int queue = 200000;
   double receive_delay = 0.0;
+  bool deterministic = false;
+  double reorder_window = 5.0;  // [s] simulated
 };
 
 /// Reads and checks the private parameters; throws badParameter (node_failure.h) on the first problem.
@@ -140,6 +138,8 @@ Options readOptions(const ros::NodeHandle& pnh) {
     for (std::string& t : *list) t = ros::names::resolve(t);
   o.queue = p.get("queue", o.queue);
   o.receive_delay = p.get("receive_delay", o.receive_delay);
+  o.deterministic = p.get("deterministic", o.deterministic);
+  o.reorder_window = p.get("reorder_window", o.reorder_window);
   if (!p.error().empty()) sowing_robot::refuseToStart(p.error());
   const std::string unknown = p.unknownKeys();
   if (!unknown.empty()) sowing_robot::refuseToStart(unknown);
@@ -148,6 +148,8 @@ Options readOptions(const ros::NodeHandle& pnh) {
         "~output (a path) and ~topics (space-separated) are required, ~queue >= 1 (got output '" + o.output + "', " +
         std::to_string(o.topics.size()) + " topics, queue " + std::to_string(o.queue) + ")");
   }
+  if (!(o.reorder_window > 0.0 && o.reorder_window <= 600.0))
+    sowing_robot::refuseToStart("~reorder_window = " + std::to_string(o.reorder_window) + " must be in (0, 600] s");
   if (!(o.receive_delay >= 0.0 && o.receive_delay < 1.0))
     sowing_robot::refuseToStart("~receive_delay = " + std::to_string(o.receive_delay) + " must be in [0, 1) s");
   for (const std::string& t : o.period_topics)
@@ -167,20 +169,48 @@ int record(ros::NodeHandle& nh, ros::NodeHandle& pnh, const Options& o) {
   RecordedUntil recorded(pnh, o.period_topics.size());
   ros::CallbackQueue* q = ros::getGlobalCallbackQueue();
   DelayingQueue delaying(q, o.receive_delay);
-  std::size_t written = 0;
+  std::size_t received = 0;
+  sowing_robot::StampOrderWriter ordered(bag, o.topics);  // ~deterministic only
+  const ros::Duration window(o.reorder_window);
+  std::unordered_set<std::string> warned;  // topics already warned of (deterministic mode)
   std::vector<ros::Subscriber> subs, period_subs;
   for (const std::string& topic : o.topics) {
     const auto period = std::find(o.period_topics.begin(), o.period_topics.end(), topic);
     const std::size_t index = static_cast<std::size_t>(period - o.period_topics.begin());
     const bool is_period = period != o.period_topics.end();
     boost::function<void(const ros::MessageEvent<topic_tools::ShapeShifter const>&)> cb =
-        [&bag, &written, &recorded, topic, index,
+        [&bag, &received, &recorded, &ordered, &window, &warned, &o, topic, index,
          is_period](const ros::MessageEvent<topic_tools::ShapeShifter const>& event) {
-          ros::Time t = ros::Time::now();
-          if (t < ros::TIME_MIN) t = ros::TIME_MIN;  // before the first /clock
-          bag.write(topic, t, event.getMessage(), event.getConnectionHeaderPtr());
-          ++written;
-          if (is_period) recorded.written(index, topic, *event.getMessage());
+          const topic_tools::ShapeShifter& msg = *event.getMessage();
+          ros::Time stamp;
+          const bool stamped = (o.deterministic || is_period) && sowing_robot::messageStamp(msg, stamp);
+          ++received;
+          if (!o.deterministic) {
+            ros::Time t = ros::Time::now();
+            if (t < ros::TIME_MIN) t = ros::TIME_MIN;  // before the first /clock
+            bag.write(topic, t, event.getMessage(), event.getConnectionHeaderPtr());
+          } else {
+            ros::Time t = stamped ? stamp : ros::Time::now();
+            if (t < ros::TIME_MIN) t = ros::TIME_MIN;  // a stamp of 0
+            if (!stamped && warned.insert(topic).second)
+              ROS_WARN(
+                  "bag_recorder: %s (%s) carries no stamp: recorded at its receive time, so the bag will not "
+                  "repeat bit for bit",
+                  topic.c_str(), msg.getDataType().c_str());
+            std::vector<std::uint8_t> bytes(msg.size());
+            ros::serialization::OStream to(bytes.data(), static_cast<std::uint32_t>(bytes.size()));
+            msg.write(to);
+            const ros::Time written_up_to = ordered.writtenUpTo();
+            if (!ordered.add(topic, t, std::move(bytes), event.getConnectionHeaderPtr()) &&
+                warned.insert(topic + " late").second)
+              ROS_WARN(
+                  "bag_recorder: %s stamped %.3f s came after the bag was written to %.3f s (~reorder_window "
+                  "%.1f s): written out of order, so the bag will not repeat bit for bit",
+                  topic.c_str(), t.toSec(), written_up_to.toSec(), window.toSec());
+          }
+          if (is_period) recorded.received(index, topic, msg, stamped, stamp);
+          if (o.deterministic && recorded.until() > ros::TIME_MIN + window)
+            ordered.writeBefore(recorded.until() - window);
         };
     ros::SubscribeOptions so;
     so.initByFullCallbackType<const ros::MessageEvent<topic_tools::ShapeShifter const>&>(
@@ -200,16 +230,23 @@ int record(ros::NodeHandle& nh, ros::NodeHandle& pnh, const Options& o) {
   // Drain: keep writing until nothing has arrived for a second, then close.
   subs.clear();
   for (ros::WallTime quiet = ros::WallTime::now(); (ros::WallTime::now() - quiet).toSec() < 1.0;) {
-    const std::size_t before = written;
+    const std::size_t before = received;
     q->callAvailable(ros::WallDuration(0.05));
-    if (written != before) quiet = ros::WallTime::now();
+    if (received != before) quiet = ros::WallTime::now();
+  }
+  std::string order;
+  if (o.deterministic) {
+    ordered.writeAll();
+    const sowing_robot::StampOrderWriter::Counts& c = ordered.counts();
+    order = " in stamp order (" + std::to_string(c.repeats) + " resent kept once, " + std::to_string(c.late) + " late)";
   }
   bag.close();
   if (std::rename(active.c_str(), o.output.c_str()) != 0) {
     ROS_ERROR("bag_recorder: could not rename %s to %s", active.c_str(), o.output.c_str());
     return 1;
   }
-  std::printf("bag_recorder: %zu messages written to %s\n", written, o.output.c_str());
+  std::printf("bag_recorder: %zu messages written to %s%s\n", o.deterministic ? ordered.counts().written : received,
+              o.output.c_str(), order.c_str());
   std::fflush(stdout);
   return 0;
 }

@@ -44,8 +44,8 @@ SeedDrillNode::SeedDrillNode(ros::NodeHandle nh, ros::NodeHandle pnh) {
   chunk_.color.g = 0.85f;
   chunk_.color.b = 0.3f;
   chunk_.color.a = 1.0f;
-  seeds_pub_ = nh.advertise<visualization_msgs::MarkerArray>("seeds", 10);
-  report_pub_ = nh.advertise<std_msgs::Float64MultiArray>("seed_report", 1, true);
+  seeds_pub_ = nh.advertise<visualization_msgs::MarkerArray>("seeds", kLockstepQueue);
+  report_pub_ = nh.advertise<std_msgs::Float64MultiArray>("seed_report", 100, true);
   // Subscribed here, not from the plan's callback: a subscription made from a callback of the shared
   // nodelet thread while the plant publishes its state hung a nodelet run (1 in ~10 under load). States that
   // come before the first plan (latched: it comes at once) are not scored (the robot is still at rest).
@@ -77,7 +77,7 @@ void SeedDrillNode::planCallback(const FieldPlan::ConstPtr& msg) {
   drill_ = std::make_unique<core::SeedDrill>(settings_.seeding, std::move(rows), std::move(obstacles),
                                              msg->influence_distance);
   ROS_INFO("seed_drill: plan of %zu row(s), %zu obstacle(s): sowing", n, msg->obstacle_radii.size());
-  publishReport();
+  publishReport(msg->header.stamp);
 }
 
 SeedDrillNode::~SeedDrillNode() {
@@ -134,18 +134,19 @@ void SeedDrillNode::update(const nav_msgs::Odometry& odom, bool tool_down) {
   visualization_msgs::MarkerArray out;
   out.markers.push_back(chunk_);
   seeds_pub_.publish(out);
-  if (++seeds_ % 50 == 0) publishReport();
+  if (++seeds_ % 50 == 0) publishReport(odom.header.stamp);
 }
 
-void SeedDrillNode::publishReport() {
+void SeedDrillNode::publishReport(const ros::Time& stamp) {
   std_msgs::Float64MultiArray r;
   const core::SeedStats &rows = drill_->onRows(), &det = drill_->detours();
   r.layout.dim.resize(1);
-  r.layout.dim[0].label = "rows_count,rows_max,rows_rms,rows_fraction_over,detour_count,detour_max,detour_rms";
-  r.layout.dim[0].size = 7;
-  r.layout.dim[0].stride = 7;
+  // the stamp last (message_stamp.h): a deterministic bag records the report at it
+  r.layout.dim[0].label = "rows_count,rows_max,rows_rms,rows_fraction_over,detour_count,detour_max,detour_rms,stamp";
+  r.layout.dim[0].size = 8;
+  r.layout.dim[0].stride = 8;
   r.data = {static_cast<double>(rows.count), rows.max, rows.rms, rows.fraction_over,
-            static_cast<double>(det.count),  det.max,  det.rms};
+            static_cast<double>(det.count),  det.max,  det.rms,  stamp.toSec()};
   report_pub_.publish(r);
 }
 

@@ -76,7 +76,7 @@ class FieldRun(unittest.TestCase):
             time.sleep(0.05)
         time.sleep(1.0)  # the drill's last report
         p = state["last"].pose.pose.position
-        rows_count, rows_max, rows_rms, rows_over, det_count, det_max, det_rms = state["report"]
+        rows_count, rows_max, rows_rms, rows_over, det_count, det_max, det_rms, _stamp = state["report"]
         print("field: min body clearance %.3f m, %d contact message(s), peak |omega| %.3f rad/s, peak |v omega| "
               "%.3f m/s^2, end (%.3f, %.3f), seeds on rows %d (max %.4f m, RMS %.4f m, %.1f %% over tolerance), "
               "detour seeds %d (max %.3f m)" %

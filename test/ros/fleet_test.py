@@ -6,13 +6,14 @@ its own at a free port:
     summary compares every period of both (15001 stamps), with the closest approach the robots' lane spacing
     (1 m, at the start) and no encounter;
   * run B (safety_distance 1.2 m, record:=true): the same metrics bit for bit; the same messages in each robot's
-    bag on every period topic, bit for bit and in the same order; fleet_monitor warns of the robots closer than
-    1.2 m and counts the encounters;
+    bag on every period topic, bit for bit and in the same order, and the same bag files byte for byte (the
+    fleet's recorders write in stamp order: bag_recorder ~deterministic); fleet_monitor warns of the robots closer
+    than 1.2 m and counts the encounters;
   * robot_0 alone (sim.launch with the same row): the same metrics as robot_0 in the fleet, bit for bit (the
     fleet's namespaces, frames and clocks change nothing in a robot's run);
   * a robot's plant_sim killed mid-run: fleet_monitor ends the run within seconds with its FATAL line and exit 3,
     never waiting for the clock the dead robot holds back.
-The bags' bytes are not compared: the recorder stamps each message with its receive time (docs/fleet.md)."""
+Seen to fail: with the recorders in receive order (record_deterministic false) the bag files differ."""
 import os
 import re
 import signal
@@ -54,6 +55,16 @@ def read(path):
         return f.read()
 
 
+def read_bytes(path):
+    with open(path, "rb") as f:
+        return f.read()
+
+
+def topic_counts(bag_path):
+    with rosbag.Bag(bag_path) as bag:
+        return {t: i.message_count for t, i in bag.get_type_and_topic_info().topics.items()}
+
+
 def period_messages(bag_path, robot):
     """{topic: [serialised message bytes, in bag order]} of the robot's period topics."""
     out = {t: [] for t in PERIOD_TOPICS}
@@ -91,7 +102,7 @@ class Fleet(unittest.TestCase):
         self.assertEqual(int(summary.group(7)), 0)
         print("fleet A: " + summary.group(0))
 
-    def test_a_repeat_gives_the_same_metrics_and_bag_messages(self):
+    def test_a_repeat_gives_the_same_metrics_and_bags(self):
         da, code_a, _, _ = self.runs["a"]
         db, code_b, out_b, _ = self.runs["b"]
         self.assertEqual((code_a, code_b), (0, 0), out_b[-3000:])
@@ -102,6 +113,9 @@ class Fleet(unittest.TestCase):
             for topic in PERIOD_TOPICS:  # (the references go on `lookahead` beyond the end)
                 self.assertGreaterEqual(len(ma[topic]), PERIODS, "%s/%s" % (robot, topic))
                 self.assertTrue(ma[topic] == mb[topic], "%s/%s differs between the runs" % (robot, topic))
+            bag_a, bag_b = os.path.join(da, robot + ".bag"), os.path.join(db, robot + ".bag")
+            self.assertTrue(read_bytes(bag_a) == read_bytes(bag_b), "%s's bag files differ: messages per topic %s against %s"
+                            % (robot, topic_counts(bag_a), topic_counts(bag_b)))
         # run B only widened the safety distance: the robots start 1 m apart, so it reports them
         self.assertRegex(out_b, r"fleet_monitor: robot_0 and robot_1 closer than 1\.200 m \(safety_distance\) at t = ")
         self.assertRegex(out_b, r"; [1-9]\d* encounter\(s\) closer than 1\.200 m")

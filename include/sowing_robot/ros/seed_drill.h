@@ -3,6 +3,10 @@
 // torque_controller's hitch control holds it up for that stamp: ~follow_hitch), shows
 // the seeds in rviz and reports the cross-track error of the sown line against the intended rows (away
 // from obstacles and in detours apart).
+// Outputs: `seeds` (visualization_msgs/MarkerArray, a chunk of points per message, stamped with the state's
+// stamp) and `seed_report` (std_msgs/Float64MultiArray, latched, at the plan and every 50 seeds; its label
+// names the entries: rows_count, rows_max, rows_rms, rows_fraction_over, detour_count, detour_max,
+// detour_rms [m], stamp [s, of the state that sowed the last seed]).
 #pragma once
 
 #include <nav_msgs/Odometry.h>
@@ -40,7 +44,7 @@ class SeedDrillNode {
   void planCallback(const FieldPlan::ConstPtr& msg);
   /// The state and the reference for the same time: move the tool, maybe drop a seed.
   void update(const nav_msgs::Odometry& odom, bool tool_down);
-  void publishReport();
+  void publishReport(const ros::Time& stamp);
 
   core::SeedDrillSettings settings_;
   std::unique_ptr<core::SeedDrill> drill_;  ///< null until the first plan

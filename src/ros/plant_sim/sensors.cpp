@@ -22,7 +22,7 @@ PlantSensors::PlantSensors(ros::NodeHandle nh, const core::SensorParams& params,
 
   odom_pub_ = nh.advertise<nav_msgs::Odometry>("odom", kLockstepQueue);
   imu_pub_ = nh.advertise<sensor_msgs::Imu>("imu", kLockstepQueue);
-  fix_pub_ = nh.advertise<geometry_msgs::PoseWithCovarianceStamped>("fix", 100);
+  fix_pub_ = nh.advertise<geometry_msgs::PoseWithCovarianceStamped>("fix", kLockstepQueue);
 
   odom_msg_.header.frame_id = odom_frame;
   odom_msg_.child_frame_id = base_frame;

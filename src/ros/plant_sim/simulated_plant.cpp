@@ -31,7 +31,7 @@ SimulatedPlant::SimulatedPlant(ros::NodeHandle nh, const core::RobotParams& robo
 
   clock_pub_ = nh.advertise<rosgraph_msgs::Clock>("/clock", 10);
   truth_pub_ = nh.advertise<nav_msgs::Odometry>("ground_truth", kLockstepQueue);
-  joint_pub_ = nh.advertise<sensor_msgs::JointState>("joint_states", 10);
+  joint_pub_ = nh.advertise<sensor_msgs::JointState>("joint_states", kLockstepQueue);
   applied_pub_ = nh.advertise<WheelTorque>("applied_torque", kLockstepQueue);
   path_pub_ = nh.advertise<nav_msgs::Path>("travelled_path", 1, true);
 

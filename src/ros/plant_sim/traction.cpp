@@ -8,6 +8,7 @@
 #include <cstdio>
 
 #include "sowing_robot/ros/common/component_params.h"
+#include "sowing_robot/ros/common/msg_checks.h"
 
 namespace sowing_robot {
 
@@ -67,7 +68,7 @@ TractionModel::TractionModel(ros::NodeHandle nh, const core::RobotParams& robot,
   plant_.setSoil(config.soil);
   plant_.setToolPoint(config.tool);
   plant_.reset(x0, 0.0);
-  slip_pub_ = nh.advertise<std_msgs::Float64MultiArray>("wheel_slip", 10);
+  slip_pub_ = nh.advertise<std_msgs::Float64MultiArray>("wheel_slip", kLockstepQueue);
   soil_pub_ = nh.advertise<visualization_msgs::MarkerArray>("soil_markers", 1, true);
   publishSoil();
   if (cfg_.traction.draft_force > 0.0) plan_sub_ = nh.subscribe("plan", 1, &TractionModel::planCallback, this);
@@ -114,12 +115,14 @@ void TractionModel::step(double tau_right, double tau_left, double dt) {
   if (plant_.toolDown()) tool_down_time_ += dt;
 }
 
-void TractionModel::publishVisuals(const ros::Time& /*stamp*/) {
+void TractionModel::publishVisuals(const ros::Time& stamp) {
   std_msgs::Float64MultiArray m;
   m.layout.dim.resize(1);
-  m.layout.dim[0].label = "slip_right,slip_left,force_right,force_left,draft_force,tool_down,patch_right,patch_left";
-  m.layout.dim[0].size = 8;
-  m.layout.dim[0].stride = 8;
+  // the stamp last (message_stamp.h): a deterministic bag records the array at it
+  m.layout.dim[0].label =
+      "slip_right,slip_left,force_right,force_left,draft_force,tool_down,patch_right,patch_left,stamp";
+  m.layout.dim[0].size = 9;
+  m.layout.dim[0].stride = 9;
   m.data = {plant_.slipRatio(core::RIGHT),
             plant_.slipRatio(core::LEFT),
             plant_.groundForce(core::RIGHT),
@@ -127,7 +130,8 @@ void TractionModel::publishVisuals(const ros::Time& /*stamp*/) {
             plant_.draftForce(),
             plant_.toolDown() ? 1.0 : 0.0,
             static_cast<double>(plant_.patchUnder(core::RIGHT)),
-            static_cast<double>(plant_.patchUnder(core::LEFT))};
+            static_cast<double>(plant_.patchUnder(core::LEFT)),
+            stamp.toSec()};
   slip_pub_.publish(m);
 }
 

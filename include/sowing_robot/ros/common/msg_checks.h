@@ -40,6 +40,9 @@ namespace sowing_robot {
 /// (which does not wait for it) must not lose messages, so the queue holds several seconds of a 1 kHz
 /// run; and a subscriber in a nodelet manager gets the reference generator's lookahead in one burst
 /// (50 references at the defaults), which a short queue would cut (dropping the oldest, the one due).
+/// The recorded topics that are not per period (seeds, joint_states, fix, wheel_slip) use it too: a
+/// publisher's queue is per subscriber, and a short one dropped the oldest of them before a lagging recorder
+/// read them (a loaded fleet run recorded 77 of 88 seed messages).
 constexpr std::uint32_t kLockstepQueue = 20000;
 }  // namespace sowing_robot
 

@@ -7,7 +7,8 @@
 // lockstep run does not start before the plan has come (ready()), so every step sees the same rows.
 // Outputs: `wheel_slip` (std_msgs/Float64MultiArray, with the visuals at publish_rate; layout label
 // names the entries: slip_right, slip_left [slip ratio], force_right, force_left [N, ground force on each
-// wheel], draft_force [N, on v], tool_down [0/1], patch_right, patch_left [index, -1: default soil]) and
+// wheel], draft_force [N, on v], tool_down [0/1], patch_right, patch_left [index, -1: default soil],
+// stamp [s, the simulated time]) and
 // `soil_markers` (visualization_msgs/MarkerArray, latched: each patch's outline and fill in odom_frame).
 #pragma once
 
