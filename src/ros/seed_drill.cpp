@@ -39,7 +39,7 @@ SeedDrillNode::SeedDrillNode(ros::NodeHandle nh, ros::NodeHandle pnh) {
   chunk_.type = visualization_msgs::Marker::SPHERE_LIST;
   chunk_.action = visualization_msgs::Marker::ADD;
   chunk_.pose.orientation.w = 1.0;
-  chunk_.scale.x = chunk_.scale.y = chunk_.scale.z = 0.04;
+  chunk_.scale.x = chunk_.scale.y = chunk_.scale.z = settings_.marker_size;
   chunk_.color.r = 0.95f;
   chunk_.color.g = 0.85f;
   chunk_.color.b = 0.3f;

@@ -212,6 +212,9 @@ const ParamTable<SeedDrillSettings>& SeedDrillSettings::table() {
              "sow only while torque_controller's hitch control leaves the tool down (WheelTorque/tool_raised on "
              "wheel_torque, paired by stamp with the state and the reference; sim.launch sets it); false: the "
              "reference's tool_down alone (no torque_controller)"),
+        number("marker_size", &S::marker_size, 0.04, Limits::closed(0.005, 1.0), "m",
+               "diameter of the seeds' spheres in rviz (display only; fleet.launch shows them larger, to be seen "
+               "at the scale of the whole field)"),
     });
     return t.nest("", &S::seeding, seedingTable());
   }();

@@ -101,6 +101,7 @@ struct SeedDrillSettings {
   SeedDrillSettings();
   std::string tool_link;
   bool follow_hitch;
+  double marker_size;  ///< rviz only: the seeds' sphere diameter
   SeedingParams seeding;
   std::string validate() const { return table().checkRanges(*this); }
   static const ParamTable<SeedDrillSettings>& table();
