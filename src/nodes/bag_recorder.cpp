@@ -183,13 +183,18 @@ int record(ros::NodeHandle& nh, ros::NodeHandle& pnh, const Options& o) {
          is_period](const ros::MessageEvent<topic_tools::ShapeShifter const>& event) {
           const topic_tools::ShapeShifter& msg = *event.getMessage();
           ros::Time stamp;
-          const bool stamped = (o.deterministic || is_period) && sowing_robot::messageStamp(msg, stamp);
+          bool stamped = false;
           ++received;
           if (!o.deterministic) {
+            stamped = is_period && sowing_robot::messageStamp(msg, stamp);
             ros::Time t = ros::Time::now();
             if (t < ros::TIME_MIN) t = ros::TIME_MIN;  // before the first /clock
             bag.write(topic, t, event.getMessage(), event.getConnectionHeaderPtr());
           } else {
+            std::vector<std::uint8_t> bytes(msg.size());  // held by the writer; the stamp is read from them
+            ros::serialization::OStream to(bytes.data(), static_cast<std::uint32_t>(bytes.size()));
+            msg.write(to);
+            stamped = sowing_robot::messageStamp(msg, bytes, stamp);
             ros::Time t = stamped ? stamp : ros::Time::now();
             if (t < ros::TIME_MIN) t = ros::TIME_MIN;  // a stamp of 0
             if (!stamped && warned.insert(topic).second)
@@ -197,9 +202,6 @@ int record(ros::NodeHandle& nh, ros::NodeHandle& pnh, const Options& o) {
                   "bag_recorder: %s (%s) carries no stamp: recorded at its receive time, so the bag will not "
                   "repeat bit for bit",
                   topic.c_str(), msg.getDataType().c_str());
-            std::vector<std::uint8_t> bytes(msg.size());
-            ros::serialization::OStream to(bytes.data(), static_cast<std::uint32_t>(bytes.size()));
-            msg.write(to);
             const ros::Time written_up_to = ordered.writtenUpTo();
             if (!ordered.add(topic, t, std::move(bytes), event.getConnectionHeaderPtr()) &&
                 warned.insert(topic + " late").second)

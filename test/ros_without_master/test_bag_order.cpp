@@ -91,6 +91,17 @@ TEST(MessageStamp, ReadsTheStampEachTypeCarries) {
   ros::Time t;
   ASSERT_TRUE(sowing_robot::messageStamp(shapeOf(odom(12.5)), t));
   EXPECT_EQ(t, ros::Time(12, 500000000));
+  // the same from bytes already serialised (the recorder's deterministic mode)
+  const nav_msgs::Odometry o = odom(7.25);
+  std::vector<std::uint8_t> bytes(ros::serialization::serializationLength(o));
+  ros::serialization::OStream out(bytes.data(), static_cast<std::uint32_t>(bytes.size()));
+  ros::serialization::serialize(out, o);
+  ASSERT_TRUE(sowing_robot::messageStamp(shapeOf(o), bytes, t));
+  EXPECT_EQ(t, ros::Time(7, 250000000));
+  EXPECT_TRUE(sowing_robot::startsWithHeader("# a comment\n\n  \t\n  Header header\nfloat64 x\n"));
+  EXPECT_FALSE(sowing_robot::startsWithHeader("float64 x\nHeader header\n"));
+  EXPECT_FALSE(sowing_robot::startsWithHeader("# only a comment\n"));
+  EXPECT_FALSE(sowing_robot::startsWithHeader(""));
 
   visualization_msgs::MarkerArray markers;
   markers.markers.resize(3);

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <tuple>
 
 #include "sowing_robot/ros/bag/message_stamp.h"
 
@@ -36,11 +37,9 @@ StampOrderWriter::Connection& StampOrderWriter::connectionOf(const std::string& 
     c.rank =
         static_cast<std::size_t>(std::find(topic_order_.begin(), topic_order_.end(), topic) - topic_order_.begin());
     c.header = header;
-    c.md5 = field(h, "md5sum");
-    c.type = field(h, "type");
-    c.definition = field(h, "message_definition");
-    c.latching = field(h, "latching") == "1" ? "1" : "0";
-    c.has_header = startsWithHeader(c.definition);
+    const std::string definition = field(h, "message_definition");
+    c.shape.morph(field(h, "md5sum"), field(h, "type"), definition, field(h, "latching") == "1" ? "1" : "0");
+    c.has_header = startsWithHeader(definition);
   }
   return c;
 }
@@ -53,14 +52,21 @@ bool StampOrderWriter::add(const std::string& topic, const ros::Time& time, std:
     write(time, c, bytes);
     return false;
   }
-  held_.emplace(Key{time, c.rank, c.topic, c.callerid, arrivals_++}, Held{&c, std::move(bytes)});
+  held_.emplace(Key{time, &c, arrivals_++}, std::move(bytes));
   return true;
+}
+
+bool StampOrderWriter::Key::operator<(const Key& o) const {
+  if (time != o.time) return time < o.time;
+  if (connection != o.connection)
+    return std::tie(connection->rank, connection->topic, connection->callerid) <
+           std::tie(o.connection->rank, o.connection->topic, o.connection->callerid);
+  return arrival < o.arrival;
 }
 
 void StampOrderWriter::writeBefore(const ros::Time& time) {
   auto it = held_.begin();
-  for (; it != held_.end() && std::get<0>(it->first) < time; ++it)
-    write(std::get<0>(it->first), *it->second.connection, it->second.bytes);
+  for (; it != held_.end() && it->first.time < time; ++it) write(it->first.time, *it->first.connection, it->second);
   held_.erase(held_.begin(), it);
   written_up_to_ = std::max(written_up_to_, time);
 }
@@ -79,11 +85,9 @@ void StampOrderWriter::write(const ros::Time& time, Connection& c, std::vector<s
     std::memcpy(bytes.data(), &c.next_seq, 4);  // little-endian, as ROS serialises
     ++c.next_seq;
   }
-  topic_tools::ShapeShifter shape;
-  shape.morph(c.md5, c.type, c.definition, c.latching);
   ros::serialization::IStream from(bytes.data(), static_cast<std::uint32_t>(bytes.size()));
-  shape.read(from);
-  bag_.write(c.topic, time, shape, c.header);
+  c.shape.read(from);
+  bag_.write(c.topic, time, c.shape, c.header);
   ++counts_.written;
 }
 

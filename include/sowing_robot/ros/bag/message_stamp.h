@@ -5,7 +5,9 @@
 #include <ros/time.h>
 #include <topic_tools/shape_shifter.h>
 
+#include <cstdint>
 #include <string>
+#include <vector>
 
 namespace sowing_robot {
 
@@ -19,6 +21,8 @@ constexpr const char* kArrayStampLabel = "stamp";
 ///   (an empty array: time 0);
 /// - std_msgs/Float64MultiArray whose comma-separated dim[0] label ends with `stamp`: that last element [s].
 bool messageStamp(const topic_tools::ShapeShifter& msg, ros::Time& stamp);
+/// The same, with `bytes` the message already serialised (the recorder's deterministic mode holds them anyway).
+bool messageStamp(const topic_tools::ShapeShifter& msg, const std::vector<std::uint8_t>& bytes, ros::Time& stamp);
 
 /// True when the message definition's first field is `Header header` (comments and blank lines skipped).
 bool startsWithHeader(const std::string& message_definition);

@@ -18,6 +18,7 @@
 
 #include <ros/time.h>
 #include <rosbag/bag.h>
+#include <topic_tools/shape_shifter.h>
 
 #include <boost/shared_ptr.hpp>
 
@@ -25,7 +26,6 @@
 #include <cstdint>
 #include <map>
 #include <string>
-#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -62,18 +62,19 @@ class StampOrderWriter {
     std::string topic, callerid;
     std::size_t rank = 0;
     boost::shared_ptr<ros::M_string> header;
-    std::string md5, type, definition, latching;
-    bool has_header = false;  // std_msgs/Header first: its seq is renumbered
+    topic_tools::ShapeShifter shape;  // morphed to the connection's type once; each message is read into it
+    bool has_header = false;          // std_msgs/Header first: its seq is renumbered
     std::uint32_t next_seq = 0;
     bool any = false;  // something written already: the repeat check has a predecessor
     ros::Time last_time;
     std::vector<std::uint8_t> last_bytes;  // seq zeroed
   };
-  /// (time, topic rank, topic, callerid) is the connection's place; then arrival.
-  using Key = std::tuple<ros::Time, std::size_t, std::string, std::string, std::size_t>;
-  struct Held {
-    Connection* connection;
-    std::vector<std::uint8_t> bytes;
+  /// The order: time, then the connection's place (topic rank, topic, callerid), then arrival.
+  struct Key {
+    ros::Time time;
+    Connection* connection;  // the map's node: stable
+    std::size_t arrival;
+    bool operator<(const Key& o) const;
   };
 
   Connection& connectionOf(const std::string& topic, const boost::shared_ptr<ros::M_string>& header);
@@ -82,7 +83,7 @@ class StampOrderWriter {
   rosbag::Bag& bag_;
   std::vector<std::string> topic_order_;
   std::map<std::pair<std::string, std::string>, Connection> connections_;  // by (topic, callerid)
-  std::map<Key, Held> held_;
+  std::map<Key, std::vector<std::uint8_t>> held_;                          // the serialised messages
   std::size_t arrivals_ = 0;
   ros::Time written_up_to_;  // every message before this time is in the bag
   Counts counts_;
