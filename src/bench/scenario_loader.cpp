@@ -313,7 +313,7 @@ core::BenchScenario loadScenarioFileImpl(const std::string& path, const std::str
     b.sine.amplitude = toDouble(required(block, "amplitude", path, "sine/"), path, "sine/amplitude");
     b.sine.wavelength = toDouble(required(block, "wavelength", path, "sine/"), path, "sine/wavelength");
   } else {
-    onlyKeys(block, {"config", "finish_tolerance", "approach", "plan_detours"}, path, "field/");
+    onlyKeys(block, {"config", "finish_tolerance", "approach", "plan_detours", "follower"}, path, "field/");
     b.field = core::FieldRunSetup().field;  // with the footprint's radius, as run_scenario --field
     const std::string config = required(block, "config", path, "field/").as<std::string>();
     loadFieldConfig(config.front() == '/' ? config : directoryOf(path) + "/" + config, b.field, b.obstacles,
@@ -321,6 +321,12 @@ core::BenchScenario loadScenarioFileImpl(const std::string& path, const std::str
     b.finish_tolerance = toDouble(required(block, "finish_tolerance", path, "field/"), path, "field/finish_tolerance");
     if (block["approach"]) b.field.approach = block["approach"].as<bool>();
     if (block["plan_detours"]) b.field.avoidance.plan_detours = block["plan_detours"].as<bool>();
+    if (const YAML::Node f = block["follower"]) {  // over the config's field/follower
+      const std::string name = f.as<std::string>();
+      if (name != "potential" && name != "path")
+        fail(path, "field/follower is '" + name + "': it must be potential or path");
+      b.field.follower = name == "path" ? core::FieldFollower::kPath : core::FieldFollower::kPotential;
+    }
   }
 
   // Plant settings that are not drawn (the disturbance's frequency); the drawn ones are refused here.

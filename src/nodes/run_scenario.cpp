@@ -34,7 +34,7 @@ const char* const kUsage =
     "usage: run_scenario [--tsmc] [--atsmc] [--disturbance] [--mismatch S] [--noise STD] [--duration T] [--rate HZ]\n"
     "                    [--switching NAME --width W] [--repeat N] [--yaml FILE]\n"
     "                    [--traction MU [--slip-stiffness K] [--rolling-resistance C]]\n"
-    "       run_scenario --field [--potential-only] [--no-approach] [--start X Y THETA] [--rate HZ]\n"
+    "       run_scenario --field [--potential-only | --path-follower] [--no-approach] [--start X Y THETA] [--rate HZ]\n"
     "                    [--tsmc] [--traction MU [--wet] [--draft N]]\n"
     "The thesis closed loop in-process (no ROS): the Table 5.5/5.6 metrics as Markdown and the wall time per run.\n\n"
     "Options (line):\n"
@@ -51,12 +51,13 @@ const char* const kUsage =
     "Options (--field: the thesis field, 100 m row, obstacles at x = 20, 50, 80, measured on the body):\n"
     "  --potential-only         the thesis potential field without the planned detours\n"
     "  --no-approach            the target starts at the row start\n"
+    "  --path-follower          field/follower path: the field's path through the path follower of input:=path\n"
     "  --start X Y THETA        the robot's start (default -1 0 0)\n"
     "  --traction MU            with --wet (the wet patch of config/field_thesis_wet.yaml), --draft N (tool draft)\n"
     "  -h, --help               this text\n";
 
 /// The thesis field on the body; returns the exit code.
-int runThesisField(bool potential_only, bool approach, const Pose2D& start, std::int64_t period_ns,
+int runThesisField(bool potential_only, bool approach, bool path_follower, const Pose2D& start, std::int64_t period_ns,
                    const TractionParams& traction, bool wet, bool adaptive) {
   FieldRunSetup s;
   s.scenario.sliding.adaptive = adaptive;
@@ -82,6 +83,7 @@ int runThesisField(bool potential_only, bool approach, const Pose2D& start, std:
   s.field.start_y = 3.0;
   s.field.potential.beta = 4.0;  // config/field_thesis.yaml (alpha 4, influence 0.5, gain 5, ratio 1 are the defaults)
   s.field.avoidance.plan_detours = !potential_only;
+  if (path_follower) s.field.follower = FieldFollower::kPath;
   s.obstacles = {{20.0, 3.0, 0.3}, {50.0, 3.0, 0.3}, {80.0, 3.0, 0.3}};
   const std::string err = s.field.validate();
   if (!err.empty()) {
@@ -98,7 +100,10 @@ int runThesisField(bool potential_only, bool approach, const Pose2D& start, std:
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const FieldRunReport w = runField(whole);
   std::printf("thesis field, %s%s%s (%.0f ms wall), start (%.2f, %.2f, %.3f), footprint circumscribed radius %.3f m:\n",
-              adaptive ? "" : "TSMC, ", potential_only ? "potential field only (thesis)" : "planned detours (issue 15)",
+              adaptive ? "" : "TSMC, ",
+              potential_only  ? "potential field only (thesis)"
+              : path_follower ? "planned detours through the path follower"
+                              : "planned detours (issue 15)",
               potential_only ? "" : (approach ? ", approach from the start" : ", no approach"), 1e3 * wall, start.x,
               start.y, start.theta, s.footprint.circumscribedRadius());
   std::printf(
@@ -130,7 +135,7 @@ int runThesisField(bool potential_only, bool approach, const Pose2D& start, std:
 
 int main(int argc, char** argv) {
   std::vector<bool> modes;
-  bool field = false, potential_only = false, approach = true, wet = false;
+  bool field = false, potential_only = false, approach = true, wet = false, path_follower = false;
   Pose2D start = Scenario().start;
   Scenario sc;
   int repeat = 1;
@@ -152,6 +157,8 @@ int main(int argc, char** argv) {
       potential_only = true;
     else if (a == "--no-approach")
       approach = false;
+    else if (a == "--path-follower")
+      path_follower = true;
     else if (a == "--start") {
       start.x = value("--start X");
       start.y = value("--start Y");
@@ -198,12 +205,18 @@ int main(int argc, char** argv) {
     }
   }
   if (field) {
+    if (potential_only && path_follower) {
+      std::fprintf(stderr,
+                   "run_scenario: --potential-only and --path-follower exclude each other (the path follower "
+                   "has no repulsion: it needs the planned detours)\n");
+      return 2;
+    }
     const std::string err = traction.enabled ? traction.validate() : "";
     if (!err.empty() || ((wet || traction.draft_force > 0.0) && !traction.enabled)) {
       std::fprintf(stderr, "run_scenario: %s\n", err.empty() ? "--wet and --draft need --traction MU" : err.c_str());
       return 2;
     }
-    return runThesisField(potential_only, approach, start, sc.control_period_ns, traction, wet,
+    return runThesisField(potential_only, approach, path_follower, start, sc.control_period_ns, traction, wet,
                           modes.empty() || modes.back());
   }
   if (modes.empty()) modes = {true, false};

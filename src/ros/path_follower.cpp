@@ -36,13 +36,14 @@ std::string loadPathPoints(ParamReader& p, std::vector<Eigen::Vector2d>& out) {
   return "";
 }
 
-PathFollower::PathFollower(ros::NodeHandle nh, ros::NodeHandle pnh, core::PathReference& source, std::string frame)
+PathFollower::PathFollower(ros::NodeHandle nh, ros::NodeHandle pnh, core::PathReference& source, std::string frame,
+                           const char* origin)
     : source_(source), frame_(std::move(frame)) {
   progress_pub_ = pnh.advertise<PathProgress>("progress", 1, true);
   planned_pub_ = nh.advertise<nav_msgs::Path>("planned_path", 1, true);
   progress_.header.frame_id = frame_;
   if (source_.hasPath()) {
-    planChanged("path/points");
+    planChanged(origin);
   } else {
     progress_.status = PathProgress::NO_PATH;
     progress_pub_.publish(progress_);

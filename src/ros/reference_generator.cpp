@@ -6,6 +6,7 @@
 #include <string>
 
 #include "sowing_robot/core/common/validation.h"
+#include "sowing_robot/core/planning/field_path_follower.h"
 #include "sowing_robot/core/planning/seeding.h"
 #include "sowing_robot/ros/common/component_params.h"
 #include "sowing_robot/ros/common/msg_checks.h"
@@ -93,13 +94,15 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
     source_ = std::move(f);
     logSettings("reference_generator", core::pathTable(), path);
   } else {
-    std::unique_ptr<core::FieldReference> f;
+    std::unique_ptr<core::FieldSource> f;
     try {
-      f = std::make_unique<core::FieldReference>(field, obstacles);
+      f = core::makeFieldSource(field, obstacles);
     } catch (const std::invalid_argument& e) {
       throw badParameter(e.what());
     }
     field_ = f.get();
+    potential_ = dynamic_cast<core::FieldReference*>(field_);
+    if (auto* as_path = dynamic_cast<core::FieldPathReference*>(field_)) path_source = &as_path->follower();
     obstacles_ = obstacles;
     source_ = std::move(f);
     logSettings("reference_generator", core::fieldTable(), field);
@@ -118,7 +121,7 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
     governor_ = governed.get();
     source_ = std::move(governed);
   }
-  if (field_) {
+  if (potential_) {
     ros::NodeHandle potential(pnh, "potential");
     reconfigure_ = std::make_unique<ReconfigureServer<ReferenceGeneratorConfig>>(potential);
     // The server would start from the .cfg defaults where a key is not set: hand it the gains in force.
@@ -138,11 +141,12 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
   if (field_) {
     marker_pub_ = nh.advertise<visualization_msgs::MarkerArray>("field_markers", 1, true);
     obstacles_sub_ = nh.subscribe("obstacles", 10, &ReferenceGenerator::obstaclesCallback, this);
-  } else if (path_source) {
-    path_follower_ = std::make_unique<PathFollower>(nh, pnh, *path_source, odom_frame_);
-  } else {
+  } else if (!path_source) {
     line_ = {settings.line_x0, settings.line_y};
   }
+  if (path_source)
+    path_follower_ = std::make_unique<PathFollower>(nh, pnh, *path_source, odom_frame_,
+                                                    field_ ? "the field's rows and turns" : "path/points");
   publishPlan();
   clock_sub_ = nh.subscribe("/clock", 10, &ReferenceGenerator::clockCallback, this, ros::TransportHints().tcpNoDelay());
   if (governor_) {
@@ -190,6 +194,7 @@ void ReferenceGenerator::obstaclesCallback(const visualization_msgs::MarkerArray
   }
   obstacles_ = std::move(obstacles);
   ROS_INFO("reference_generator: %zu obstacle(s) in force now", obstacles_.size());
+  if (path_follower_) path_follower_->replaced("the field re-planned round the obstacles");
   publishPlan();
 }
 
@@ -223,13 +228,13 @@ void ReferenceGenerator::publishPlan() {
       plan.obstacle_centres.push_back(point(Eigen::Vector2d(o.x, o.y)));
       plan.obstacle_radii.push_back(o.radius);
     }
-    plan.influence_distance = field_->potentialField().params().influence_distance;
+    plan.influence_distance = field_->params().potential.influence_distance;
     const core::AvoidanceStatus& s = field_->status();
     plan.status = core::AvoidanceStatus::name(s.code);
     plan.reason = s.code == core::AvoidanceStatus::Code::kOk ? s.bounds_note : s.reason;
     plan.within_bounds = s.within_bounds;
     plan.detours = static_cast<std::uint32_t>(s.detours);
-  } else if (!path_follower_) {  // type path: no rows, no obstacles
+  } else if (!path_follower_) {  // type line (type path: no rows, no obstacles)
     plan.row_starts.push_back(point(line_));
     plan.row_ends.push_back(point(line_ + Eigen::Vector2d(1e5, 0.0)));  // the thesis line, open-ended
     plan.open_ended = true;
@@ -259,7 +264,7 @@ void ReferenceGenerator::publishMarkers() {
     m.color.a = a;
     return m;
   };
-  const double d = field_->potentialField().params().influence_distance;
+  const double d = field_->params().potential.influence_distance;
   for (std::size_t i = 0; i < obstacles_.size(); ++i) {
     const core::Obstacle& o = obstacles_[i];
     Marker body = marker("obstacles", static_cast<int>(i), Marker::CYLINDER, 0.55f, 0.35f, 0.17f, 1.0f);
@@ -293,9 +298,9 @@ void ReferenceGenerator::publishMarkers() {
 }
 
 void ReferenceGenerator::reconfigure(ReferenceGeneratorConfig& config, uint32_t) {
-  const core::PotentialFieldParams old = field_->potentialField().params();
+  const core::PotentialFieldParams old = potential_->potentialField().params();
   try {
-    field_->setGains(config.alpha, config.beta, config.gain, config.tangential_ratio);
+    potential_->setGains(config.alpha, config.beta, config.gain, config.tangential_ratio);
   } catch (const std::invalid_argument& e) {
     ROS_WARN("reference_generator: rejected gain change: %s; keeping alpha %g, beta %g, gain %g, tangential_ratio %g",
              e.what(), old.alpha, old.beta, old.gain, old.tangential_ratio);

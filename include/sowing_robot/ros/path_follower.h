@@ -1,4 +1,5 @@
-// reference_generator's type path (core/planning/path_plan.h): where the path comes from, and what is
+// reference_generator's type path (core/planning/path_plan.h), and type field with field/follower path (the
+// field's rows and turns as a path, core/planning/field_path_follower.h): where the path comes from, and what is
 // reported of following it. The references themselves are sent by reference_generator, like any other.
 //   ~path/points ([[x, y], ...] in the odom frame [m]): the path at start-up (sim.launch path_file:= loads it).
 //   path (nav_msgs/Path, latched or not): replaces the path in force from the reference last sent, so it applies
@@ -34,8 +35,12 @@ std::string loadPathPoints(ParamReader& p, std::vector<Eigen::Vector2d>& out);
 
 class PathFollower {
  public:
-  /// `source` is reference_generator's (it outlives this object); frame: run/odom_frame.
-  PathFollower(ros::NodeHandle nh, ros::NodeHandle pnh, core::PathReference& source, std::string frame);
+  /// `source` is reference_generator's (it outlives this object); frame: run/odom_frame; origin: where the path
+  /// given at start-up comes from (the log line's "path 1 from ...").
+  PathFollower(ros::NodeHandle nh, ros::NodeHandle pnh, core::PathReference& source, std::string frame,
+               const char* origin = "path/points");
+  /// The owner replaced the path in force (the field re-planned round new obstacles): report it as a new path.
+  void replaced(const char* why) { planChanged(why); }
   /// reference_generator has sent the reference stamped stamp_ns: the path source's time then (with the speed
   /// governor it runs slower than the clock) and the path in force, against which the state of that stamp is
   /// measured.

@@ -8,6 +8,8 @@
 //   type field: core::FieldReference (rows + headland turns through the potential field) with the
 //               obstacles from the `obstacles` parameter; `obstacles` (MarkerArray) replaces them at
 //               run time, and `field_markers` (latched) shows obstacles, influence zones and rows.
+//               With field/follower path: core::FieldPathReference, the field's rows and turns as a path
+//               through the follower of type path (core/planning/field_path_follower.h), with its reports.
 //   type path:  core::PathReference (a given path, rounded and timed: core/planning/path_plan.h), from
 //               path/points or nav_msgs/Path on `path`; ros/path_follower.h says what it reports.
 // Speed governor (speed_governor/..., core/planning/speed_governor.h; off by default): the source's time runs
@@ -76,9 +78,10 @@ class ReferenceGenerator {
   core::GovernedReference* governor_ = nullptr;    ///< source_ when the speed governor is on, else null
   bool lockstep_ = false;                          ///< run/mode
   std::int64_t verdict_ns_ = -1;                   ///< stamp of the last traction-control verdict [ns]; -1: none
-  core::FieldReference* field_ = nullptr;          ///< source_ when type is field, else null
+  core::FieldSource* field_ = nullptr;             ///< source_ when type is field, else null
+  core::FieldReference* potential_ = nullptr;      ///< field_ with field/follower potential, else null
   std::vector<core::Obstacle> obstacles_;          ///< the obstacles in force (type field)
-  std::unique_ptr<PathFollower> path_follower_;    ///< type path: its inputs and progress, else null
+  std::unique_ptr<PathFollower> path_follower_;    ///< type path, field/follower path: inputs, progress; else null
   ros::Subscriber clock_sub_, obstacles_sub_, traction_sub_;
   ros::Publisher ref_pub_, path_pub_, marker_pub_, plan_pub_;
   std::string odom_frame_ = "odom";    ///< run/odom_frame
@@ -92,7 +95,7 @@ class ReferenceGenerator {
   std::int64_t period_ns_ = 1000000;  ///< control period (control_rate) [ns]
   std::unique_ptr<PathBuffer> path_;  // reference_path (spacing from the parameters)
   double path_spacing_ = 0.1;         // [m] between stored reference path points
-  std::unique_ptr<ReconfigureServer<ReferenceGeneratorConfig>> reconfigure_;  // type field only
+  std::unique_ptr<ReconfigureServer<ReferenceGeneratorConfig>> reconfigure_;  // field/follower potential only
   ReadyAnnouncer ready_;                                                      // plant_sim waits for it before step 0
 };
 

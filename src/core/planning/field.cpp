@@ -57,6 +57,11 @@ const ParamTable<FieldParams>& fieldTable() {
         number("field/approach_settle", &F::approach_settle, 1.0, Limits::nonNegative(), "m",
                "after the approach joins the row, the tool stays up for this distance while the robot settles "
                "on it (thesis field: with 0 the first seeds fall 8.6 mm off the row, with 1 m at most 3.4 mm)"),
+        choice("field/follower", &F::follower, FieldFollower::kPotential,
+               {{"potential", FieldFollower::kPotential}, {"path", FieldFollower::kPath}},
+               "what follows the rows and turns: potential, the potential field (steers round obstacles also by "
+               "repulsion); path, the path follower of input:=path on the field as a path (planned detours only, "
+               "docs/interfaces.md)"),
     });
     t.nest("field/avoidance/", &F::avoidance, avoidanceTable());
     return t.nest("potential/", &F::potential, potentialFieldTable());

@@ -101,25 +101,65 @@ std::vector<Eigen::Vector2d> simplifyPolyline(const std::vector<Eigen::Vector2d>
   return out;
 }
 
-PathPlan::PathPlan(const std::vector<Eigen::Vector2d>& points, const PathStart& start, const PathParams& params)
+namespace {
+/// simplifyPolyline of each run of equal tool flags (so a point where the tool goes up or down stays); tool[k] is
+/// the flag of the segment from points[k] on, for the kept points as for the given ones.
+std::vector<Eigen::Vector2d> simplifyRuns(const std::vector<Eigen::Vector2d>& points, double tolerance,
+                                          std::vector<bool>& tool) {
+  std::vector<Eigen::Vector2d> out;
+  std::vector<bool> flags;
+  std::size_t a = 0;
+  while (a + 1 < points.size()) {
+    std::size_t b = a + 1;
+    while (b + 1 < points.size() && tool[b] == tool[a]) ++b;
+    const std::vector<Eigen::Vector2d> run =
+        simplifyPolyline(std::vector<Eigen::Vector2d>(points.begin() + a, points.begin() + b + 1), tolerance);
+    for (std::size_t k = 0; k + 1 < run.size(); ++k) {
+      if (!out.empty() && (run[k] - out.back()).norm() < kSamePoint) continue;
+      out.push_back(run[k]);
+      flags.push_back(tool[a]);
+    }
+    a = b;
+  }
+  if (out.empty() || (points.back() - out.back()).norm() >= kSamePoint) {
+    out.push_back(points.back());
+    flags.push_back(false);
+  }
+  tool = std::move(flags);
+  return out;
+}
+}  // namespace
+
+PathPlan::PathPlan(const std::vector<Eigen::Vector2d>& points, const PathStart& start, const PathParams& params,
+                   std::vector<bool> tool)
     : params_(params) {
   const std::string e = params_.validate();
   if (!e.empty()) throw std::invalid_argument("path parameters: " + e);
   if (!allFinite(start.pose.x, start.pose.y, start.pose.theta, start.v) || start.v < 0.0)
     throw std::invalid_argument("path start: a non-finite pose or a negative speed");
   if (points.empty()) throw std::invalid_argument("path: no point");
+  if (!tool.empty() && tool.size() + 1 != points.size())
+    throw std::invalid_argument("path: " + std::to_string(tool.size()) + " tool flags for " +
+                                std::to_string(points.size()) + " points (one per segment)");
   for (std::size_t k = 0; k < points.size(); ++k)
     if (!points[k].allFinite()) throw std::invalid_argument("path: point " + std::to_string(k) + " is not finite");
 
   // Join: a lead along the current heading long enough to stop from the current speed (twice that, so half of
   // it is left beside a rounded corner at its end), then the path from the point closest to the lead's end.
-  const std::vector<Eigen::Vector2d> path = simplifyPolyline(points, params_.simplify_tolerance);
+  // Without flags the tool is params_.tool_down everywhere (the lead too); with them it is up on the lead.
+  const bool flagged = !tool.empty();
+  if (!flagged) tool.assign(points.size() - 1, params_.tool_down);
+  const std::vector<Eigen::Vector2d> path = flagged ? simplifyRuns(points, params_.simplify_tolerance, tool)
+                                                    : simplifyPolyline(points, params_.simplify_tolerance);
+  const bool lead_tool = !flagged && params_.tool_down;
   const Eigen::Vector2d p0(start.pose.x, start.pose.y);
   std::vector<Eigen::Vector2d> v{p0};
+  std::vector<bool> v_tool{lead_tool};  // the flag of the segment from each vertex on
   Eigen::Vector2d from = p0;
   if (start.v > 0.0) {
     from = p0 + (2.0 * rampDistance(start.v, 0.0, params_.a_max) + 0.01) * unitVector(start.pose.theta);
     v.push_back(from);
+    v_tool.push_back(lead_tool);
   }
   std::size_t seg = 0;
   Eigen::Vector2d join = path.front();
@@ -129,9 +169,20 @@ PathPlan::PathPlan(const std::vector<Eigen::Vector2d>& points, const PathStart& 
     if ((from - q).norm() < best - 1e-12) best = (from - q).norm(), join = q, seg = k;
   }
   v.push_back(join);
-  for (std::size_t k = seg + 1; k < path.size(); ++k) v.push_back(path[k]);
-  for (const Eigen::Vector2d& p : v)
-    if (vertices_.empty() || (p - vertices_.back()).norm() >= kSamePoint) vertices_.push_back(p);
+  v_tool.push_back(path.size() > 1 ? tool[seg] : false);
+  for (std::size_t k = seg + 1; k < path.size(); ++k) {
+    v.push_back(path[k]);
+    v_tool.push_back(k + 1 < path.size() ? tool[k] : false);
+  }
+  std::vector<bool> vertex_tool;
+  for (std::size_t k = 0; k < v.size(); ++k) {
+    if (vertices_.empty() || (v[k] - vertices_.back()).norm() >= kSamePoint) {
+      vertices_.push_back(v[k]);
+      vertex_tool.push_back(v_tool[k]);
+    } else {
+      vertex_tool.back() = v_tool[k];  // the segment from the kept vertex is now the dropped one's
+    }
+  }
 
   end_theta_ = start.pose.theta;
   const std::size_t n = vertices_.size();
@@ -166,10 +217,11 @@ PathPlan::PathPlan(const std::vector<Eigen::Vector2d>& points, const PathStart& 
   for (std::size_t k = 0; k + 1 < n; ++k) {
     const bool corner = k + 1 < n - 1;
     addStraight(vertices_[k] + tangent[k] * unitVector(seg_dir[k]), seg_len[k] - tangent[k] - tangent[k + 1],
-                seg_dir[k]);
+                seg_dir[k], vertex_tool[k]);
     pivot_after.push_back(corner && pivot[k + 1] ? turn[k + 1] : 0.0);
     if (corner && fillet_len[k + 1] > 0.0) {
-      addFillet(vertices_[k + 1], tangent[k + 1], seg_dir[k], turn[k + 1], fillet_len[k + 1]);
+      addFillet(vertices_[k + 1], tangent[k + 1], seg_dir[k], turn[k + 1], fillet_len[k + 1],
+                vertex_tool[k] && vertex_tool[k + 1]);
       pivot_after.push_back(0.0);
     }
   }
@@ -178,8 +230,9 @@ PathPlan::PathPlan(const std::vector<Eigen::Vector2d>& points, const PathStart& 
   planSpeeds(start.v, pivot_after);
 }
 
-void PathPlan::addStraight(const Eigen::Vector2d& from, double length, double heading) {
+void PathPlan::addStraight(const Eigen::Vector2d& from, double length, double heading, bool tool_down) {
   Element el;
+  el.tool_down = tool_down;
   el.s0 = length_;
   el.length = std::max(0.0, length);
   el.p0 = from;
@@ -189,8 +242,10 @@ void PathPlan::addStraight(const Eigen::Vector2d& from, double length, double he
   elements_.push_back(el);
 }
 
-void PathPlan::addFillet(const Eigen::Vector2d& vertex, double tangent, double theta0, double phi, double length) {
+void PathPlan::addFillet(const Eigen::Vector2d& vertex, double tangent, double theta0, double phi, double length,
+                         bool tool_down) {
   Element el;
+  el.tool_down = tool_down;
   el.s0 = length_;
   el.length = length;
   el.p0 = vertex - tangent * unitVector(theta0);
@@ -320,13 +375,14 @@ Reference PathPlan::at(double tau) const {
     return r;
   }
   const RampState m = rampState(ph.s0, ph.v0, ph.v1, ph.duration, t);
-  geometry(std::min(m.s, ph.s0 + ph.distance), p, theta, kappa, dkappa);
+  const double s = std::min(m.s, ph.s0 + ph.distance);
+  geometry(s, p, theta, kappa, dkappa);
   r.pose = Pose2D{p.x(), p.y(), wrapAngle(theta)};
   r.v = m.sd;
   r.omega = kappa * m.sd;
   r.v_dot = m.sdd;
   r.omega_dot = dkappa * m.sd * m.sd + kappa * m.sdd;
-  r.tool_down = params_.tool_down;
+  r.tool_down = elementAt(s).tool_down;
   return r;
 }
 
@@ -388,24 +444,25 @@ PathPlan::Projection PathPlan::project(const Eigen::Vector2d& p, double s_lo, do
   return best;
 }
 
-PathReference::PathReference(const PathParams& params, const Pose2D& start, std::vector<Eigen::Vector2d> points)
-    : params_(params), start_(start), initial_points_(std::move(points)) {
+PathReference::PathReference(const PathParams& params, const Pose2D& start, std::vector<Eigen::Vector2d> points,
+                             std::vector<bool> tool)
+    : params_(params), start_(start), initial_points_(std::move(points)), initial_tool_(std::move(tool)) {
   const std::string e = params_.validate();
   if (!e.empty()) throw std::invalid_argument("path parameters: " + e);
   restart();
 }
 
 std::unique_ptr<ReferenceSource> PathReference::clone() const {
-  return std::make_unique<PathReference>(params_, start_, initial_points_);
+  return std::make_unique<PathReference>(params_, start_, initial_points_, initial_tool_);
 }
 
 void PathReference::restart() {
   has_plan_ = !initial_points_.empty();
   plan_t0_ = 0.0;
-  plan_ = has_plan_ ? PathPlan(initial_points_, PathStart{start_, 0.0}, params_) : PathPlan();
+  plan_ = has_plan_ ? PathPlan(initial_points_, PathStart{start_, 0.0}, params_, initial_tool_) : PathPlan();
 }
 
-void PathReference::setPath(const std::vector<Eigen::Vector2d>& points) {
+void PathReference::setPath(const std::vector<Eigen::Vector2d>& points, std::vector<bool> tool) {
   const double now = lastTime();
   PathStart from{start_, 0.0};
   if (has_plan_) {
@@ -413,7 +470,7 @@ void PathReference::setPath(const std::vector<Eigen::Vector2d>& points) {
     from.pose = r.pose;
     from.v = std::max(0.0, r.v);
   }
-  plan_ = PathPlan(points, from, params_);  // throws before anything changes
+  plan_ = PathPlan(points, from, params_, std::move(tool));  // throws before anything changes
   has_plan_ = true;
   plan_t0_ = now;
 }

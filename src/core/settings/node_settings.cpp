@@ -188,7 +188,8 @@ const ParamTable<ReferenceGeneratorSettings>& ReferenceGeneratorSettings::table(
   static const ParamTable<S> table({
       choice("type", &S::type, S::Type::kLine,
              {{"line", S::Type::kLine}, {"field", S::Type::kField}, {"path", S::Type::kPath}},
-             "line: the thesis's sowing line of Table 5.2; field: rows + potential field (config/field*.yaml); "
+             "line: the thesis's sowing line of Table 5.2; field: rows and headland turns (config/field*.yaml) "
+             "followed by the potential field or the path follower (field/follower); "
              "path: a given path (path/points, or nav_msgs/Path on `path`) with a speed profile (config/path.yaml)"),
       number("line/x0", &S::line_x0, 0.0, Limits::any(), "m", "type line: x_d = x0 + v_r t"),
       number("line/v_r", &S::line_v_r, 1.0, Limits::closed(0.0, 10.0), "m/s", "type line: reference speed v_r"),

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "sowing_robot/core/planning/field_path_follower.h"
 #include "sowing_robot/core/simulation/estimated_run.h"
 
 namespace sowing_robot {
@@ -34,7 +35,8 @@ FieldRunReport runField(const FieldRunSetup& setup) {
   // The target starts where the robot does (field/approach), as the node does with plant_sim's start.
   FieldParams field = setup.field;
   if (!field.start_pose) field.start_pose = setup.scenario.start;
-  FieldReference reference(field, setup.obstacles);
+  const std::unique_ptr<FieldSource> source = makeFieldSource(field, setup.obstacles);
+  FieldSource& reference = *source;
   ContactMonitor contacts(setup.footprint, setup.obstacles);
   SeedDrill drill(setup.seeding, rowsOf(setup.field),
                   setup.scoring_obstacles.empty() ? setup.obstacles : setup.scoring_obstacles,
@@ -93,7 +95,11 @@ double approachExtraTime(const FieldRunSetup& setup) {
   if (!with.start_pose) with.start_pose = setup.scenario.start;
   FieldParams without = with;
   without.approach = false;
-  return FieldPath(with, setup.obstacles).duration() - FieldPath(without, setup.obstacles).duration();
+  // The path follower drives the same field in its own time (slower on the turns): the run grows by that too.
+  const double with_duration = with.follower == FieldFollower::kPath
+                                   ? FieldPathReference(with, setup.obstacles).duration()
+                                   : FieldPath(with, setup.obstacles).duration();
+  return with_duration - FieldPath(without, setup.obstacles).duration();
 }
 
 std::string FieldRunReport::summary() const {

@@ -79,6 +79,18 @@ TEST(ScenarioLoader, EverySuiteFileLoads) {
   EXPECT_EQ(bench::loadScenario("sine_rows", kSuite).track, TrackKind::sine);
   EXPECT_GE(bench::loadScenario("heavy_robot", kSuite).spec.mass_scale.lo, 1.3);
   EXPECT_GE(bench::loadScenario("disturbance_sweep", kSuite).spec.amplitude.hi, 5.0);
+  // The same fields through the path follower (config/scenarios/path_follower/): only the follower differs.
+  for (const char* n : {"thesis_field", "three_row_field"}) {
+    SCOPED_TRACE(n);
+    const BenchScenario own = bench::loadScenario(n, kSuite);
+    const BenchScenario path = bench::loadScenarioFile(kSuite + "/path_follower/" + std::string(n) + "_path.yaml");
+    EXPECT_EQ(own.field.follower, core::FieldFollower::kPotential);
+    EXPECT_EQ(path.field.follower, core::FieldFollower::kPath);
+    EXPECT_EQ(path.field.rows, own.field.rows);
+    EXPECT_EQ(path.obstacles.size(), own.obstacles.size());
+    EXPECT_EQ(path.base.duration, own.base.duration);
+    EXPECT_EQ(path.spec.base_seed, own.spec.base_seed);
+  }
 }
 
 TEST(ScenarioLoader, TyposAndMissingKeysAreRefusedNamingThem) {
@@ -99,6 +111,14 @@ TEST(ScenarioLoader, TyposAndMissingKeysAreRefusedNamingThem) {
   EXPECT_NE(e.find("mass_scale"), std::string::npos) << e;
   e = loadError(variant(dir, "disturbance: {frequency: 3.0}", "disturbance: {frequence: 3.0}"));
   EXPECT_NE(e.find("frequence"), std::string::npos) << e;
+  {  // a field's follower must be one of the two
+    const std::string field = readFile(kSuite + "/path_follower/three_row_field_path.yaml");
+    std::string text = field;
+    text.replace(text.find("follower: path"), 14, "follower: pth");
+    text.replace(text.find("../../field.yaml"), 16, kSuite + "/../field.yaml");
+    e = loadError(dir.write("three_row_field_path.yaml", text));
+    EXPECT_NE(e.find("field/follower is 'pth': it must be potential or path"), std::string::npos) << e;
+  }
   e = loadError(variant(dir, "name: thesis_line", "name: other"));
   EXPECT_NE(e.find("must be the file's name"), std::string::npos) << e;
   // Every message is one line, starting with the file.

@@ -140,8 +140,8 @@ TEST(Avoidance, TargetInsideAnObstacleStopsAtTheNearestSafePointWithAReport) {
   const FieldRunSetup s = row60({{60.0, 3.0, 0.3}});  // the row's end at the obstacle's centre
   double last_x = 0.0, moved_late = 0.0;
   FieldRunSetup t = s;
-  t.on_step = [&](double time, FieldReference& ref, ContactMonitor&) {
-    const double x = ref.potentialField().position().x();
+  t.on_step = [&](double time, FieldSource& source, ContactMonitor&) {
+    const double x = static_cast<FieldReference&>(source).potentialField().position().x();
     if (time > 70.0) moved_late = std::max(moved_late, std::fabs(x - last_x));
     if (time <= 70.0) last_x = x;
   };
@@ -178,7 +178,7 @@ TEST(Avoidance, ObstacleAddedAtRunTimeAheadOfTheRobotIsAvoided) {
   const Obstacle added{24.0, 3.0, 0.3};
   s.scoring_obstacles = {added};
   bool set = false;
-  s.on_step = [&](double time, FieldReference& ref, ContactMonitor& contacts) {
+  s.on_step = [&](double time, FieldSource& ref, ContactMonitor& contacts) {
     if (!set && time >= 20.0) {  // the robot is near x = 20: the obstacle comes 4 m ahead
       ref.setObstacles({added});
       contacts.setObstacles({added});

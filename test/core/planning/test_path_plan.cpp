@@ -155,6 +155,35 @@ TEST(PathPlan, RejectsBadInput) {
   EXPECT_THROW(PathPlan({{0, 0}, {1, 1}}, PathStart{}, p), std::invalid_argument);
 }
 
+TEST(PathPlan, ToolFlagsHoldPerSegmentAndKeepTheirPointsThroughSimplification) {
+  PathParams p;
+  // Down, up, down along a straight line: without the flags the middle points would be simplified away.
+  const Points pts{{0, 0}, {4, 0}, {6, 0}, {10, 0}};
+  const PathPlan plan(pts, PathStart{}, p, {true, false, true});
+  EXPECT_EQ(plan.vertices().size(), 4u);
+  for (double tau = 0.0; tau < plan.duration(); tau += 0.01) {
+    const Reference r = plan.at(tau);
+    if (r.pose.x < 3.99) EXPECT_TRUE(r.tool_down) << r.pose.x;
+    if (r.pose.x > 4.01 && r.pose.x < 5.99) EXPECT_FALSE(r.tool_down) << r.pose.x;
+    if (r.pose.x > 6.01) EXPECT_TRUE(r.tool_down) << r.pose.x;
+  }
+  EXPECT_FALSE(plan.at(plan.duration()).tool_down);  // the end hold
+  // A rounded corner keeps the tool down only between two tool-down segments.
+  const PathPlan corner({{0, 0}, {5, 0}, {5, 5}}, PathStart{}, p, {true, false});
+  const Reference mid = corner.at(corner.timeAt(5.0));
+  EXPECT_FALSE(mid.tool_down);
+  EXPECT_EQ(corner.fillets(), 1);
+  // Flags that do not fit, and the lead from a moving start (a transit: up).
+  EXPECT_THROW(PathPlan(pts, PathStart{}, p, {true}), std::invalid_argument);
+  const PathPlan led({{2, 0}, {10, 0}}, PathStart{Pose2D{0, 0, 0}, 0.8}, p, {true});
+  EXPECT_FALSE(led.at(0.05).tool_down);
+  EXPECT_TRUE(led.at(led.duration() - 0.5).tool_down);
+  // Without flags: path/tool_down everywhere, the lead too (as before the flags).
+  p.tool_down = true;
+  const PathPlan plain({{2, 0}, {10, 0}}, PathStart{Pose2D{0, 0, 0}, 0.8}, p);
+  EXPECT_TRUE(plain.at(0.05).tool_down);
+}
+
 TEST(PathReference, HoldsTheStartUntilAPathComesThenReplacesItContinuously) {
   PathParams p;
   PathReference ref(p, Pose2D{0, 0, 0});

@@ -13,6 +13,7 @@
 #include "sowing_robot/core/evaluation/benchmark.h"
 #include "sowing_robot/core/model/contact.h"
 #include "sowing_robot/core/planning/field.h"
+#include "sowing_robot/core/planning/field_path_follower.h"
 #include "sowing_robot/core/simulation/field_run.h"
 #include "sowing_robot/core/simulation/runner.h"
 
@@ -111,7 +112,7 @@ class RowMeter {
 /// reference was last asked for (ReferenceSource::lastTime()), not the run's duration: a speed governor
 /// slows the path's own time, and a robot close to a slowed target that is still short of the path's
 /// end has not finished.
-inline void markNotFinished(RunRow& row, const FieldReference& reference, double duration, double tolerance) {
+inline void markNotFinished(RunRow& row, const FieldSource& reference, double duration, double tolerance) {
   if (!row.failure.empty() && row.failure != "cross-track") return;
   const bool stopped = reference.status().code != AvoidanceStatus::Code::kOk;
   const bool ended = reference.finished(std::min(duration, reference.lastTime()));
@@ -133,7 +134,8 @@ RunRow fieldRow(const BenchScenario& bench, Scenario sc, RunExtras extras, Measu
   setup.field.start_pose = sc.start;
   setup.obstacles = bench.obstacles;
   sc.duration += approachExtraTime(setup);
-  FieldReference reference(setup.field, bench.obstacles);
+  const std::unique_ptr<FieldSource> source = makeFieldSource(setup.field, bench.obstacles);
+  FieldSource& reference = *source;
   ContactMonitor contacts(bench.footprint, bench.obstacles);
   Pose2D last_ref;
   extras.contacts = &contacts;

@@ -32,6 +32,10 @@
 namespace sowing_robot {
 namespace core {
 
+/// What follows the field's rows and turns: the potential field (the thesis's reference, steering round the obstacles
+/// also by repulsion) or the path follower of input:=path on the field as a path (field_path_follower.h).
+enum class FieldFollower { kPotential, kPath };
+
 /// Defaults, ranges, units and meanings: fieldTable() (keys field/... and potential/...).
 struct FieldParams {
   FieldParams();
@@ -53,6 +57,7 @@ struct FieldParams {
   /// joins the first row within the detours' bounds (approach.h); false: it starts at the row start.
   bool approach;
   double approach_settle;  ///< the tool stays up this far past the approach's join [m], >= 0
+  FieldFollower follower;  ///< field/follower: potential (default) or path
   /// The robot's start pose [m, m, rad]. Not a parameter: the caller sets it (the node from plant_sim's
   /// start/{x, y, theta}, as avoidance.footprint_radius from the URDF). Unset: no approach.
   std::optional<Pose2D> start_pose;
@@ -164,8 +169,23 @@ class FieldPath : public TargetTrajectory {
   double duration_ = 0.0, total_length_ = 0.0;
 };
 
+/// What a field run needs of its reference, whichever follower drives the rows (FieldParams::follower):
+/// FieldReference (potential) or FieldPathReference (path, field_path_follower.h).
+class FieldSource : public ReferenceSource {
+ public:
+  /// True once the path has ended at time t: the reference then holds the last row's end (or a stop short).
+  virtual bool finished(double t) const = 0;
+  virtual double duration() const = 0;  ///< [s] when the path in force ends
+  /// Replace the obstacles at run time and re-plan (throws std::invalid_argument, keeping the old ones).
+  virtual void setObstacles(std::vector<Obstacle> obstacles) = 0;
+  virtual const std::vector<Obstacle>& obstacles() const = 0;  ///< as given (not inflated)
+  virtual const AvoidanceStatus& status() const = 0;           ///< the plan's status
+  virtual const FieldPath& path() const = 0;                   ///< the rows, turns and detours planned
+  virtual const FieldParams& params() const = 0;
+};
+
 /// Reference for a whole field: PotentialField tracking of a FieldPath.
-class FieldReference : public ReferenceSource {
+class FieldReference : public FieldSource {
  public:
   /// Throws std::invalid_argument on invalid parameters or obstacles. With avoidance.plan_detours the
   /// path is planned around the obstacles (FieldPath) and the repulsion gets repulsionObstacles().
@@ -174,26 +194,26 @@ class FieldReference : public ReferenceSource {
   std::unique_ptr<ReferenceSource> clone() const override;
 
   /// True once the path has ended (t >= duration()); the reference then stops at the last row's end.
-  bool finished(double t) const { return t >= duration_; }
-  double duration() const { return duration_; }  ///< [s]
+  bool finished(double t) const override { return t >= duration_; }
+  double duration() const override { return duration_; }  ///< [s]
 
   /// Replace the obstacles at run time (throws std::invalid_argument, keeping the old ones). With a plan,
   /// the path is re-planned as if the new list had been known from the start; the reference point and
   /// its velocity are kept, so where the new plan differs from the old one at the current time (the
   /// obstacle came too close ahead to plan for) the potential field pulls the reference onto it and
   /// status().within_bounds turns false.
-  void setObstacles(std::vector<Obstacle> obstacles);
+  void setObstacles(std::vector<Obstacle> obstacles) override;
   /// The obstacles as given (not inflated).
-  const std::vector<Obstacle>& obstacles() const { return obstacles_; }
+  const std::vector<Obstacle>& obstacles() const override { return obstacles_; }
   /// The plan's status: the node logs it and publishes it (a stop, no safe way, bounds not held).
-  const AvoidanceStatus& status() const { return status_; }
+  const AvoidanceStatus& status() const override { return status_; }
   /// See PotentialField::setGains.
   void setGains(double alpha, double beta, double gain, double tangential_ratio) {
     field_.setGains(alpha, beta, gain, tangential_ratio);
   }
   const PotentialField& potentialField() const { return field_; }
-  const FieldPath& path() const { return static_cast<const FieldPath&>(field_.target()); }
-  const FieldParams& params() const { return params_; }
+  const FieldPath& path() const override { return static_cast<const FieldPath&>(field_.target()); }
+  const FieldParams& params() const override { return params_; }
 
  protected:
   void restart() override { field_.reset(); }

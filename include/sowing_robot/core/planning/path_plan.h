@@ -61,8 +61,12 @@ struct PathStart {
 class PathPlan {
  public:
   PathPlan() = default;  ///< no path: duration 0, at() holds the origin
-  /// Throws std::invalid_argument for invalid params, a non-finite point or start, or no point at all.
-  PathPlan(const std::vector<Eigen::Vector2d>& points, const PathStart& start, const PathParams& params);
+  /// Throws std::invalid_argument for invalid params, a non-finite point or start, no point at all, or tool flags
+  /// that are neither empty nor one per segment. tool[k]: the tool is down from points[k] to points[k + 1] (a
+  /// rounded corner keeps it down only between two such segments; the lead from the start keeps it up); empty:
+  /// params.tool_down along the whole path, the lead included.
+  PathPlan(const std::vector<Eigen::Vector2d>& points, const PathStart& start, const PathParams& params,
+           std::vector<bool> tool = {});
 
   /// The reference tau seconds after the plan's start (tau < 0 counts as 0); past duration(): the last
   /// point, at rest, with stop set.
@@ -96,6 +100,7 @@ class PathPlan {
     double phi = 0.0;                    ///< fillets: turning angle [rad]; 0 for a straight
     double v_limit = 0.0;                ///< [m/s]
     std::vector<Eigen::Vector2d> nodes;  ///< fillets: positions every length/kFilletNodes
+    bool tool_down = false;              ///< the reference's tool_down along it
   };
   /// A piece of the timeline: moving along [s0, s0 + ...] from v0 to v1, or a pivot at arc length s0.
   struct Phase {
@@ -105,9 +110,10 @@ class PathPlan {
   };
   static constexpr int kFilletNodes = 32;
 
-  void addStraight(const Eigen::Vector2d& from, double length, double heading);
+  void addStraight(const Eigen::Vector2d& from, double length, double heading, bool tool_down);
   /// The fillet of corner `vertex`, starting `tangent` before it on the incoming heading theta0.
-  void addFillet(const Eigen::Vector2d& vertex, double tangent, double theta0, double phi, double length);
+  void addFillet(const Eigen::Vector2d& vertex, double tangent, double theta0, double phi, double length,
+                 bool tool_down);
   /// The speed at every element boundary (forward and backward pass) and the phases; pivot_after[j]: the turn
   /// in place after element j (0: none).
   void planSpeeds(double v_start, const std::vector<double>& pivot_after);
@@ -131,14 +137,16 @@ class PathPlan {
 /// the one in force from the reference last returned (its pose and speed), so the reference stays continuous.
 class PathReference : public ReferenceSource {
  public:
-  /// Follows `points` from `start` at rest (none: holds `start` until setPath()). Throws
-  /// std::invalid_argument for invalid params or points.
-  PathReference(const PathParams& params, const Pose2D& start, std::vector<Eigen::Vector2d> points = {});
+  /// Follows `points` from `start` at rest (none: holds `start` until setPath()), with the tool flags of PathPlan.
+  /// Throws std::invalid_argument for invalid params, points or flags.
+  PathReference(const PathParams& params, const Pose2D& start, std::vector<Eigen::Vector2d> points = {},
+                std::vector<bool> tool = {});
   std::unique_ptr<ReferenceSource> clone() const override;
 
-  /// Follow `points` from the reference last returned (from the start pose at rest before any). Throws
-  /// std::invalid_argument (the path in force is kept) for a non-finite point or no point at all.
-  void setPath(const std::vector<Eigen::Vector2d>& points);
+  /// Follow `points` (tool flags as PathPlan's) from the reference last returned (from the start pose at rest before
+  /// any). Throws std::invalid_argument (the path in force is kept) for a non-finite point, no point at all or
+  /// flags that do not fit.
+  void setPath(const std::vector<Eigen::Vector2d>& points, std::vector<bool> tool = {});
   bool hasPath() const { return has_plan_; }
   const PathPlan& plan() const { return plan_; }
   double planStart() const { return plan_t0_; }  ///< time at which the plan in force began [s]
@@ -152,6 +160,7 @@ class PathReference : public ReferenceSource {
   PathParams params_;
   Pose2D start_;
   std::vector<Eigen::Vector2d> initial_points_;  ///< the path given at construction (reset() goes back to it)
+  std::vector<bool> initial_tool_;               ///< and its tool flags
   PathPlan plan_;
   bool has_plan_ = false;
   double plan_t0_ = 0.0;

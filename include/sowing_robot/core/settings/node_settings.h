@@ -89,7 +89,7 @@ struct TorqueControllerSettings {
 struct ReferenceGeneratorSettings {
   enum class Type { kLine, kField, kPath };
   ReferenceGeneratorSettings();
-  Type type;  ///< line (the thesis line), field (rows + potential field) or path (a given path, path_plan.h)
+  Type type;  ///< line (the thesis line), field (rows and turns, field/follower) or path (a given path, path_plan.h)
   double line_x0, line_v_r, line_y;
   double path_spacing, lookahead;
   std::string validate() const { return table().checkRanges(*this); }

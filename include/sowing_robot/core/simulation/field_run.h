@@ -1,5 +1,6 @@
-// A field run in-process, measured on the body: the closed loop (closed_loop.h) on a FieldReference,
-// with the footprint checked against the obstacles (ContactMonitor), the seed drill scoring the tool
+// A field run in-process, measured on the body: the closed loop (closed_loop.h) on the field's reference (a
+// FieldReference, or with field/follower path a FieldPathReference), with the footprint checked against the
+// obstacles (ContactMonitor), the seed drill scoring the tool
 // point, and the peaks of the robot's yaw rate and lateral acceleration v omega. Used by the avoidance
 // tests and by run_scenario --field (the figures of the README's field table).
 #pragma once
@@ -39,7 +40,7 @@ struct FieldRunSetup {
   /// Obstacles the seed drill scores against when not empty (e.g. with one added at run time); else `obstacles`.
   std::vector<Obstacle> scoring_obstacles;
   /// Called every period after the reference of time t was taken (e.g. to change the obstacles).
-  std::function<void(double t, FieldReference& reference, ContactMonitor& contacts)> on_step;
+  std::function<void(double t, FieldSource& reference, ContactMonitor& contacts)> on_step;
   /// Peaks are taken from this time on (e.g. after the approach from the start) [s].
   double peaks_from = 0.0;
   /// Set: the traction plant (traction.h) in place of the no-slip Plant, on these soil patches, with the tool's draft
@@ -72,8 +73,9 @@ struct FieldRunReport {
 /// Throws std::invalid_argument on invalid parameters.
 FieldRunReport runField(const FieldRunSetup& setup);
 
-/// How much longer the path is with the approach from the start pose than without it [s] (0 without
-/// one): a run of fixed duration lengthened by this ends at the same point of the rows.
+/// How much longer the field's reference runs than its path without the approach from the start pose [s]: the
+/// approach, and with field/follower path the follower's own timing (0 for neither). A run of fixed duration
+/// lengthened by this ends at the same point of the rows.
 double approachExtraTime(const FieldRunSetup& setup);
 
 }  // namespace core
