@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "sowing_robot/core/common/validation.h"
+#include "sowing_robot/core/control/traction_control.h"
 #include "sowing_robot/core/simulation/lockstep.h"
 #include "sowing_robot/core/simulation/runner.h"
 #include "sowing_robot/ros/common/component_params.h"
@@ -34,10 +35,22 @@ RunMonitor::RunMonitor(ros::NodeHandle nh, ros::NodeHandle pnh) : pnh_(pnh) {
   metrics_.reserve(static_cast<std::size_t>(duration_ * 1000.0) + 2);
   // Subscribed from the start: the recorder's latched stamp is then already here when the run ends.
   if (!recorder_topic_.empty()) recorder_sub_ = nh.subscribe(recorder_topic_, 10, &RunMonitor::recordedCallback, this);
+  status_pub_ = pnh.advertise<std_msgs::String>("status", 1, true);
   const auto hints = ros::TransportHints().tcpNoDelay();
   truth_sub_ = nh.subscribe("ground_truth", kLockstepQueue, &RunMonitor::truthCallback, this, hints);
   ref_sub_ = nh.subscribe("reference", kLockstepQueue, &RunMonitor::referenceCallback, this, hints);
-  ready_ = ReadyAnnouncer(nh, pnh, run.lockstep, {truth_sub_, ref_sub_});  // last: all subscribed (ready_roster.h)
+  std::vector<ros::Subscriber> awaited{truth_sub_, ref_sub_};
+  // With the traction control the run may end on its no-traction verdict (torque_controller's keys).
+  bool traction_control = false;
+  nh.param("torque_controller/traction_control/enabled", traction_control, false);
+  if (traction_control) {
+    nh.param("torque_controller/traction_control/no_traction_hold", no_traction_hold_,
+             core::TractionControlParams().no_traction_hold);
+    gated_ = run.lockstep;
+    traction_sub_ = nh.subscribe("traction_control/state", kLockstepQueue, &RunMonitor::tractionCallback, this, hints);
+    awaited.push_back(traction_sub_);
+  }
+  ready_ = ReadyAnnouncer(nh, pnh, run.lockstep, awaited);  // last: all subscribed (ready_roster.h)
 }
 
 void RunMonitor::truthCallback(const nav_msgs::Odometry::ConstPtr& msg) {
@@ -55,16 +68,51 @@ void RunMonitor::addPair() {
   const ReferenceState& r = inputs_.second();
   const ros::Time stamp = truth.header.stamp;
   if (metrics_.samples() > 0 && stamp <= last_) return;  // repeats answer a retried state
+  if (!held_.empty() && stamp <= held_.back().stamp) return;
   core::Reference ref;
   ref.pose = {r.x, r.y, r.theta};
   double ex, ey, eth;
   core::worldErrors(ref, poseOf(truth), ex, ey, eth);
+  if (!gated_) {
+    score(stamp, ex, ey, eth);
+    return;
+  }
+  held_.push_back(Held{stamp, ex, ey, eth});
+  flush();
+}
+
+void RunMonitor::score(const ros::Time& stamp, double ex, double ey, double eth) {
   if (!metrics_.add(stamp.toSec(), ex, ey, eth)) {  // refuses non-finite errors
     ROS_WARN_THROTTLE(1.0, "run_monitor: non-finite tracking error ignored");
     return;
   }
   last_ = stamp;
+  // The in-process loop's end (closed_loop.h): the first period at or past the verdict + no_traction_hold.
+  const double t = core::secondsFromNanos(static_cast<std::int64_t>(stamp.toNSec()));
+  if (end_at_ && t >= *end_at_) {
+    ROS_ERROR("run_monitor: the run ends at t = %.3f s: %s (torque_controller)", t, no_traction_.c_str());
+    finish();
+    return;
+  }
   if (stamp.toSec() >= duration_ - 1e-9) finish();
+}
+
+void RunMonitor::tractionCallback(const TractionControlState::ConstPtr& msg) {
+  if (done_) return;
+  if (msg->no_traction && !end_at_) {
+    end_at_ = core::secondsFromNanos(static_cast<std::int64_t>(msg->header.stamp.toNSec())) + no_traction_hold_;
+    no_traction_ = msg->no_traction_report;
+  }
+  if (msg->header.stamp > traction_until_) traction_until_ = msg->header.stamp;
+  flush();
+}
+
+void RunMonitor::flush() {
+  while (!done_ && !held_.empty() && held_.front().stamp <= traction_until_) {
+    const Held h = held_.front();
+    held_.pop_front();
+    score(h.stamp, h.ex, h.ey, h.eth);
+  }
 }
 
 void RunMonitor::finish() {
@@ -76,13 +124,18 @@ void RunMonitor::finish() {
   // In lockstep every period is stepped once, so a missing one is a lost message, not timing: say so
   // rather than hand out metrics that quietly differ from the same run's.
   const auto samples = static_cast<std::int64_t>(metrics_.samples());
-  if (expected_samples_ > 0 && samples != expected_samples_)
+  if (expected_samples_ > 0 && samples != expected_samples_ && !end_at_)
     ROS_ERROR(
         "run_monitor: %ld of the run's %ld periods were scored (%zu messages dropped unpaired): the metrics "
         "miss the rest",
         samples, expected_samples_, inputs_.dropped());
   else if (inputs_.dropped() > 0)
     ROS_WARN("run_monitor: %zu messages dropped unpaired", inputs_.dropped());
+  std_msgs::String status;
+  char at[64];
+  std::snprintf(at, sizeof at, "t = %.3f s", last_.toSec());
+  status.data = end_at_ ? no_traction_ + "; ended at " + at : std::string("completed at ") + at;
+  status_pub_.publish(status);
   std::printf("%s", core::metricsTable({label_}, {m}).c_str());
   std::fflush(stdout);
   if (!output_.empty() && !core::writeMetricsYaml(output_, label_, m))

@@ -45,6 +45,7 @@ TorqueController::TorqueController(ros::NodeHandle nh, ros::NodeHandle pnh) {
   logSettings("torque_controller", core::tractionControlTable(), traction);
   if (traction.enabled) {
     traction_control_.emplace(traction, robot.L);  // validated above
+    traction_monitor_.emplace(traction);
     L_ = robot.L;
   }
   if (hitch.enabled) {
@@ -153,7 +154,10 @@ void TorqueController::desiredCallback(const DesiredVelocity::ConstPtr& msg) {
 void TorqueController::compute() {
   const nav_msgs::Odometry& odom = inputs_.first();
   const DesiredVelocity& d = inputs_.second();
-  const core::VelocityCommand cmd{d.v, d.omega, d.v_dot, d.omega_dot, d.hold != 0};
+  // No traction (closed_loop.h): from the period after the verdict the hold, whatever the plan asks.
+  const bool no_traction = traction_monitor_ && traction_monitor_->detected();
+  const core::VelocityCommand cmd =
+      no_traction ? core::holdCommand() : core::VelocityCommand{d.v, d.omega, d.v_dot, d.omega_dot, d.hold != 0};
   if (stale_) {  // input is back after a gap: restart the integrals (sliding mode: keep the estimates)
     if (smc_)
       smc_->resetSurfaces();
@@ -175,7 +179,7 @@ void TorqueController::compute() {
   holding_ = out.holding;
   core::WheelTorques sent = out.torques;
   if (traction_control_) {
-    sent = limitTraction(out.torques, odom);
+    sent = limitTraction(out.torques, odom, !cmd.hold);
     // As the in-process loop (closed_loop.h, step 4): the inner loop learns which torques were held back.
     if (traction_control_->params().anti_windup) inner_->heldBack(sent);
     // As the in-process loop (closed_loop.h): this period's verdict and the fed speed's travel decide the
@@ -204,7 +208,8 @@ void TorqueController::compute() {
   publishShared(state_pub_, state_);
 }
 
-core::WheelTorques TorqueController::limitTraction(const core::WheelTorques& requested, const nav_msgs::Odometry& fed) {
+core::WheelTorques TorqueController::limitTraction(const core::WheelTorques& requested, const nav_msgs::Odometry& fed,
+                                                   bool driving) {
   while (!wheel_speeds_.empty() && wheel_speeds_.front().stamp < fed.header.stamp) wheel_speeds_.pop_front();
   if (wheel_speeds_.empty() || wheel_speeds_.front().stamp != fed.header.stamp) {
     // Cannot happen: a fed state reaches the pair only with its encoders' message (feed()).
@@ -224,6 +229,18 @@ core::WheelTorques TorqueController::limitTraction(const core::WheelTorques& req
   traction_state_.requested_left = requested.left;
   traction_state_.slipping = traction_control_->slipping();
   traction_state_.limiting = traction_control_->limiting();
+  // The progress check, after the limit as in the in-process loop (closed_loop.h): its verdict holds the robot
+  // from the next period on.
+  if (traction_monitor_ && !traction_monitor_->detected() &&
+      traction_monitor_->update(core::secondsFromNanos(static_cast<std::int64_t>(fed.header.stamp.toNSec())),
+                                poseOf(fed), driving, traction_control_->slipping(), dt_)) {
+    traction_state_.no_traction = true;
+    traction_state_.no_traction_report = traction_monitor_->report().text();
+    ROS_ERROR(
+        "torque_controller: %s; the robot is held from now on, and the run ends %.3f s later "
+        "(traction_control/no_traction_hold)",
+        traction_state_.no_traction_report.c_str(), traction_control_->params().no_traction_hold);
+  }
   publishShared(traction_pub_, traction_state_);  // before the torque: the governor's input for the next reference
   return sent;
 }

@@ -5,19 +5,28 @@
 // optionally writes them to YAML and ends the launch (headless runs). With a recorder
 // (`~recorder`: its recorded_until topic) it ends the launch only once the recorder has written the
 // run's last period, or, after `~recorder_timeout` wall seconds without that, with a failure (exit 3).
+// With torque_controller's traction control on, its `traction_control/state` may bring the no-traction verdict
+// (core/control/traction_monitor.h): the run then ends no_traction_hold after it, with the report, as the
+// in-process loop ends it. In lockstep a period is scored only once the traction state of its stamp is in, so the
+// end falls on the same period whatever the messages' timing.
+// `~status` (std_msgs/String, latched) says once how the run ended: "completed at t = T s" or "no traction at
+// (x y): ...; ended at t = T s".
 #pragma once
 
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
+#include <std_msgs/String.h>
 #include <std_msgs/Time.h>
 
 #include <condition_variable>
+#include <deque>
 #include <mutex>
 #include <optional>
 #include <string>
 #include <thread>
 
 #include "sowing_robot/ReferenceState.h"
+#include "sowing_robot/TractionControlState.h"
 #include "sowing_robot/core/simulation/metrics.h"
 #include "sowing_robot/ros/common/node_failure.h"
 #include "sowing_robot/ros/common/ready_roster.h"
@@ -36,8 +45,13 @@ class RunMonitor {
  private:
   void truthCallback(const nav_msgs::Odometry::ConstPtr& msg);
   void referenceCallback(const ReferenceState::ConstPtr& msg);
-  /// The true error of the state and reference paired for one stamp.
+  /// The true error of the state and reference paired for one stamp (scored now, or held until the traction
+  /// state of its stamp is in).
   void addPair();
+  void score(const ros::Time& stamp, double ex, double ey, double eth);
+  void tractionCallback(const TractionControlState::ConstPtr& msg);
+  /// Scores the held periods up to the last traction state's stamp.
+  void flush();
   void recordedCallback(const std_msgs::Time::ConstPtr& msg);
   void waitForRecorder();
   void finish();
@@ -54,7 +68,19 @@ class RunMonitor {
   // states can arrive seconds ahead of their references, so both streams hold a whole lookahead's worth.
   ListenerPair<nav_msgs::Odometry, ReferenceState> inputs_;
   std::int64_t expected_samples_ = 0;  // lockstep: every period of the run, both ends included (0: not checked)
-  ros::Subscriber truth_sub_, ref_sub_, recorder_sub_;
+  ros::Subscriber truth_sub_, ref_sub_, recorder_sub_, traction_sub_;
+  ros::Publisher status_pub_;  ///< ~status
+  // No traction (torque_controller's traction control on).
+  struct Held {
+    ros::Time stamp;
+    double ex, ey, eth;
+  };
+  std::deque<Held> held_;          ///< lockstep: periods waiting for their traction state
+  bool gated_ = false;             ///< lockstep with traction control: periods wait for their traction state
+  ros::Time traction_until_;       ///< the latest traction state's stamp
+  double no_traction_hold_ = 3.0;  ///< torque_controller/traction_control/no_traction_hold [s]
+  std::optional<double> end_at_;   ///< the verdict came: the run ends at this time [s]
+  std::string no_traction_;        ///< its report
 
   // The wait for the recorder: a thread of its own with a bounded wait, not a ros::WallTimer: roscpp's
   // timer thread queues a callback while holding its timer lock, and InlineCallbackQueue runs it right

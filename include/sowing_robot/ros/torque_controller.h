@@ -12,6 +12,11 @@
 // the truth, the odometry or the estimate), never the plant's hidden state; with feedback other than odom it
 // pairs the two by stamp. Each period's verdict goes out on `traction_control/state` (latched, before the
 // torque) for the reference generator's speed governor.
+// No traction (traction_control/no_traction_*, core/control/traction_monitor.h), as the in-process loop: the
+// progress check on the fed pose and the slip verdict; from the period after its verdict the inner loop is
+// given the hold command (the standstill hold brakes the robot where it is, whatever the desired velocity), the
+// report is logged once (ERROR) and carried by every later traction_control/state, and run_monitor ends the run
+// no_traction_hold after the verdict; should the plant go on (exit_at_end false), the hold goes on.
 #pragma once
 
 #include <dynamic_reconfigure/server.h>
@@ -35,6 +40,7 @@
 #include "sowing_robot/core/control/sliding_mode.h"
 #include "sowing_robot/core/control/standstill_hold.h"
 #include "sowing_robot/core/control/traction_control.h"
+#include "sowing_robot/core/control/traction_monitor.h"
 #include "sowing_robot/ros/common/ready_roster.h"
 #include "sowing_robot/ros/common/stamp_pair.h"
 
@@ -55,7 +61,8 @@ class TorqueController {
   void compute();
   /// The traction control on the inner loop's torques for the fed state `fed` (its wheel speeds from
   /// wheel_speeds_); publishes its state; returns the torques to send.
-  core::WheelTorques limitTraction(const core::WheelTorques& requested, const nav_msgs::Odometry& fed);
+  /// `driving`: the command is not a hold (the progress check rests at a stop).
+  core::WheelTorques limitTraction(const core::WheelTorques& requested, const nav_msgs::Odometry& fed, bool driving);
   /// Realtime only: zero torque for this odom stamp when the desired velocity is older than input_timeout.
   bool holdZeroIfStale(const nav_msgs::Odometry& odom);
 
@@ -75,6 +82,7 @@ class TorqueController {
   ros::Publisher torque_pub_, state_pub_, traction_pub_;
   // Traction control (unset: off).
   std::optional<core::TractionControl> traction_control_;
+  std::optional<core::TractionMonitor> traction_monitor_;  ///< with the traction control: the no-traction check
   // Slip-limit hitch control (hitch_control/...; unset: off): on the traction control's grip verdict, its
   // command goes to plant_sim with the torque (WheelTorque/tool_raised).
   std::optional<core::HitchControl> hitch_;

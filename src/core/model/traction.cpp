@@ -257,6 +257,10 @@ void TractionPlant::rollingResistance(double& force, double& moment) const {
   }
 }
 
+namespace {
+constexpr double kDraftRestSpeed = 1e-150;  // [m/s] below it the tool's damper sees the robot at rest
+}  // namespace
+
 void TractionPlant::draft(double dt, double& force, double& moment) const {
   const double xt = tool_.x(), yt = tool_.y(), v = state_[V], w = state_[OMEGA];
   const double vx = v - w * yt, vy = w * xt, speed = std::hypot(vx, vy);
@@ -266,7 +270,10 @@ void TractionPlant::draft(double dt, double& force, double& moment) const {
   // mobility along the motion, M = (vx²/m + (xt vy − yt vx)²/I) / speed²: c / (1 + dt c M) cannot reverse
   // the motion in one step, and a draft the motors cannot overcome brings the robot to rest. At speed the
   // factor is 1 + O(dt D / (m v)) (7e-4 for 10 N at 1 m/s).
-  if (!(speed > 0.0)) {
+  // At rest, and at speeds so small that speed² below would underflow to 0 (the mobility then 0 / 0: a robot held
+  // still with the tool down decays towards 1e-164 m/s in some 5 s and went NaN, seen in no_traction.test), the
+  // damper's force, c speed < 1e-148 N, is none.
+  if (!(speed > kDraftRestSpeed)) {
     force = moment = 0.0;
     return;
   }

@@ -520,6 +520,25 @@ TEST(TractionDraft, ADraftTheMotorsCannotOvercomeHoldsTheRobotFinite) {
               p.slipRatio(RIGHT));
 }
 
+// A robot at rest with the tool down, its speeds decaying towards the smallest doubles (as under a long standstill
+// hold): speed² underflowed to 0 and the draft's mobility became 0 / 0, NaN (no_traction.test, 5 s into a hold).
+TEST(TractionDraft, ARobotAlmostAtRestWithTheToolDownStaysFinite) {
+  TractionParams t;
+  t.draft_force = 10.0;
+  TractionPlant plant(RobotParams{}, PlantDisturbance{}, t);
+  plant.setToolPoint({-0.45, 0.0});
+  plant.setToolDown(true);
+  for (const double speed : {1e-140, 1e-155, 1e-160, 1e-163, 5e-324}) {
+    State x = State::Zero();
+    x[V] = speed;
+    x[OMEGA] = -30.0 * speed;
+    plant.reset(x);
+    for (int i = 0; i < 100; ++i) plant.step(0.0, 0.0, kDt);
+    EXPECT_TRUE(plant.state().allFinite()) << speed;
+    EXPECT_TRUE(std::isfinite(plant.draftForce())) << speed;
+  }
+}
+
 // Ice: no grip, a coasting robot with the tool down is braked to rest by the draft, not reversed; with
 // a wheel in the air the draft is still finite.
 TEST(TractionDraft, IceAndAWheelInTheAirWithTheDraftStayFinite) {
