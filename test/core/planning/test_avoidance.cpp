@@ -175,16 +175,8 @@ TEST(Avoidance, NoSafeWayStopsBeforeTheObstaclesAndSaysWhy) {
 
 TEST(Avoidance, ObstacleAddedAtRunTimeAheadOfTheRobotIsAvoided) {
   FieldRunSetup s = row60({});
-  const Obstacle added{24.0, 3.0, 0.3};
-  s.scoring_obstacles = {added};
   bool set = false;
-  s.on_step = [&](double time, FieldSource& ref, ContactMonitor& contacts) {
-    if (!set && time >= 20.0) {  // the robot is near x = 20: the obstacle comes 4 m ahead
-      ref.setObstacles({added});
-      contacts.setObstacles({added});
-      set = true;
-    }
-  };
+  test::addObstacleAtRunTime(s, 20.0, {24.0, 3.0, 0.3}, set);  // the robot is near x = 20: 4 m ahead
   const FieldRunReport r = runField(s);
   std::printf("obstacle added at run time 4 m ahead: %s\n", r.summary().c_str());
   ASSERT_TRUE(set);

@@ -119,16 +119,8 @@ TEST(FieldPathReference, ObstacleAddedAtRunTimeIsPlannedRoundFromTheRobotsProgre
   s.field.follower = FieldFollower::kPath;
   s.obstacles = {};
   s.scenario.duration = 110.0 + approachExtraTime(s) + 20.0;  // the detour is slower than the row
-  const Obstacle added{40.0, 3.0, 0.3};
-  s.scoring_obstacles = {added};
   bool set = false;
-  s.on_step = [&](double time, FieldSource& ref, ContactMonitor& contacts) {
-    if (!set && time >= 20.0) {  // the robot is near x = 20: the obstacle comes 20 m ahead
-      ref.setObstacles({added});
-      contacts.setObstacles({added});
-      set = true;
-    }
-  };
+  test::addObstacleAtRunTime(s, 20.0, {40.0, 3.0, 0.3}, set);  // the robot is near x = 20: 20 m ahead
   const FieldRunReport r = runField(s);
   std::printf("obstacle added at run time, path follower: %s\n", r.summary().c_str());
   ASSERT_TRUE(set);

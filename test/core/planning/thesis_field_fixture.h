@@ -29,6 +29,18 @@ inline FieldRunSetup thesisField() {
   return s;
 }
 
+/// From `time` on [s] (once), `obstacle` is added at run time: to the reference (re-planned) and to the contact
+/// monitor, and the seeds are scored against it; `added` says whether it was.
+inline void addObstacleAtRunTime(FieldRunSetup& s, double time, const Obstacle& obstacle, bool& added) {
+  s.scoring_obstacles = {obstacle};
+  s.on_step = [time, obstacle, &added](double t, FieldSource& reference, ContactMonitor& contacts) {
+    if (added || t < time) return;
+    reference.setObstacles({obstacle});
+    contacts.setObstacles({obstacle});
+    added = true;
+  };
+}
+
 }  // namespace test
 }  // namespace core
 }  // namespace sowing_robot
