@@ -280,7 +280,7 @@ void ReferenceGenerator::publishMarkers() {
     zone.pose.position.z = 0.01;
     zone.scale.x = zone.scale.y = 2.0 * (o.radius + d);
     zone.scale.z = 0.02;
-    out.markers.push_back(zone);
+    if (potential_) out.markers.push_back(zone);  // the path follower has no repulsion: no zone to show
   }
   Marker rows = marker("rows", 0, Marker::LINE_LIST, 0.1f, 0.8f, 0.1f, 1.0f);
   rows.scale.x = 0.03;

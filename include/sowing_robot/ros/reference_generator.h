@@ -69,7 +69,7 @@ class ReferenceGenerator {
   void publishPlan();
   /// type field: the plan's status in the log (a stop short of a target, no safe way, bounds not held).
   void reportStatus();
-  /// type field: obstacles, influence zones and row lines on field_markers.
+  /// type field: obstacles, influence zones (field/follower potential) and row lines on field_markers.
   void publishMarkers();
   /// type field: live avoidance gains, validated like the start-up values (a rejected change keeps them).
   void reconfigure(ReferenceGeneratorConfig& config, uint32_t level);
