@@ -102,6 +102,12 @@ double approachExtraTime(const FieldRunSetup& setup) {
   return with_duration - FieldPath(without, setup.obstacles).duration();
 }
 
+double approachExtraTime(const FieldSource& reference) {
+  FieldParams without = reference.params();
+  without.approach = false;
+  return reference.duration() - FieldPath(without, reference.obstacles()).duration();
+}
+
 std::string FieldRunReport::summary() const {
   char b[600];
   std::snprintf(b, sizeof(b),

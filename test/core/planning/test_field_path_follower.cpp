@@ -137,8 +137,10 @@ TEST(FieldPathReference, ApproachExtraTimeCoversTheFollowersSlowerCurves) {
   FieldParams plain = s.field;
   plain.approach = false;
   EXPECT_NEAR(approachExtraTime(s), ref.duration() - FieldPath(plain, s.obstacles).duration(), 1e-9);
+  EXPECT_EQ(approachExtraTime(ref), approachExtraTime(s));  // from the reference built (the benchmark's rows)
   s.field.follower = FieldFollower::kPotential;
   EXPECT_LT(approachExtraTime(s), 5.0);  // the approach only
+  EXPECT_EQ(approachExtraTime(FieldReference(withStart(s), s.obstacles)), approachExtraTime(s));
 }
 
 }  // namespace

@@ -77,6 +77,8 @@ FieldRunReport runField(const FieldRunSetup& setup);
 /// approach, and with field/follower path the follower's own timing (0 for neither). A run of fixed duration
 /// lengthened by this ends at the same point of the rows.
 double approachExtraTime(const FieldRunSetup& setup);
+/// The same for a reference already built (its params() carry the start pose).
+double approachExtraTime(const FieldSource& reference);
 
 }  // namespace core
 }  // namespace sowing_robot
