@@ -88,7 +88,7 @@ void RunMonitor::score(const ros::Time& stamp, double ex, double ey, double eth)
   }
   last_ = stamp;
   // The in-process loop's end (closed_loop.h): the first period at or past the verdict + no_traction_hold.
-  const double t = core::secondsFromNanos(static_cast<std::int64_t>(stamp.toNSec()));
+  const double t = loopSeconds(stamp);
   if (end_at_ && t >= *end_at_) {
     ROS_ERROR("run_monitor: the run ends at t = %.3f s: %s (torque_controller)", t, no_traction_.c_str());
     finish();
@@ -100,7 +100,7 @@ void RunMonitor::score(const ros::Time& stamp, double ex, double ey, double eth)
 void RunMonitor::tractionCallback(const TractionControlState::ConstPtr& msg) {
   if (done_) return;
   if (msg->no_traction && !end_at_) {
-    end_at_ = core::secondsFromNanos(static_cast<std::int64_t>(msg->header.stamp.toNSec())) + no_traction_hold_;
+    end_at_ = loopSeconds(msg->header.stamp) + no_traction_hold_;
     no_traction_ = msg->no_traction_report;
   }
   if (msg->header.stamp > traction_until_) traction_until_ = msg->header.stamp;

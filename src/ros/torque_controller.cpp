@@ -232,8 +232,8 @@ core::WheelTorques TorqueController::limitTraction(const core::WheelTorques& req
   // The progress check, after the limit as in the in-process loop (closed_loop.h): its verdict holds the robot
   // from the next period on.
   if (traction_monitor_ && !traction_monitor_->detected() &&
-      traction_monitor_->update(core::secondsFromNanos(static_cast<std::int64_t>(fed.header.stamp.toNSec())),
-                                poseOf(fed), driving, traction_control_->slipping(), dt_)) {
+      traction_monitor_->update(loopSeconds(fed.header.stamp), poseOf(fed), driving, traction_control_->slipping(),
+                                dt_)) {
     traction_state_.no_traction = true;
     traction_state_.no_traction_report = traction_monitor_->report().text();
     ROS_ERROR(

@@ -3,6 +3,7 @@
 
 #include <geometry_msgs/Quaternion.h>
 #include <nav_msgs/Odometry.h>
+#include <ros/time.h>
 
 #include <cmath>
 #include <cstdint>
@@ -16,6 +17,13 @@ namespace sowing_robot {
 inline core::Pose2D poseOf(const nav_msgs::Odometry& o) {
   const auto& q = o.pose.pose.orientation;
   return {o.pose.pose.position.x, o.pose.pose.position.y, std::atan2(2.0 * q.w * q.z, 1.0 - 2.0 * q.z * q.z)};
+}
+
+/// A stamp as the in-process loop's time of that period (core::secondsFromNanos of its nanoseconds), so a time
+/// compared or stored by a node is the same double as in the in-process runner (ros::Time::toSec can differ in the
+/// last bit).
+inline double loopSeconds(const ros::Time& stamp) {
+  return core::secondsFromNanos(static_cast<std::int64_t>(stamp.toNSec()));
 }
 
 /// The quaternion of a yaw about z, as core::yawThroughQuaternion builds it (poseOf inverts it).
