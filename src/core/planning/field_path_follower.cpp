@@ -85,9 +85,7 @@ FieldPathReference::FieldPathReference(const FieldParams& params, std::vector<Ob
       obstacles_(std::move(obstacles)),
       path_(std::make_shared<const FieldPath>(params_, obstacles_)),
       coverage_(coveragePath(*path_, kSpacing)),
-      follower_(fieldFollowerParams(params_), startOf(coverage_)) {
-  restart();
-}
+      follower_(fieldFollowerParams(params_), startOf(coverage_), coverage_.points, coverage_.tool_down) {}
 
 void FieldPathReference::restart() {
   follower_ = PathReference(fieldFollowerParams(params_), startOf(coverage_), coverage_.points, coverage_.tool_down);
@@ -101,9 +99,7 @@ std::unique_ptr<ReferenceSource> FieldPathReference::clone() const {
 
 bool FieldPathReference::finished(double t) const { return t >= duration(); }
 
-double FieldPathReference::duration() const {
-  return follower_.hasPath() ? follower_.planStart() + follower_.plan().duration() : 0.0;
-}
+double FieldPathReference::duration() const { return follower_.planStart() + follower_.plan().duration(); }
 
 void FieldPathReference::setObstacles(std::vector<Obstacle> obstacles) {
   auto path = std::make_shared<const FieldPath>(params_, obstacles);  // throws before anything changes
