@@ -321,12 +321,9 @@ core::BenchScenario loadScenarioFileImpl(const std::string& path, const std::str
     b.finish_tolerance = toDouble(required(block, "finish_tolerance", path, "field/"), path, "field/finish_tolerance");
     if (block["approach"]) b.field.approach = block["approach"].as<bool>();
     if (block["plan_detours"]) b.field.avoidance.plan_detours = block["plan_detours"].as<bool>();
-    if (const YAML::Node f = block["follower"]) {  // over the config's field/follower
-      const std::string name = f.as<std::string>();
-      if (name != "potential" && name != "path")
-        fail(path, "field/follower is '" + name + "': it must be potential or path");
-      b.field.follower = name == "path" ? core::FieldFollower::kPath : core::FieldFollower::kPotential;
-    }
+    // Over the config's field/follower, through its table entry (the choices are named there only).
+    if (const YAML::Node f = block["follower"])
+      applyKeys(core::fieldTable(), {{"field/follower", f}}, b.field, path, "");
   }
 
   // Plant settings that are not drawn (the disturbance's frequency); the drawn ones are refused here.

@@ -117,7 +117,7 @@ TEST(ScenarioLoader, TyposAndMissingKeysAreRefusedNamingThem) {
     text.replace(text.find("follower: path"), 14, "follower: pth");
     text.replace(text.find("../../field.yaml"), 16, kSuite + "/../field.yaml");
     e = loadError(dir.write("three_row_field_path.yaml", text));
-    EXPECT_NE(e.find("field/follower is 'pth': it must be potential or path"), std::string::npos) << e;
+    EXPECT_NE(e.find("field/follower = 'pth' must be one of potential, path"), std::string::npos) << e;
   }
   e = loadError(variant(dir, "name: thesis_line", "name: other"));
   EXPECT_NE(e.find("must be the file's name"), std::string::npos) << e;
