@@ -236,6 +236,8 @@ core::WheelTorques TorqueController::limitTraction(const core::WheelTorques& req
                                 dt_)) {
     traction_state_.no_traction = true;
     traction_state_.no_traction_report = traction_monitor_->report().text();
+    traction_state_.no_traction_where.x = traction_monitor_->report().where.x;
+    traction_state_.no_traction_where.y = traction_monitor_->report().where.y;
     ROS_ERROR(
         "torque_controller: %s; the robot is held from now on, and the run ends %.3f s later "
         "(traction_control/no_traction_hold)",

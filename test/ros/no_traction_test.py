@@ -5,8 +5,10 @@ from then on the robot is held: from 3 s after the verdict to the plant's durati
 plant goes on: exit_at_end false, the hold with it) |v| and |omega| stay within 0.01 (m/s, rad/s) and it moves less
 than 2 cm (issue 26: "a stop is a stop"); the plant never diverges (it did 5.2 s after the verdict, the draft's
 damper at speeds near 1e-164 m/s: test_traction); run_monitor's ~status says the run ended on no traction, no_traction_hold (3 s) after
-the verdict, to the period."""
+the verdict, to the period; plant_sim says why on no_traction_diagnosis: the patch's grip budget at the verdict's place, its
+peak traction below what driving there needs."""
 import math
+import re
 import threading
 import time
 import unittest
@@ -28,7 +30,7 @@ class NoTraction(unittest.TestCase):
     def test_no_traction(self):
         rospy.init_node("no_traction_test")
         lock = threading.Lock()
-        verdicts, truth, status = [], [], []
+        verdicts, truth, status, diagnosis = [], [], [], []
 
         def on_state(m):
             if m.no_traction:
@@ -43,11 +45,12 @@ class NoTraction(unittest.TestCase):
         rospy.Subscriber("traction_control/state", TractionControlState, on_state, queue_size=100000)
         rospy.Subscriber("ground_truth", Odometry, on_truth, queue_size=100000)
         rospy.Subscriber("run_monitor/status", String, lambda m: status.append(m.data), queue_size=1)
+        rospy.Subscriber("no_traction_diagnosis", String, lambda m: diagnosis.append(m.data), queue_size=1)
         duration = rospy.get_param("/run/duration")
         stop = time.time() + TIMEOUT
         while time.time() < stop and not rospy.is_shutdown():
             with lock:
-                if status and truth and truth[-1][0] >= duration - 1e-6:
+                if status and diagnosis and truth and truth[-1][0] >= duration - 1e-6:
                     break
             time.sleep(0.05)
         with lock:
@@ -73,6 +76,15 @@ class NoTraction(unittest.TestCase):
         self.assertTrue(status[0].startswith(report), status[0])
         ended = float(status[0].rsplit("t = ", 1)[1].split(" ")[0])
         self.assertAlmostEqual(ended, t_v + HOLD, delta=0.0015)
+        self.assertTrue(diagnosis, "plant_sim said nothing on no_traction_diagnosis")
+        budget = re.match(r"soil patch 0 grip budget: peak traction ([0-9.]+) N \(sliding ([0-9.]+) N\) against "
+                          r"([0-9.]+) N needed$", diagnosis[0])
+        self.assertTrue(budget, diagnosis[0])
+        peak, slide, needed = map(float, budget.groups())
+        self.assertLess(slide, peak)
+        self.assertLess(peak, needed, "no grip to be had on the patch, but the budget says there is")
+        self.assertAlmostEqual(first.no_traction_where.x, x_v, delta=0.05)
+        print("plant_sim: %s" % diagnosis[0])
         print("no traction: verdict at t = %.3f s, x = %.3f m: %s; held from %.3f s to %.3f s: |v| <= %.4f m/s, "
               "|omega| <= %.4f rad/s, moved %.4f m; run_monitor: %s"
               % (t_v, x_v, report, held[0][0], held[-1][0], worst_v, worst_w, drift, status[0]))

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <stdexcept>
 
@@ -176,6 +177,19 @@ GripBudget gripBudget(const RobotParams& robot, double mass_scale, const Tractio
   b.peak = mu_peak * drive;
   b.slide = mu_slide * drive;
   b.needed = rolling_resistance * (drive + n.caster) + traction.draft_force;
+  return b;
+}
+
+std::string gripDiagnosis(const RobotParams& robot, double mass_scale, const TractionParams& traction,
+                          const SoilMap& soil, const Eigen::Vector2d& where) {
+  const int i = soil.patchAt(where);
+  const SoilPatch* p = i >= 0 ? &soil.patches()[static_cast<std::size_t>(i)] : nullptr;
+  const GripBudget g =
+      gripBudget(robot, mass_scale, traction, p ? p->mu_peak : traction.mu_peak, p ? p->mu_slide : traction.mu_slide,
+                 p ? p->rolling_resistance : traction.rolling_resistance);
+  char b[200];
+  std::snprintf(b, sizeof(b), "%s grip budget: peak traction %.1f N (sliding %.1f N) against %.1f N needed",
+                i >= 0 ? ("soil patch " + std::to_string(i)).c_str() : "field soil", g.peak, g.slide, g.needed);
   return b;
 }
 

@@ -188,15 +188,8 @@ std::string gripDiagnosis(const Scenario& sc, const EstimatedRunConfig& cfg, con
   if constexpr (!PlantT::kTraction) {
     return "";
   } else {
-    const TractionParams& t = *cfg.traction;
-    const int i = plant.plant.soil().patchAt({where.x, where.y});
-    const SoilPatch* p = i >= 0 ? &plant.plant.soil().patches()[static_cast<std::size_t>(i)] : nullptr;
-    const GripBudget g = gripBudget(sc.robot, sc.disturbance.mass_scale, t, p ? p->mu_peak : t.mu_peak,
-                                    p ? p->mu_slide : t.mu_slide, p ? p->rolling_resistance : t.rolling_resistance);
-    char b[200];
-    std::snprintf(b, sizeof(b), "%s grip budget: peak traction %.1f N (sliding %.1f N) against %.1f N needed",
-                  i >= 0 ? ("soil patch " + std::to_string(i)).c_str() : "field soil", g.peak, g.slide, g.needed);
-    return b;
+    return core::gripDiagnosis(sc.robot, sc.disturbance.mass_scale, *cfg.traction, plant.plant.soil(),
+                               {where.x, where.y});
   }
 }
 

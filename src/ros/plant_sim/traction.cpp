@@ -1,6 +1,7 @@
 #include "sowing_robot/ros/plant_sim/traction.h"
 
 #include <std_msgs/Float64MultiArray.h>
+#include <std_msgs/String.h>
 #include <visualization_msgs/MarkerArray.h>
 
 #include <algorithm>
@@ -62,6 +63,8 @@ TractionModel::TractionModel(ros::NodeHandle nh, const core::RobotParams& robot,
                              const core::PlantDisturbance& disturbance, const core::State& x0, const Config& config)
     : cfg_(config),
       plant_(robot, disturbance, config.traction),
+      robot_(robot),
+      mass_scale_(disturbance.mass_scale),
       m0_(robot.m0() * disturbance.mass_scale),
       i0_(robot.I0() * disturbance.inertia_scale),
       tool_(config.seeding, {}) {
@@ -72,6 +75,20 @@ TractionModel::TractionModel(ros::NodeHandle nh, const core::RobotParams& robot,
   soil_pub_ = nh.advertise<visualization_msgs::MarkerArray>("soil_markers", 1, true);
   publishSoil();
   if (cfg_.traction.draft_force > 0.0) plan_sub_ = nh.subscribe("plan", 1, &TractionModel::planCallback, this);
+  diagnosis_pub_ = nh.advertise<std_msgs::String>("no_traction_diagnosis", 1, true);
+  traction_sub_ = nh.subscribe("traction_control/state", 10, &TractionModel::tractionCallback, this);
+}
+
+void TractionModel::tractionCallback(const TractionControlState::ConstPtr& msg) {
+  if (!msg->no_traction) return;
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!no_traction_.empty()) return;  // the verdict is latched: every later message repeats it
+  const Eigen::Vector2d where(msg->no_traction_where.x, msg->no_traction_where.y);
+  no_traction_ = core::gripDiagnosis(robot_, mass_scale_, cfg_.traction, cfg_.soil, where);
+  ROS_ERROR("plant_sim: no traction at (%.2f %.2f): %s", where.x(), where.y(), no_traction_.c_str());
+  std_msgs::String out;
+  out.data = no_traction_;
+  diagnosis_pub_.publish(out);
 }
 
 void TractionModel::planCallback(const FieldPlan::ConstPtr& plan) {
@@ -142,7 +159,8 @@ std::string TractionModel::report() const {
                 "the hitch control %.2f s, max draft %.1f N (traction/draft_force %g N)",
                 max_slip_, static_cast<long>(steps_), cfg_.soil.patches().size(), tool_down_time_, tool_held_up_time_,
                 max_draft_, cfg_.traction.draft_force);
-  return text;
+  std::lock_guard<std::mutex> lock(mutex_);
+  return no_traction_.empty() ? std::string(text) : std::string(text) + "; no traction: " + no_traction_;
 }
 
 void TractionModel::publishSoil() {

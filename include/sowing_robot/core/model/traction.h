@@ -151,6 +151,11 @@ struct GripBudget {
 };
 GripBudget gripBudget(const RobotParams& robot, double mass_scale, const TractionParams& traction, double mu_peak,
                       double mu_slide, double rolling_resistance);
+/// The grip budget of the soil at `where` (the patch there, else the field's soil) as one line: "soil patch 2 grip
+/// budget: peak traction 7.4 N (sliding 5.9 N) against 24.1 N needed". What a simulation adds to a no-traction
+/// report (the robot itself cannot know the soil's grip): the in-process loop's and plant_sim's.
+std::string gripDiagnosis(const RobotParams& robot, double mass_scale, const TractionParams& traction,
+                          const SoilMap& soil, const Eigen::Vector2d& where);
 
 enum Wheel { RIGHT = 0, LEFT = 1 };
 constexpr int kCaster = 2;  ///< contact index of the caster (patchUnder)

@@ -10,6 +10,10 @@
 // wheel], draft_force [N, on v], tool_down [0/1], patch_right, patch_left [index, -1: default soil],
 // stamp [s, the simulated time]) and
 // `soil_markers` (visualization_msgs/MarkerArray, latched: each patch's outline and fill in odom_frame).
+// No traction: on torque_controller's first `traction_control/state` with the verdict, the soil's grip budget at
+// the verdict's place (core::gripDiagnosis, the in-process run's diagnosis to the character) is logged at ERROR,
+// published latched on `no_traction_diagnosis` (std_msgs/String) and added to the end-of-run report: the robot
+// knows it has no traction, only the simulation knows whether there was grip to be had.
 #pragma once
 
 #include <ros/ros.h>
@@ -19,6 +23,7 @@
 #include <vector>
 
 #include "sowing_robot/FieldPlan.h"
+#include "sowing_robot/TractionControlState.h"
 #include "sowing_robot/core/model/soil_map.h"
 #include "sowing_robot/core/model/traction.h"
 #include "sowing_robot/core/planning/tool_engagement.h"
@@ -69,10 +74,13 @@ class TractionModel : public PlantModel {
 
  private:
   void planCallback(const FieldPlan::ConstPtr& plan);
+  void tractionCallback(const TractionControlState::ConstPtr& msg);
   void publishSoil();
 
   Config cfg_;
   core::TractionPlant plant_;
+  core::RobotParams robot_;  // nominal, with the true mass scale below: the grip budget's loads
+  double mass_scale_;
   double m0_, i0_;
   mutable std::mutex mutex_;  // the plan comes on another thread than the steps
   core::ToolEngagement tool_;
@@ -81,8 +89,9 @@ class TractionModel : public PlantModel {
   double max_slip_ = 0.0, tool_down_time_ = 0.0, tool_held_up_time_ = 0.0;
   double max_draft_ = 0.0;
   std::int64_t steps_ = 0;
-  ros::Publisher slip_pub_, soil_pub_;
-  ros::Subscriber plan_sub_;
+  std::string no_traction_;  // the grip diagnosis at the verdict, once it has come
+  ros::Publisher slip_pub_, soil_pub_, diagnosis_pub_;
+  ros::Subscriber plan_sub_, traction_sub_;
 };
 
 }  // namespace sowing_robot
