@@ -1,6 +1,7 @@
 // Traction control (core/control/traction_control.h): off and on gripping wheels it passes the torques;
 // a slipping wheel's torque is cut at once and recovers at the raise rate; the estimate uses the wheel's
-// speed against its contact point's ground speed; bad parameters are refused.
+// speed against its contact point's ground speed, or against a reference that follows it no faster than
+// max_ground_accel; bad parameters are refused.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -80,6 +81,44 @@ TEST(TractionControl, LimitingSaysWhenACommandIsHeldBack) {
   EXPECT_FALSE(off.limiting());
 }
 
+// Both wheels spinning up together under a fed twist that follows them (the encoders): slip 0 as fed. With
+// max_ground_accel the reference ground speed rises no faster than that, so the spin shows and is cut; a fed
+// speed that changes within the bound is taken as it is.
+TEST(TractionControl, ABoundOnGroundAccelerationShowsWheelsSpinningUpTogether) {
+  TractionControlParams p = on();
+  TractionControl blind(p, kL);
+  p.max_ground_accel = 1.0;
+  TractionControl bounded(p, kL);
+  double speed = 0.5;  // the wheels and the fed speed: 0.5 m/s, spinning up at 20 m/s^2
+  WheelTorques a{}, b{};
+  for (int i = 0; i < 50; ++i, speed += 20.0 * kDt) {
+    const WheelGroundSpeeds fed{speed, speed, speed, 0.0};
+    a = blind.limit({5.0, 5.0}, fed, kDt);
+    b = bounded.limit({5.0, 5.0}, fed, kDt);
+  }
+  EXPECT_EQ(a.right, 5.0);
+  EXPECT_FALSE(blind.slipping());
+  // After 50 ms the wheels turn at 1.5 m/s over a reference of 0.5 + 1.0 x 0.049 m/s: slip 0.63, both cut.
+  EXPECT_NEAR(bounded.slip(0), (1.48 - 0.549) / 1.48, 1e-9);
+  EXPECT_NEAR(bounded.slip(1), bounded.slip(0), 1e-12);
+  EXPECT_TRUE(bounded.slipping());
+  EXPECT_LT(b.right, 5.0);
+  EXPECT_LT(b.left, 5.0);
+  // A robot speeding up at 0.5 m/s^2 (within the bound), turning at 0.5 rad/s: no slip, nothing cut.
+  TractionControl smooth(p, kL);
+  speed = 0.5;
+  for (int i = 0; i < 1000; ++i, speed += 0.5 * kDt) {
+    const WheelTorques c = smooth.limit({5.0, 5.0}, {speed + kL * 0.5, speed - kL * 0.5, speed, 0.5}, kDt);
+    EXPECT_EQ(c.right, 5.0);
+    EXPECT_FALSE(smooth.slipping());
+  }
+  EXPECT_NEAR(smooth.slip(0), 0.0, 1e-12);
+  // reset() forgets the reference: the next fed speed is taken as it is.
+  bounded.reset();
+  bounded.limit({5.0, 5.0}, {3.0, 3.0, 3.0, 0.0}, kDt);
+  EXPECT_FALSE(bounded.slipping());
+}
+
 TEST(TractionControl, BadParametersAreRefused) {
   TractionControlParams p = on();
   p.slip_target = 0.0;
@@ -89,4 +128,7 @@ TEST(TractionControl, BadParametersAreRefused) {
   EXPECT_NE(p.validate().find("traction_control/min_torque"), std::string::npos);
   EXPECT_THROW(TractionControl(p, kL), std::invalid_argument);
   EXPECT_THROW(TractionControl(on(), 0.0), std::invalid_argument);
+  p = on();
+  p.max_ground_accel = -1.0;
+  EXPECT_NE(p.validate().find("traction_control/max_ground_accel"), std::string::npos);
 }

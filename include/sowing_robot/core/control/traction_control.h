@@ -12,6 +12,11 @@
 // last sent, else it rises linearly (raise_rate) back to max_torque; the command is clipped to
 // [-ceiling, ceiling]. So the ceiling settles about the largest torque the soil carries at the target
 // slip (additive increase, multiplicative decrease).
+//
+// With max_ground_accel > 0 the ground speed u is not taken as fed: each contact point's reference speed follows
+// the fed one at most that fast (a slope-limited reference speed, as automotive traction control estimates the
+// speed of a vehicle whose every wheel is driven). A fed twist built from the encoders rises with wheels that
+// spin up together, and would hide their slip; the reference does not rise faster than the soil can push.
 #pragma once
 
 #include <string>
@@ -35,6 +40,8 @@ struct TractionControlParams {
   /// Tell the inner loop which torques were held back, so that its integrators do not wind up against
   /// the ceiling (InnerController::heldBack).
   bool anti_windup;
+  /// [m/s^2] the fastest a contact point's reference ground speed follows the fed one (0: the fed speed as it is).
+  double max_ground_accel;
 
   /// No traction (traction_monitor.h): the window [s] (0: never), the progress that restarts it [m], the
   /// share of it the wheels must slip [-], and how long the robot is held after the verdict [s].
@@ -43,7 +50,7 @@ struct TractionControlParams {
   std::string validate() const;
 };
 /// traction_control/{enabled, slip_target, speed_floor, cut_rate, raise_rate, min_torque, max_torque, anti_windup,
-/// no_traction_window, no_traction_progress, no_traction_slip_share, no_traction_hold}.
+/// max_ground_accel, no_traction_window, no_traction_progress, no_traction_slip_share, no_traction_hold}.
 const ParamTable<TractionControlParams>& tractionControlTable();
 
 /// What the layer measures in one period.
@@ -79,6 +86,8 @@ class TractionControl {
   TractionControlParams params_;
   double L_;
   double ceiling_[2], slip_[2] = {0.0, 0.0}, sent_[2] = {0.0, 0.0};
+  double ground_[2] = {0.0, 0.0};  ///< each contact point's reference ground speed (max_ground_accel) [m/s]
+  bool have_ground_ = false;       ///< false until the first finite fed twist after a reset
   bool slipping_ = false, limiting_ = false;
 };
 
