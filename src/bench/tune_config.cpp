@@ -41,8 +41,9 @@ std::string relativeTo(const std::string& dir, const std::string& file) {
 
 /// The robust: block: the objective and the training set, each scenario driven by c.base's pair and gains.
 void loadRobust(const YAML::Node& r, const std::string& path, TuneConfig& c) {
-  if (!r.IsMap()) fail(path, "robust must be a mapping (aggregate, quantile, failure_penalty, profile, training)");
-  onlyKeys(r, {"aggregate", "quantile", "failure_penalty", "profile", "training"}, path, "robust/");
+  if (!r.IsMap())
+    fail(path, "robust must be a mapping (aggregate, quantile, failure_penalty, max_slip_share, profile, training)");
+  onlyKeys(r, {"aggregate", "quantile", "failure_penalty", "max_slip_share", "profile", "training"}, path, "robust/");
   if (const YAML::Node a = r["aggregate"]) {
     const std::string name = a.as<std::string>();
     if (!core::parseAggregate(name, c.robust.aggregate))
@@ -50,6 +51,7 @@ void loadRobust(const YAML::Node& r, const std::string& path, TuneConfig& c) {
   }
   if (r["quantile"]) c.robust.quantile = toDouble(r["quantile"], path, "robust/quantile");
   if (r["failure_penalty"]) c.robust.failure_penalty = toDouble(r["failure_penalty"], path, "robust/failure_penalty");
+  if (r["max_slip_share"]) c.robust.max_slip_share = toDouble(r["max_slip_share"], path, "robust/max_slip_share");
   const std::string oe = c.robust.validate();
   if (!oe.empty()) fail(path, oe);
   const std::string dir = directoryOf(path);
@@ -89,7 +91,9 @@ std::string TuneConfig::scenarioText() const {
         "robust: " +
         std::string(robust.aggregate == core::RobustObjective::Aggregate::mean ? "mean"
                                                                                : "quantile " + g(robust.quantile)) +
-        " of the run costs, failure penalty " + g(robust.failure_penalty) + ", " + base.controllerName() + "; training";
+        " of the run costs, failure penalty " + g(robust.failure_penalty) +
+        (robust.max_slip_share < 1.0 ? " (also past slip share " + g(robust.max_slip_share) + ")" : "") + ", " +
+        base.controllerName() + "; training";
     for (const auto& t : training)
       s += " " + t.bench.name + " (runs 0-" + std::to_string(t.runs - 1) + ", base seed " +
            std::to_string(t.bench.spec.base_seed) + ")";

@@ -330,8 +330,11 @@ int run(farm::Farm& farm, int argc, char** argv) {
   std::string h = "# Controller gains tuned offline by tune (PSO, thesis eqs 4.26-4.31, Table 5.4).\n";
   h += "# config: " + args.config + "\n# scenario: " + cfg.scenarioText() + "\n";
   if (cfg.isRobust()) {
-    h += "# cost: per training run min(2 ITAE(x+y+theta)/T^2, penalty) + penalty if not a success "
-         "(core/evaluation/robust_tuning.h), " +
+    h += "# cost: per training run min(2 ITAE(x+y+theta)/T^2, penalty) + penalty if not a success" +
+         std::string(cfg.robust.max_slip_share < 1.0
+                         ? " or beyond twice the peak's slip for more than " + g(cfg.robust.max_slip_share) + " of it"
+                         : "") +
+         " (core/evaluation/robust_tuning.h), " +
          std::string(cfg.robust.aggregate == core::RobustObjective::Aggregate::mean
                          ? "mean"
                          : "quantile " + g(cfg.robust.quantile)) +

@@ -13,6 +13,7 @@
 //     aggregate: mean                                 # mean | quantile
 //     quantile: 0.9                                   # for quantile, in (0, 1]
 //     failure_penalty: 1.0                            # per failed run, and the tracking term's cap [m]
+//     max_slip_share: 1.0                             # a run longer beyond 2x the peak's slip fails (1: off)
 //     profile: ../profiles/field.yaml                 # applied on every training scenario ("" none)
 //     training:                                       # benchmark scenario files, relative to this file
 //       - {scenario: ../scenarios/training/wet_turns.yaml, runs: 4, base_seed: 1001}

@@ -14,6 +14,8 @@ std::string RobustObjective::validate() const {
     return "robust/failure_penalty must be finite and > 0, not " + std::to_string(failure_penalty);
   if (aggregate == Aggregate::quantile && !(quantile > 0.0 && quantile <= 1.0))
     return "robust/quantile must be in (0, 1], not " + std::to_string(quantile);
+  if (!(max_slip_share > 0.0 && max_slip_share <= 1.0))
+    return "robust/max_slip_share must be in (0, 1], not " + std::to_string(max_slip_share);
   return "";
 }
 
@@ -33,7 +35,9 @@ double trainingRunCost(const RunRow& row, double duration, const RobustObjective
   double tracking = 2.0 * itae / (duration * duration);
   // A diverged run's non-finite ITAE, like any too large one, costs the cap.
   if (!(tracking < objective.failure_penalty)) tracking = objective.failure_penalty;
-  return tracking + (row.success ? 0.0 : objective.failure_penalty);
+  // A run without the traction plant has no slip share (NaN): only the benchmark's rule judges it.
+  const bool slipped = objective.max_slip_share < 1.0 && row.high_slip_share > objective.max_slip_share;
+  return tracking + (row.success && !slipped ? 0.0 : objective.failure_penalty);
 }
 
 RobustTuningProblem::RobustTuningProblem(std::vector<TrainingScenario> set, std::vector<GainBounds> gains,

@@ -54,6 +54,29 @@ TEST(RobustTuning, RunCostIsTheCappedTrackingTermPlusThePenaltyOfAFailure) {
   EXPECT_DOUBLE_EQ(1.0, trainingRunCost(row, 10.0, o));
 }
 
+// max_slip_share: a success whose wheels spent longer beyond twice the peak's slip costs the penalty too; off
+// (1), or a run without the traction plant (no share: NaN), only the benchmark's rule counts.
+TEST(RobustTuning, ASlipShareLimitMakesASlippingSuccessAFailure) {
+  RobustObjective o;
+  RunRow row;
+  row.metrics[AXIS_Y].itae = 5.0;
+  row.success = true;
+  row.high_slip_share = 0.08;
+  EXPECT_DOUBLE_EQ(0.1, trainingRunCost(row, 10.0, o));
+  o.max_slip_share = 0.05;
+  EXPECT_EQ("", o.validate());
+  EXPECT_DOUBLE_EQ(0.1 + 1.0, trainingRunCost(row, 10.0, o));
+  row.high_slip_share = 0.05;  // at the limit: within it
+  EXPECT_DOUBLE_EQ(0.1, trainingRunCost(row, 10.0, o));
+  row.high_slip_share = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_DOUBLE_EQ(0.1, trainingRunCost(row, 10.0, o));
+  row.success = false;  // one penalty for a run that fails both ways
+  row.high_slip_share = 0.5;
+  EXPECT_DOUBLE_EQ(0.1 + 1.0, trainingRunCost(row, 10.0, o));
+  o.max_slip_share = 0.0;
+  EXPECT_NE(o.validate().find("robust/max_slip_share"), std::string::npos);
+}
+
 TEST(RobustTuning, MeanAndQuantileOfTheRuns) {
   RobustObjective o;
   const RobustTuningProblem mean(smallSet(), kanayamaGains(), o, 1);

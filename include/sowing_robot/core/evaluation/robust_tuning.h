@@ -10,6 +10,9 @@
 // error e is e T^2 / 2), in m (+ rad), comparable across scenarios of different length. A failure
 // (diverged, body contact, not finished, cross-track above the threshold after the settle time: the
 // benchmark's success rule) costs the penalty on top, so the search first buys successes, then accuracy.
+// With max_slip_share < 1 a run whose wheels spent more than that share of it beyond twice the friction
+// peak's slip (RunRow::high_slip_share: issue 26's "slip within 2x the peak for 95 % of the run" at 0.05) is
+// a failure too: the search then buys runs that meet the slip target, not only the benchmark's success.
 // The set's cost is the mean of the run costs, or a chosen quantile (nearest rank) of them.
 #pragma once
 
@@ -34,6 +37,7 @@ struct RobustObjective {
   Aggregate aggregate = Aggregate::mean;
   double quantile = 0.9;         ///< for Aggregate::quantile, in (0, 1]
   double failure_penalty = 1.0;  ///< added per failed run, and the cap of the tracking term [m] (> 0)
+  double max_slip_share = 1.0;   ///< a run beyond twice the peak's slip longer than this share fails; 1 = off
 
   std::string validate() const;
 };
