@@ -151,7 +151,8 @@ void BM_ThesisRun25sTraction(benchmark::State& state) {
 BENCHMARK(BM_ThesisRun25sTraction)->Unit(benchmark::kMillisecond);
 
 // The drive train's cost (issue 26: motor model and traction control at most 20 % of a traction-plant run):
-// BM_ThesisRun25sTraction with the DC motors (arg 1), and with the traction control too (arg 2); arg 0 is
+// BM_ThesisRun25sTraction with the DC motors (arg 1), and with the traction control too (arg 2: the table's
+// defaults; arg 3: the field profile's, with its slope-limited reference ground speed); arg 0 is
 // BM_ThesisRun25sTraction itself, so the ratios come from one program run.
 void BM_ThesisRun25sDriveTrain(benchmark::State& state) {
   const Scenario sc = bench::thesisScenario();
@@ -161,6 +162,14 @@ void BM_ThesisRun25sDriveTrain(benchmark::State& state) {
   motor.enabled = state.range(0) >= 1;
   TractionControlParams tc_params;
   tc_params.enabled = state.range(0) >= 2;
+  if (state.range(0) >= 3) {  // the traction control of config/profiles/field.yaml, its reference ground speed on
+    tc_params.slip_target = 0.1;
+    tc_params.max_ground_accel = 1.0;
+    tc_params.raise_rate = 10.0;
+    tc_params.speed_floor = 0.3;
+    tc_params.min_torque = 1.4;
+    tc_params.anti_windup = true;
+  }
   const std::function<void(const LoopSample&)> no_trace;
   volatile double itae = 0.0;
   for (auto _ : state) {
@@ -177,7 +186,7 @@ void BM_ThesisRun25sDriveTrain(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * sc.steps());
   state.counters["itae_y"] = benchmark::Counter(itae, benchmark::Counter::kDefaults);
 }
-BENCHMARK(BM_ThesisRun25sDriveTrain)->ArgName("layers")->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ThesisRun25sDriveTrain)->ArgName("layers")->Arg(0)->Arg(1)->Arg(2)->Arg(3)->Unit(benchmark::kMillisecond);
 
 void BM_ThesisRunPotentialField(benchmark::State& state) {
   PotentialField ref = bench::thesisPotentialField();

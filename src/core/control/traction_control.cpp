@@ -30,9 +30,8 @@ const ParamTable<TractionControlParams>& tractionControlTable() {
            "tell the inner loop which torques were held back, so that its integrators (PID integral, sliding-mode "
            "surface integral and adaptation) do not wind up against the ceiling"),
       number("traction_control/max_ground_accel", &P::max_ground_accel, 0.0, Limits::nonNegative(), "m/s^2",
-             "the fastest a wheel's contact point can speed up or slow down over ground: the fed ground speed is "
-             "followed no faster, so wheels that spin up (or lock) together show their slip; 0 = the fed speed as "
-             "it is"),
+             "the fastest the robot can speed up or slow down over ground: the fed speed is followed no faster, so "
+             "wheels that spin up (or lock) together show their slip; 0 = the fed speed as it is"),
       number("traction_control/no_traction_window", &P::no_traction_window, 5.0, Limits::nonNegative(), "s",
              "no traction: this long without no_traction_progress of ground progress, the wheels slipping for "
              "no_traction_slip_share of it, and the robot is stopped and the run ends (0 = never)"),
@@ -92,22 +91,22 @@ WheelTorques TractionControl::limit(const WheelTorques& command, const WheelGrou
   if (!params_.enabled) return command;
   slipping_ = limiting_ = false;
   WheelTorques out;
-  double u[2] = {m.v + L_ * m.omega, m.v - L_ * m.omega};
-  // A fed twist that follows the encoders (odometry, or the EKF between fixes) speeds up with wheels that spin
-  // up together, so their slip would not show; the ground cannot speed the robot up faster than its grip
-  // allows, so the reference ground speed follows the fed one only that fast (automotive traction control's
-  // slope-limited reference speed for a vehicle with every wheel driven).
-  if (params_.max_ground_accel > 0.0 && std::isfinite(u[0]) && std::isfinite(u[1])) {
+  // A fed speed that follows the encoders (odometry, or the EKF between fixes) rises with wheels that spin up
+  // together, so their slip would not show; the ground cannot speed the robot up faster than its grip allows,
+  // so the reference speed follows the fed one only that fast (automotive traction control's slope-limited
+  // reference speed for a vehicle with every wheel driven). The yaw rate is taken as fed: the gyro's, which
+  // wheel spin does not drive, and which a sharp turn may change faster than any such bound.
+  double v = m.v;
+  if (params_.max_ground_accel > 0.0 && std::isfinite(v)) {
     if (!have_ground_) {
-      ground_[0] = u[0];
-      ground_[1] = u[1];
+      ground_ = v;
       have_ground_ = true;
     }
     const double step = params_.max_ground_accel * dt;
-    for (int i = 0; i < 2; ++i) u[i] = ground_[i] = std::clamp(u[i], ground_[i] - step, ground_[i] + step);
+    v = ground_ = std::clamp(v, ground_ - step, ground_ + step);
   }
-  out.right = limitWheel(0, command.right, m.wheel_right, u[0], dt);
-  out.left = limitWheel(1, command.left, m.wheel_left, u[1], dt);
+  out.right = limitWheel(0, command.right, m.wheel_right, v + L_ * m.omega, dt);
+  out.left = limitWheel(1, command.left, m.wheel_left, v - L_ * m.omega, dt);
   return out;
 }
 

@@ -13,10 +13,11 @@
 // [-ceiling, ceiling]. So the ceiling settles about the largest torque the soil carries at the target
 // slip (additive increase, multiplicative decrease).
 //
-// With max_ground_accel > 0 the ground speed u is not taken as fed: each contact point's reference speed follows
-// the fed one at most that fast (a slope-limited reference speed, as automotive traction control estimates the
-// speed of a vehicle whose every wheel is driven). A fed twist built from the encoders rises with wheels that
-// spin up together, and would hide their slip; the reference does not rise faster than the soil can push.
+// With max_ground_accel > 0 the body's speed v in u is not taken as fed: a reference speed follows the fed one
+// at most that fast (a slope-limited reference speed, as automotive traction control estimates the speed of a
+// vehicle whose every wheel is driven). A fed speed built from the encoders rises with wheels that spin up
+// together, and would hide their slip; the reference does not rise faster than the soil can push. The yaw
+// rate stays as fed (the gyro's: wheel spin does not drive it).
 #pragma once
 
 #include <string>
@@ -40,7 +41,7 @@ struct TractionControlParams {
   /// Tell the inner loop which torques were held back, so that its integrators do not wind up against
   /// the ceiling (InnerController::heldBack).
   bool anti_windup;
-  /// [m/s^2] the fastest a contact point's reference ground speed follows the fed one (0: the fed speed as it is).
+  /// [m/s^2] the fastest the reference ground speed follows the fed v (0: the fed speed as it is).
   double max_ground_accel;
 
   /// No traction (traction_monitor.h): the window [s] (0: never), the progress that restarts it [m], the
@@ -86,8 +87,8 @@ class TractionControl {
   TractionControlParams params_;
   double L_;
   double ceiling_[2], slip_[2] = {0.0, 0.0}, sent_[2] = {0.0, 0.0};
-  double ground_[2] = {0.0, 0.0};  ///< each contact point's reference ground speed (max_ground_accel) [m/s]
-  bool have_ground_ = false;       ///< false until the first finite fed twist after a reset
+  double ground_ = 0.0;       ///< the reference ground speed of the body (max_ground_accel) [m/s]
+  bool have_ground_ = false;  ///< false until the first finite fed twist after a reset
   bool slipping_ = false, limiting_ = false;
 };
 
