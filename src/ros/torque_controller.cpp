@@ -232,7 +232,7 @@ core::WheelTorques TorqueController::limitTraction(const core::WheelTorques& req
   // The progress check, after the limit as in the in-process loop (closed_loop.h): its verdict holds the robot
   // from the next period on.
   if (traction_monitor_ && !traction_monitor_->detected() &&
-      traction_monitor_->update(loopSeconds(fed.header.stamp), poseOf(fed), driving, traction_control_->slipping(),
+      traction_monitor_->update(loopSeconds(fed.header.stamp), poseOf(fed), driving, traction_control_->slippingAsFed(),
                                 dt_)) {
     traction_state_.no_traction = true;
     traction_state_.no_traction_report = traction_monitor_->report().text();

@@ -66,13 +66,18 @@ TractionControl::TractionControl(const TractionControlParams& params, double L) 
 void TractionControl::reset() {
   ceiling_[0] = ceiling_[1] = params_.max_torque;
   slip_[0] = slip_[1] = sent_[0] = sent_[1] = 0.0;
-  slipping_ = limiting_ = false;
+  slipping_ = limiting_ = slipping_as_fed_ = false;
   have_ground_ = false;
 }
 
-double TractionControl::limitWheel(int wheel, double command, double wheel_speed, double ground_speed, double dt) {
+/// The slip ratio of a wheel turning at wheel_speed over ground moving at ground_speed (0 when either is not finite).
+double TractionControl::slipRatio(double wheel_speed, double ground_speed) const {
   const double scale = std::max({std::fabs(wheel_speed), std::fabs(ground_speed), params_.speed_floor});
-  slip_[wheel] = std::isfinite(wheel_speed) && std::isfinite(ground_speed) ? (wheel_speed - ground_speed) / scale : 0.0;
+  return std::isfinite(wheel_speed) && std::isfinite(ground_speed) ? (wheel_speed - ground_speed) / scale : 0.0;
+}
+
+double TractionControl::limitWheel(int wheel, double command, double wheel_speed, double ground_speed, double dt) {
+  slip_[wheel] = slipRatio(wheel_speed, ground_speed);
   double& ceiling = ceiling_[wheel];
   if (std::fabs(slip_[wheel]) > params_.slip_target) {
     slipping_ = true;
@@ -89,7 +94,7 @@ double TractionControl::limitWheel(int wheel, double command, double wheel_speed
 
 WheelTorques TractionControl::limit(const WheelTorques& command, const WheelGroundSpeeds& m, double dt) {
   if (!params_.enabled) return command;
-  slipping_ = limiting_ = false;
+  slipping_ = limiting_ = slipping_as_fed_ = false;
   WheelTorques out;
   // A fed speed that follows the encoders (odometry, or the EKF between fixes) rises with wheels that spin up
   // together, so their slip would not show; the ground cannot speed the robot up faster than its grip allows,
@@ -97,7 +102,8 @@ WheelTorques TractionControl::limit(const WheelTorques& command, const WheelGrou
   // reference speed for a vehicle with every wheel driven). The yaw rate is taken as fed: the gyro's, which
   // wheel spin does not drive, and which a sharp turn may change faster than any such bound.
   double v = m.v;
-  if (params_.max_ground_accel > 0.0 && std::isfinite(v)) {
+  const bool bounded = params_.max_ground_accel > 0.0 && std::isfinite(v);
+  if (bounded) {
     if (!have_ground_) {
       ground_ = v;
       have_ground_ = true;
@@ -107,6 +113,9 @@ WheelTorques TractionControl::limit(const WheelTorques& command, const WheelGrou
   }
   out.right = limitWheel(0, command.right, m.wheel_right, v + L_ * m.omega, dt);
   out.left = limitWheel(1, command.left, m.wheel_left, v - L_ * m.omega, dt);
+  slipping_as_fed_ = bounded ? std::fabs(slipRatio(m.wheel_right, m.v + L_ * m.omega)) > params_.slip_target ||
+                                   std::fabs(slipRatio(m.wheel_left, m.v - L_ * m.omega)) > params_.slip_target
+                             : slipping_;
   return out;
 }
 

@@ -56,6 +56,7 @@ TEST(TractionControl, ASlippingWheelIsCutAndRecovers) {
   // Braking slip (a wheel slower than the ground) is cut the same way.
   out = tc.limit({-5.0, 0.0}, {0.0, 1.0, 1.0, 0.0}, kDt);
   EXPECT_TRUE(tc.slipping());
+  EXPECT_TRUE(tc.slippingAsFed());  // without the bound, the same verdict
   EXPECT_GT(out.right, -5.0);
   tc.reset();
   EXPECT_EQ(tc.ceiling(0), p.max_torque);
@@ -98,10 +99,13 @@ TEST(TractionControl, ABoundOnGroundAccelerationShowsWheelsSpinningUpTogether) {
   }
   EXPECT_EQ(a.right, 5.0);
   EXPECT_FALSE(blind.slipping());
+  EXPECT_FALSE(blind.slippingAsFed());
   // After 50 ms the wheels turn at 1.5 m/s over a reference of 0.5 + 1.0 x 0.049 m/s: slip 0.63, both cut.
   EXPECT_NEAR(bounded.slip(0), (1.48 - 0.549) / 1.48, 1e-9);
   EXPECT_NEAR(bounded.slip(1), bounded.slip(0), 1e-12);
   EXPECT_TRUE(bounded.slipping());
+  // The no-traction check's input stays the slip against the fed speed: none here (the wheels are the fed speed).
+  EXPECT_FALSE(bounded.slippingAsFed());
   EXPECT_LT(b.right, 5.0);
   EXPECT_LT(b.left, 5.0);
   // A robot speeding up at 0.5 m/s^2 (within the bound), turning at 0.5 rad/s: no slip, nothing cut.

@@ -74,6 +74,10 @@ class TractionControl {
   double ceiling(int wheel) const { return ceiling_[wheel]; }
   /// Either wheel slipped beyond the target in the last period.
   bool slipping() const { return slipping_; }
+  /// The same against the fed ground speed as it is, without max_ground_accel's bound (with the bound off:
+  /// slipping()). What the no-traction check reads: the bounded reference also reads a robot rocking in place
+  /// faster than the bound (a chattering inner loop) as slip, and a stop that ends the run must not fire on that.
+  bool slippingAsFed() const { return slipping_as_fed_; }
   /// Either wheel's command was cut to its ceiling in the last period: the inner loop asked for more
   /// torque than the soil has carried (the wheel is held at the friction peak). This, not slipping(), is
   /// the grip-limit verdict while the control works: it keeps the slip about the target, so slipping()
@@ -83,13 +87,14 @@ class TractionControl {
 
  private:
   double limitWheel(int wheel, double command, double wheel_speed, double ground_speed, double dt);
+  double slipRatio(double wheel_speed, double ground_speed) const;
 
   TractionControlParams params_;
   double L_;
   double ceiling_[2], slip_[2] = {0.0, 0.0}, sent_[2] = {0.0, 0.0};
   double ground_ = 0.0;       ///< the reference ground speed of the body (max_ground_accel) [m/s]
   bool have_ground_ = false;  ///< false until the first finite fed twist after a reset
-  bool slipping_ = false, limiting_ = false;
+  bool slipping_ = false, limiting_ = false, slipping_as_fed_ = false;
 };
 
 }  // namespace core

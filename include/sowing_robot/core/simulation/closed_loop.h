@@ -207,7 +207,7 @@ EstimatedRunResult closedLoop(const Scenario& sc, PlantT& plant, Feed& feed, Out
           last = std::min(2 * n, n + static_cast<std::int64_t>(std::ceil(lost / dt - 1e-9)));
         }
       }
-      if (layers.monitor && !no_traction && layers.monitor->update(t, fed.pose, !cmd.hold, tc->slipping(), dt)) {
+      if (layers.monitor && !no_traction && layers.monitor->update(t, fed.pose, !cmd.hold, tc->slippingAsFed(), dt)) {
         out.no_traction = layers.monitor->report();
         end_at = t + tc->params().no_traction_hold;
       }
