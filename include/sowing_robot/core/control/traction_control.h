@@ -75,8 +75,8 @@ class TractionControl {
   /// Either wheel slipped beyond the target in the last period.
   bool slipping() const { return slipping_; }
   /// The same against the fed ground speed as it is, without max_ground_accel's bound (with the bound off:
-  /// slipping()). What the no-traction check reads: the bounded reference also reads a robot rocking in place
-  /// faster than the bound (a chattering inner loop) as slip, and a stop that ends the run must not fire on that.
+  /// slipping()). What the no-traction check reads: the bounded reference also reads a fed speed swinging faster
+  /// than the bound (an aggressive inner loop) as slip, and a stop that ends the run must not fire on that.
   bool slippingAsFed() const { return slipping_as_fed_; }
   /// Either wheel's command was cut to its ceiling in the last period: the inner loop asked for more
   /// torque than the soil has carried (the wheel is held at the friction peak). This, not slipping(), is
