@@ -17,7 +17,7 @@ PLANT = dict(duration=4.0, disturbance=True, mass_scale=1.2, inertia_scale=1.2)
 # config/profiles/field.yaml spelled out by hand: a key added to the profile and not here fails the tests below
 FIELD_KEYS = dict(traction={"enabled": True}, motor={"enabled": True}, hitch_control={"enabled": True},
                   traction_control={"enabled": True, "raise_rate": 10.0, "speed_floor": 0.3, "anti_windup": True,
-                                    "min_torque": 1.4, "slip_target": 0.1, "max_ground_accel": 1.0},
+                                    "min_torque": 1.4},
                   speed_governor={"enabled": True}, estimator={"slip": {"detect": True}})
 
 
