@@ -152,7 +152,7 @@ BENCHMARK(BM_ThesisRun25sTraction)->Unit(benchmark::kMillisecond);
 
 // The drive train's cost (issue 26: motor model and traction control at most 20 % of a traction-plant run):
 // BM_ThesisRun25sTraction with the DC motors (arg 1), and with the traction control too (arg 2: the table's
-// defaults; arg 3: the field profile's, with its slope-limited reference ground speed); arg 0 is
+// defaults; arg 3: the field profile's with the max_ground_accel option of results/drive_train.md); arg 0 is
 // BM_ThesisRun25sTraction itself, so the ratios come from one program run.
 void BM_ThesisRun25sDriveTrain(benchmark::State& state) {
   const Scenario sc = bench::thesisScenario();
@@ -162,7 +162,7 @@ void BM_ThesisRun25sDriveTrain(benchmark::State& state) {
   motor.enabled = state.range(0) >= 1;
   TractionControlParams tc_params;
   tc_params.enabled = state.range(0) >= 2;
-  if (state.range(0) >= 3) {  // the traction control of config/profiles/field.yaml, its reference ground speed on
+  if (state.range(0) >= 3) {  // config/profiles/field.yaml's traction control, the ground-speed option on
     tc_params.slip_target = 0.1;
     tc_params.max_ground_accel = 1.0;
     tc_params.raise_rate = 10.0;
