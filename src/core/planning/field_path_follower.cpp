@@ -85,11 +85,13 @@ FieldPathReference::FieldPathReference(const FieldParams& params, std::vector<Ob
       obstacles_(std::move(obstacles)),
       path_(std::make_shared<const FieldPath>(params_, obstacles_)),
       coverage_(coveragePath(*path_, kSpacing)),
-      follower_(fieldFollowerParams(params_), startOf(coverage_), coverage_.points, coverage_.tool_down) {}
+      follower_(followerFromStart()) {}
 
-void FieldPathReference::restart() {
-  follower_ = PathReference(fieldFollowerParams(params_), startOf(coverage_), coverage_.points, coverage_.tool_down);
+PathReference FieldPathReference::followerFromStart() const {
+  return PathReference(fieldFollowerParams(params_), startOf(coverage_), coverage_.points, coverage_.tool_down);
 }
+
+void FieldPathReference::restart() { follower_ = followerFromStart(); }
 
 std::unique_ptr<ReferenceSource> FieldPathReference::clone() const {
   auto c = std::make_unique<FieldPathReference>(*this);

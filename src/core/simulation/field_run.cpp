@@ -91,18 +91,13 @@ FieldRunReport runField(const FieldRunSetup& setup) {
 }
 
 double approachExtraTime(const FieldRunSetup& setup) {
-  FieldParams with = setup.field;
-  if (!with.start_pose) with.start_pose = setup.scenario.start;
-  FieldParams without = with;
-  without.approach = false;
-  // The path follower drives the same field in its own time (slower on the turns): the run grows by that too.
-  const double with_duration = with.follower == FieldFollower::kPath
-                                   ? FieldPathReference(with, setup.obstacles).duration()
-                                   : FieldPath(with, setup.obstacles).duration();
-  return with_duration - FieldPath(without, setup.obstacles).duration();
+  FieldParams field = setup.field;
+  if (!field.start_pose) field.start_pose = setup.scenario.start;
+  return approachExtraTime(*makeFieldSource(field, setup.obstacles));
 }
 
 double approachExtraTime(const FieldSource& reference) {
+  // The path follower drives the same field in its own time (slower on the turns): the run grows by that too.
   FieldParams without = reference.params();
   without.approach = false;
   return reference.duration() - FieldPath(without, reference.obstacles()).duration();

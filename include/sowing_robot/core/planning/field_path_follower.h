@@ -70,6 +70,9 @@ class FieldPathReference : public FieldSource {
   Reference evaluate(double t) override { return follower_.next(t); }
 
  private:
+  /// The follower from the start of coverage_ (the constructor's and restart()'s).
+  PathReference followerFromStart() const;
+
   FieldParams params_;
   std::vector<Obstacle> obstacles_;
   std::shared_ptr<const FieldPath> path_;  ///< shared by clones: immutable once built
