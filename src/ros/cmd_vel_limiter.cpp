@@ -38,7 +38,7 @@ bool CmdVelLimiter::throttle(ros::WallTime& last) {
 
 void CmdVelLimiter::twistCallback(const geometry_msgs::Twist::ConstPtr& msg) {
   if (lockstep_) {
-    if (throttle(ignored_log_))
+    if (throttle(plain_log_))
       ROS_WARN(
           "cmd_vel_limiter: lockstep pairs commands with states by stamp: a geometry_msgs/Twist on cmd_vel has none "
           "and is ignored; publish geometry_msgs/TwistStamped on cmd_vel_stamped");
@@ -50,7 +50,7 @@ void CmdVelLimiter::twistCallback(const geometry_msgs::Twist::ConstPtr& msg) {
 void CmdVelLimiter::stampedCallback(const geometry_msgs::TwistStamped::ConstPtr& msg) {
   const bool unstamped = msg->header.stamp.isZero();
   if (unstamped && lockstep_) {
-    if (throttle(ignored_log_))
+    if (throttle(unstamped_log_))
       ROS_WARN("cmd_vel_limiter: a TwistStamped stamped 0 on cmd_vel_stamped cannot be paired: ignored");
     return;
   }

@@ -30,12 +30,13 @@ def teleop(t0, t1, v, omega, rate=10.0):
 
 # (stamp [s], v [m/s], omega [rad/s]) in stamp order; the last stamp is the run's end (duration): lockstep
 # answers the state at t once a twist stamped t or later has come, so the final one lets the run finish.
+# The first is stamped one control period in: a stamp of 0 reads as "unstamped" and lockstep drops it.
 SCHEDULES = {
     # at rest, then 0.3 m/s and 0.2 rad/s at 10 Hz from 0.5 s to 4 s (the last twist stamped 3.9 s): stale
     # at 4.4 s (cmd_vel_timeout 0.5 s), when the limiter ramps to a stop.
-    "step": [(0.0, 0.0, 0.0)] + teleop(0.5, 4.0, 0.3, 0.2) + [(8.0, 0.0, 0.0)],
+    "step": [(PERIOD, 0.0, 0.0)] + teleop(0.5, 4.0, 0.3, 0.2) + [(8.0, 0.0, 0.0)],
     # astern at -0.3 m/s, -0.2 rad/s, then straight to +0.3, +0.2 (through zero), then stop.
-    "reverse": ([(0.0, 0.0, 0.0)] + teleop(0.5, 3.0, -0.3, -0.2) + teleop(3.0, 6.0, 0.3, 0.2) +
+    "reverse": ([(PERIOD, 0.0, 0.0)] + teleop(0.5, 3.0, -0.3, -0.2) + teleop(3.0, 6.0, 0.3, 0.2) +
                 teleop(6.0, 8.0, 0.0, 0.0) + [(8.0, 0.0, 0.0)]),
 }
 STEP_AT = 0.5        # [s] when the step starts, in both schedules

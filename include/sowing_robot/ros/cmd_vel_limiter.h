@@ -52,7 +52,8 @@ class CmdVelLimiter {
   bool wait_reported_ = false;  // for pending_stamp_
   bool stale_reported_ = false;
   long dropped_ = 0;
-  ros::WallTime dropped_log_, ignored_log_;  // throttle()
+  // throttle(), one per warning: a shared one let a stamped-0 twist hide the plain-Twist warning
+  ros::WallTime dropped_log_, plain_log_, unstamped_log_;
   DesiredVelocity desired_;
   ros::Publisher desired_pub_;
   ros::Subscriber state_sub_, twist_sub_, stamped_sub_;
