@@ -184,7 +184,8 @@ struct ProfileBlock {
   const char* node;
   const char* block;
 };
-constexpr ProfileBlock kProfileBlocks[] = {{"plant_sim", "traction"},
+constexpr ProfileBlock kProfileBlocks[] = {{"kinematic_controller", "limits"},
+                                           {"plant_sim", "traction"},
                                            {"plant_sim", "motor"},
                                            {"plant_sim", "sensors"},
                                            {"torque_controller", "traction_control"},
@@ -196,10 +197,13 @@ constexpr ProfileBlock kProfileBlocks[] = {{"plant_sim", "traction"},
 /// into the scenario's block of that name (the profile's value wins), profile/feedback over the feedback.
 void applyProfile(YAML::Node& root, const std::string& profile) {
   const YAML::Node prof = loadYaml(profile);
-  onlyKeys(prof, {"profile", "plant_sim", "torque_controller", "reference_generator", "state_estimator"}, profile, "");
+  onlyKeys(prof,
+           {"profile", "kinematic_controller", "plant_sim", "torque_controller", "reference_generator", "state_estimator"},
+           profile, "");
   const YAML::Node own = required(prof, "profile", profile, "");
   onlyKeys(own, {"name", "description", "feedback"}, profile, "profile/");
-  for (const char* node : {"plant_sim", "torque_controller", "reference_generator", "state_estimator"}) {
+  for (const char* node :
+       {"kinematic_controller", "plant_sim", "torque_controller", "reference_generator", "state_estimator"}) {
     const YAML::Node blocks = prof[node];
     if (!blocks) continue;
     std::set<std::string> allowed;
@@ -218,7 +222,7 @@ void applyProfile(YAML::Node& root, const std::string& profile) {
 }
 
 /// The blocks that put a scenario on the estimated loop (traction:, sensors:, estimator:, feedback:, motor:,
-/// traction_control:, speed_governor:, hitch_control:), each through the nodes' parameter table, onto `traction` and
+/// limits:, traction_control:, speed_governor:, hitch_control:), each through the nodes' parameter table, onto `traction` and
 /// `cfg` (what they do not set stays).
 void applyLoopBlocks(const YAML::Node& root, const std::string& path, core::TractionParams& traction,
                      core::EstimatedRunConfig& cfg) {
@@ -234,6 +238,7 @@ void applyLoopBlocks(const YAML::Node& root, const std::string& path, core::Trac
   if (const YAML::Node block = root["estimator"])
     applyTableBlock(core::ekfTable(), block, cfg.estimator, path, "estimator");
   if (const YAML::Node block = root["motor"]) applyTableBlock(core::motorTable(), block, cfg.motor, path, "motor");
+  if (const YAML::Node block = root["limits"]) applyTableBlock(core::commandLimitsTable(), block, cfg.limits, path, "limits");
   if (const YAML::Node block = root["traction_control"])
     applyTableBlock(core::tractionControlTable(), block, cfg.traction_control, path, "traction_control");
   if (const YAML::Node block = root["speed_governor"])
@@ -269,6 +274,7 @@ core::BenchScenario loadScenarioFileImpl(const std::string& path, const std::str
                   "estimator",
                   "feedback",
                   "motor",
+                  "limits",
                   "traction_control",
                   "speed_governor",
                   "hitch_control"},
@@ -372,8 +378,9 @@ core::BenchScenario loadScenarioFileImpl(const std::string& path, const std::str
   // The drive train's layers (motor:, traction_control:, speed_governor:) likewise, through their tables.
   const YAML::Node traction = root["traction"], sensors = root["sensors"], estimator = root["estimator"],
                    feedback = root["feedback"], motor = root["motor"], traction_control = root["traction_control"],
-                   speed_governor = root["speed_governor"], hitch_control = root["hitch_control"];
-  if (traction || sensors || estimator || feedback || motor || traction_control || speed_governor || hitch_control) {
+                   speed_governor = root["speed_governor"], hitch_control = root["hitch_control"], limits = root["limits"];
+  if (traction || sensors || estimator || feedback || motor || traction_control || speed_governor || hitch_control ||
+      limits) {
     core::EstimatedRunConfig cfg;
     core::TractionParams t;
     applyLoopBlocks(root, path, t, cfg);

@@ -15,6 +15,8 @@ KinematicController::KinematicController(ros::NodeHandle nh, ros::NodeHandle pnh
   loadTable(p, core::KinematicControllerSettings::table(), settings);
   requireValid(p, settings.validate());
   input_timeout_ = settings.input_timeout;
+  limiter_ = std::make_unique<core::CommandLimiter>(settings.limits);  // validated above: does not throw
+  period_ = core::secondsFromNanos(run.periodNs());  // the in-process loop's dt, to the bit
   // Live gains of the controller in use (reconfigure_bridge.h; one server on the private namespace).
   if (settings.outer == core::OuterKind::kanayama) {
     auto kanayama = std::make_unique<core::OuterAdapter<core::Kanayama>>(core::Kanayama(settings.gains));
@@ -85,6 +87,7 @@ void KinematicController::stopIfStale(const nav_msgs::Odometry& odom) {
   desired_.header.stamp = odom.header.stamp;
   desired_.v = desired_.omega = desired_.v_dot = desired_.omega_dot = 0.0;
   desired_.hold = true;
+  limiter_->reset();  // from rest when the reference is back, as after any hold
   publishShared(desired_pub_, desired_);
 }
 
@@ -108,7 +111,8 @@ void KinematicController::compute() {
   ref.omega_dot = r.omega_dot;
   ref.tool_down = r.tool_down != 0;
   ref.stop = r.stop != 0;
-  const core::VelocityCommand cmd = outer_->compute(ref, pose, odom.twist.twist.linear.x, odom.twist.twist.angular.z);
+  const core::VelocityCommand cmd = limiter_->limit(
+      outer_->compute(ref, pose, odom.twist.twist.linear.x, odom.twist.twist.angular.z), period_);
   desired_.header.stamp = odom.header.stamp;
   desired_.v = cmd.v;
   desired_.omega = cmd.omega;

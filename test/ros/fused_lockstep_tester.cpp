@@ -7,7 +7,8 @@
 // formed the EKF's inputs otherwise (e.g. without the quaternion round trip or the increment covariance) or
 // applied the fixes at another time gives other numbers (the printed differences say how far).
 // The drive train (issue 26) comes from the nodes' namespaces too: plant_sim's traction/ (+ field/patches) and
-// motor/, torque_controller's traction_control/, reference_generator's speed_governor/ (fused_field_lockstep.test:
+// motor/, kinematic_controller's limits/, torque_controller's traction_control/, reference_generator's speed_governor/
+// (fused_field_lockstep.test:
 // sim.launch profile:=field on a wet stretch of the line). ~expect_drive_train: the in-process run must show the
 // traction control cutting and the governor slowing the target, so the comparison covers them at work.
 #include <gtest/gtest.h>
@@ -48,7 +49,8 @@ TEST(FusedLockstep, NodePipelineEqualsTheInProcessEstimatedLoop) {
   core::EstimatedRunConfig cfg;
   cfg.feedback = core::Feedback::fused;
   ParamReader plant(ros::NodeHandle("/plant_sim")), estimator(ros::NodeHandle("/state_estimator")),
-      torque(ros::NodeHandle("/torque_controller")), reference(ros::NodeHandle("/reference_generator"));
+      torque(ros::NodeHandle("/torque_controller")), reference(ros::NodeHandle("/reference_generator")),
+      kinematic(ros::NodeHandle("/kinematic_controller"));
   loadTable(plant, core::sensorsTable(), cfg.sensors);
   loadTable(estimator, core::ekfTable(), cfg.estimator);
   core::TractionParams traction;
@@ -59,11 +61,13 @@ TEST(FusedLockstep, NodePipelineEqualsTheInProcessEstimatedLoop) {
     patch_error = loadSoilPatches(plant, "field/patches", traction, cfg.patches);
   }
   loadTable(plant, core::motorTable(), cfg.motor);
+  loadTable(kinematic, core::commandLimitsTable(), cfg.limits);
   loadTable(torque, core::tractionControlTable(), cfg.traction_control);
   loadTable(torque, core::hitchControlTable(), cfg.hitch_control);  // inert here: no draft, no tool
   loadTable(reference, core::speedGovernorTable(), cfg.speed_governor);
   ASSERT_EQ(core::firstError(
-                {plant.error(), estimator.error(), torque.error(), reference.error(), patch_error, cfg.validate()}),
+                {plant.error(), estimator.error(), kinematic.error(), torque.error(), reference.error(), patch_error,
+                 cfg.validate()}),
             "");
   // The tool's draft needs the plan's rows and the URDF's tool point here too: not set up by this tester.
   ASSERT_EQ(traction.draft_force, 0.0) << "this tester compares runs without the tool's draft";

@@ -17,6 +17,7 @@
 #include "sowing_robot/PurePursuitConfig.h"
 #include "sowing_robot/ReferenceState.h"
 #include "sowing_robot/TrackingError.h"
+#include "sowing_robot/core/control/command_limits.h"
 #include "sowing_robot/core/control/controllers.h"
 #include "sowing_robot/core/control/kanayama.h"
 #include "sowing_robot/core/control/pure_pursuit.h"
@@ -37,6 +38,8 @@ class KinematicController {
   void stopIfStale(const nav_msgs::Odometry& odom);
 
   std::unique_ptr<core::OuterController> outer_;
+  std::unique_ptr<core::CommandLimiter> limiter_;  // limits/ (passes the command unchanged when off)
+  double period_ = 0.0;                            // [s] between two states: the limiter's dt (run/control_rate)
   core::Kanayama* kanayama_ = nullptr;         // outer_'s Kanayama when outer is kanayama, else null
   core::PurePursuit* pure_pursuit_ = nullptr;  // outer_'s (R)PP when outer is pure_pursuit or rpp, else null
   ros::Subscriber odom_sub_, ref_sub_;

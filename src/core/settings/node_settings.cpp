@@ -133,6 +133,7 @@ const ParamTable<KinematicControllerSettings>& KinematicControllerSettings::tabl
     nestMarked(t, &S::pure_pursuit, purePursuitTable(), [](const std::string& key) {
       return key.rfind("regulated_", 0) == 0 ? "[rpp]" : "[pure_pursuit, rpp]";  // RPP's speed heuristic
     });
+    t.nest("", &S::limits, commandLimitsTable());  // whichever controller runs
     return t;
   }();
   return table;
@@ -141,7 +142,7 @@ const ParamTable<KinematicControllerSettings>& KinematicControllerSettings::tabl
 KinematicControllerSettings::KinematicControllerSettings() { table().applyDefaults(*this); }
 
 std::string KinematicControllerSettings::validate() const {
-  return firstError({table().checkRanges(*this), pure_pursuit.validate()});
+  return firstError({table().checkRanges(*this), pure_pursuit.validate(), limits.validate()});
 }
 
 const ParamTable<TorqueControllerSettings>& TorqueControllerSettings::table() {

@@ -205,6 +205,11 @@ EstimatedRunResult run(const Scenario& sc, const EstimatedRunConfig& cfg, PlantT
   LoopLayers layers;
   layers.tool = &tool;
   if (cfg.traction) layers.high_slip = 2.0 * cfg.traction->slip_peak;
+  std::optional<CommandLimiter> limiter;
+  if (cfg.limits.enabled) {
+    limiter.emplace(cfg.limits);
+    layers.limiter = &*limiter;
+  }
   std::optional<TractionControl> traction_control;
   std::optional<TractionMonitor> monitor;
   if (cfg.traction_control.enabled) {

@@ -10,6 +10,7 @@
 
 #include "sowing_robot/core/common/param_table.h"
 #include "sowing_robot/core/common/types.h"
+#include "sowing_robot/core/control/command_limits.h"
 #include "sowing_robot/core/control/controllers.h"
 #include "sowing_robot/core/control/kanayama.h"
 #include "sowing_robot/core/control/sliding_mode.h"
@@ -61,6 +62,7 @@ struct KinematicControllerSettings {
   OuterKind outer;
   KanayamaGains gains;
   PurePursuitParams pure_pursuit;
+  CommandLimitsParams limits;  ///< limits/: bounds on the command handed on (whichever controller runs)
   /// Ranges (the table), then the pure pursuit's min <= L <= max (checked even when not selected).
   std::string validate() const;
   static const ParamTable<KinematicControllerSettings>& table();

@@ -34,6 +34,7 @@
 #include <functional>
 #include <limits>
 
+#include "sowing_robot/core/control/command_limits.h"
 #include "sowing_robot/core/control/hitch_control.h"
 #include "sowing_robot/core/control/standstill_hold.h"
 #include "sowing_robot/core/control/traction_control.h"
@@ -110,6 +111,7 @@ struct ToolRule {
 /// The loop's optional layers (null: off).
 struct LoopLayers {
   ToolRule* tool = nullptr;                     ///< the traction plant's tool rule
+  CommandLimiter* limiter = nullptr;            ///< between the outer and the inner loop
   TractionControl* traction_control = nullptr;  ///< between the inner loop and the motors
   GovernedReference* governor = nullptr;        ///< the reference the loop is given, governed
   HitchControl* hitch = nullptr;                ///< raises the tool on the traction control's grip verdict
@@ -154,6 +156,7 @@ EstimatedRunResult closedLoop(const Scenario& sc, PlantT& plant, Feed& feed, Out
   plant.reset(startState(sc), phaseStartTime(sc));
   reference.reset();
   feed.start(plant.state());
+  if (layers.limiter) layers.limiter->reset();
   if (layers.traction_control) layers.traction_control->reset();
   if (layers.hitch) layers.hitch->reset();
   if (layers.monitor) layers.monitor->reset();
@@ -182,7 +185,8 @@ EstimatedRunResult closedLoop(const Scenario& sc, PlantT& plant, Feed& feed, Out
     worldErrors(ref, truth, ex, ey, eth);
     metrics.add(t, ex, ey, eth);
     const bool no_traction = layers.monitor != nullptr && layers.monitor->detected();
-    const VelocityCommand cmd = no_traction ? holdCommand() : outer.compute(ref, fed.pose, fed.v, fed.omega);
+    VelocityCommand cmd = no_traction ? holdCommand() : outer.compute(ref, fed.pose, fed.v, fed.omega);
+    if (layers.limiter) cmd = layers.limiter->limit(cmd, dt);
     InnerOutput u = inner.update(cmd, fed.v, fed.omega, dt);
     if (u.holding) {  // a stop: the inner loop is frozen, the brake holds the robot where it is
       if (!holding) hold.engage();

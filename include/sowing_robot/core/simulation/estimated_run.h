@@ -29,6 +29,7 @@
 #include <string>
 #include <vector>
 
+#include "sowing_robot/core/control/command_limits.h"
 #include "sowing_robot/core/control/hitch_control.h"
 #include "sowing_robot/core/control/traction_control.h"
 #include "sowing_robot/core/control/traction_monitor.h"
@@ -65,6 +66,8 @@ struct EstimatedRunConfig {
   SensorParams sensors;   ///< sensors.yaml defaults
   EkfParams estimator;    ///< estimator.yaml defaults (feedback fused)
   MotorParams motor;      ///< the drive motors (off: the commanded torque reaches the wheel)
+  /// Bounds on the outer loop's command, kinematic_controller's limits/ (off: the command as computed).
+  CommandLimitsParams limits;
   /// Between the inner loop and the motors: each wheel's torque capped while it slips (off: unchanged).
   TractionControlParams traction_control;
   /// The target slowed along its path while a wheel slips (needs traction_control; off: planned timing).
