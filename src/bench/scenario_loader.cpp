@@ -197,9 +197,10 @@ constexpr ProfileBlock kProfileBlocks[] = {{"kinematic_controller", "limits"},
 /// into the scenario's block of that name (the profile's value wins), profile/feedback over the feedback.
 void applyProfile(YAML::Node& root, const std::string& profile) {
   const YAML::Node prof = loadYaml(profile);
-  onlyKeys(prof,
-           {"profile", "kinematic_controller", "plant_sim", "torque_controller", "reference_generator", "state_estimator"},
-           profile, "");
+  onlyKeys(
+      prof,
+      {"profile", "kinematic_controller", "plant_sim", "torque_controller", "reference_generator", "state_estimator"},
+      profile, "");
   const YAML::Node own = required(prof, "profile", profile, "");
   onlyKeys(own, {"name", "description", "feedback"}, profile, "profile/");
   for (const char* node :
@@ -222,8 +223,8 @@ void applyProfile(YAML::Node& root, const std::string& profile) {
 }
 
 /// The blocks that put a scenario on the estimated loop (traction:, sensors:, estimator:, feedback:, motor:,
-/// limits:, traction_control:, speed_governor:, hitch_control:), each through the nodes' parameter table, onto `traction` and
-/// `cfg` (what they do not set stays).
+/// limits:, traction_control:, speed_governor:, hitch_control:), each through the nodes' parameter table, onto
+/// `traction` and `cfg` (what they do not set stays).
 void applyLoopBlocks(const YAML::Node& root, const std::string& path, core::TractionParams& traction,
                      core::EstimatedRunConfig& cfg) {
   const YAML::Node sensors = root["sensors"], feedback = root["feedback"];
@@ -238,7 +239,8 @@ void applyLoopBlocks(const YAML::Node& root, const std::string& path, core::Trac
   if (const YAML::Node block = root["estimator"])
     applyTableBlock(core::ekfTable(), block, cfg.estimator, path, "estimator");
   if (const YAML::Node block = root["motor"]) applyTableBlock(core::motorTable(), block, cfg.motor, path, "motor");
-  if (const YAML::Node block = root["limits"]) applyTableBlock(core::commandLimitsTable(), block, cfg.limits, path, "limits");
+  if (const YAML::Node block = root["limits"])
+    applyTableBlock(core::commandLimitsTable(), block, cfg.limits, path, "limits");
   if (const YAML::Node block = root["traction_control"])
     applyTableBlock(core::tractionControlTable(), block, cfg.traction_control, path, "traction_control");
   if (const YAML::Node block = root["speed_governor"])
@@ -255,30 +257,12 @@ void applyLoopBlocks(const YAML::Node& root, const std::string& path, core::Trac
 core::BenchScenario loadScenarioFileImpl(const std::string& path, const std::string& profile) {
   YAML::Node root = loadYaml(path);
   if (!profile.empty()) applyProfile(root, profile);
-  onlyKeys(root, {"name",
-                  "description",
-                  "track",
-                  "duration",
-                  "control_rate",
-                  "start",
-                  "line",
-                  "sine",
-                  "field",
-                  "plant",
-                  "draws",
-                  "success",
-                  "envelope_period",
-                  "requires",
-                  "traction",
-                  "sensors",
-                  "estimator",
-                  "feedback",
-                  "motor",
-                  "limits",
-                  "traction_control",
-                  "speed_governor",
-                  "hitch_control"},
-           path, "");
+  onlyKeys(
+      root,
+      {"name",      "description", "track", "duration", "control_rate",     "start",          "line",         "sine",
+       "field",     "plant",       "draws", "success",  "envelope_period",  "requires",       "traction",     "sensors",
+       "estimator", "feedback",    "motor", "limits",   "traction_control", "speed_governor", "hitch_control"},
+      path, "");
   core::BenchScenario b;
   std::vector<PatchSpec> patch_specs;
   b.name = required(root, "name", path, "").as<std::string>();
@@ -378,7 +362,8 @@ core::BenchScenario loadScenarioFileImpl(const std::string& path, const std::str
   // The drive train's layers (motor:, traction_control:, speed_governor:) likewise, through their tables.
   const YAML::Node traction = root["traction"], sensors = root["sensors"], estimator = root["estimator"],
                    feedback = root["feedback"], motor = root["motor"], traction_control = root["traction_control"],
-                   speed_governor = root["speed_governor"], hitch_control = root["hitch_control"], limits = root["limits"];
+                   speed_governor = root["speed_governor"], hitch_control = root["hitch_control"],
+                   limits = root["limits"];
   if (traction || sensors || estimator || feedback || motor || traction_control || speed_governor || hitch_control ||
       limits) {
     core::EstimatedRunConfig cfg;

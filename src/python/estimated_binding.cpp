@@ -112,7 +112,7 @@ py::dict fixCounts(const FixCounts& c, long lost_from_queue) {
 py::dict runEstimatedPy(const std::string& controller, const py::object& params, const py::object& gains,
                         const std::string& feedback, const py::object& traction, const py::object& patches,
                         const py::object& sensors, const py::object& estimator, const py::object& motor,
-                        const py::object& traction_control, const py::object& speed_governor,
+                        const py::object& limits, const py::object& traction_control, const py::object& speed_governor,
                         const py::object& hitch_control, const py::object& profile, double duration,
                         std::int64_t control_period_ns, bool disturbance, double mass_scale, double inertia_scale,
                         double noise_std, std::uint64_t seed, const std::array<double, 3>& start,
@@ -135,6 +135,7 @@ py::dict runEstimatedPy(const std::string& controller, const py::object& params,
   if (!sensors.is_none()) applyTableDict(sensorsTable(), cfg.sensors, "sensors/", sensors, "sensors");
   if (!estimator.is_none()) applyTableDict(ekfTable(), cfg.estimator, "estimator/", estimator, "estimator");
   if (!motor.is_none()) applyTableDict(motorTable(), cfg.motor, "motor/", motor, "motor");
+  if (!limits.is_none()) applyTableDict(commandLimitsTable(), cfg.limits, "limits/", limits, "limits");
   if (!traction_control.is_none())
     applyTableDict(tractionControlTable(), cfg.traction_control, "traction_control/", traction_control,
                    "traction_control");
@@ -191,6 +192,7 @@ py::dict runEstimatedPy(const std::string& controller, const py::object& params,
   d["fixes"] = fixCounts(r.fixes, r.fixes_lost_from_queue);
   d["profile"] = profile_name;
   d["motor"] = cfg.motor.enabled;
+  d["limits"] = cfg.limits.enabled;
   d["traction_control"] = cfg.traction_control.enabled;
   d["speed_governor"] = cfg.speed_governor.enabled;
   d["hitch_control"] = cfg.hitch_control.enabled;
@@ -209,9 +211,10 @@ void bindEstimated(py::module& m) {
     m.def("run_estimated", &runEstimatedPy, py::kw_only(), py::arg("controller") = std::string("kanayama+atsmc"),
           py::arg("params") = py::none(), py::arg("gains") = py::none(), py::arg("feedback") = std::string("fused"),
           py::arg("traction") = py::none(), py::arg("patches") = py::none(), py::arg("sensors") = py::none(),
-          py::arg("estimator") = py::none(), py::arg("motor") = py::none(), py::arg("traction_control") = py::none(),
-          py::arg("speed_governor") = py::none(), py::arg("hitch_control") = py::none(),
-          py::arg("profile") = py::none(), plant..., py::arg("keep_samples") = true, py::arg("trace") = false,
+          py::arg("estimator") = py::none(), py::arg("motor") = py::none(), py::arg("limits") = py::none(),
+          py::arg("traction_control") = py::none(), py::arg("speed_governor") = py::none(),
+          py::arg("hitch_control") = py::none(), py::arg("profile") = py::none(), plant...,
+          py::arg("keep_samples") = true, py::arg("trace") = false,
           R"doc(core::runEstimatedLoop: run() with an estimate in the loop, scored on the truth (as run_monitor).
 
 feedback: what the controllers are fed: "ground_truth" (then equal to run(), bit for bit), "odometry" (the
@@ -221,7 +224,8 @@ plant_sim's traction/ keys ({"mu_peak": 0.35, "draft_force": 10.0}). patches: so
 [{"polygon": [[x, y], ...], "mu_peak": 0.2, "mu_slide": 0.15, "rolling_resistance": 0.08}], a coefficient
 left out taking the traction block's. sensors: plant_sim's sensors/ keys ({"seed": 3, "fix": {"sigma":
 0.05}}); estimator: state_estimator's estimator/ keys ({"fix": {"gate": 0}}). The drive train (docs/drive_train.md):
-motor: plant_sim's motor/ keys ({"enabled": True}), traction_control: torque_controller's traction_control/ keys,
+motor: plant_sim's motor/ keys ({"enabled": True}), limits: kinematic_controller's limits/ keys (the outer loop's
+command bounded), traction_control: torque_controller's traction_control/ keys,
 speed_governor: reference_generator's speed_governor/ keys, hitch_control: torque_controller's hitch_control/ keys. profile: a profile's name ("field":
 config/profiles/field.yaml, what sim.launch profile:=field and benchmark --profile apply) or a file path, read as
 the benchmark reads it and applied on top of the blocks above (its keys win; its feedback replaces feedback=);
@@ -229,7 +233,7 @@ patches then take the traction in force. Other arguments as run()'s.
 Returns run()'s dict plus "feedback", "traction", "max_abs_slip", "tool_down_time", "fed_error_rms",
 "fed_error_max", "fed_heading_error_max" (the fed pose against the truth), "odometry_error_final",
 "odometry_error_max", "fixes" ({"applied", "reanchored", "slip_onsets", "gated", "too_old", "future",
-"invalid", "lost_from_queue"}), "profile" (its name, "" for none), "motor", "traction_control", "speed_governor", "hitch_control" (on
+"invalid", "lost_from_queue"}), "profile" (its name, "" for none), "motor", "limits", "traction_control", "speed_governor", "hitch_control" (on
 or off), "traction_control_time" (s a wheel slipped beyond the target), "governor_min_rate", "hitch_raises",
 "unsown_distance" (m of row the raised tool missed); with trace=True run()'s columns plus fed_x, fed_y, fed_theta, fed_v, fed_omega,
 slip_right, slip_left, tool_down. Raises ValueError for a bad name, key or value (naming the key).)doc");

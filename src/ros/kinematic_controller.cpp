@@ -16,7 +16,7 @@ KinematicController::KinematicController(ros::NodeHandle nh, ros::NodeHandle pnh
   requireValid(p, settings.validate());
   input_timeout_ = settings.input_timeout;
   limiter_ = std::make_unique<core::CommandLimiter>(settings.limits);  // validated above: does not throw
-  period_ = core::secondsFromNanos(run.periodNs());  // the in-process loop's dt, to the bit
+  period_ = core::secondsFromNanos(run.periodNs());                    // the in-process loop's dt, to the bit
   // Live gains of the controller in use (reconfigure_bridge.h; one server on the private namespace).
   if (settings.outer == core::OuterKind::kanayama) {
     auto kanayama = std::make_unique<core::OuterAdapter<core::Kanayama>>(core::Kanayama(settings.gains));
@@ -111,8 +111,8 @@ void KinematicController::compute() {
   ref.omega_dot = r.omega_dot;
   ref.tool_down = r.tool_down != 0;
   ref.stop = r.stop != 0;
-  const core::VelocityCommand cmd = limiter_->limit(
-      outer_->compute(ref, pose, odom.twist.twist.linear.x, odom.twist.twist.angular.z), period_);
+  const core::VelocityCommand cmd =
+      limiter_->limit(outer_->compute(ref, pose, odom.twist.twist.linear.x, odom.twist.twist.angular.z), period_);
   desired_.header.stamp = odom.header.stamp;
   desired_.v = cmd.v;
   desired_.omega = cmd.omega;

@@ -15,9 +15,9 @@ FIELD = os.path.join(os.path.dirname(os.path.dirname(HERE)), "config", "profiles
 WET = [{"polygon": [[1.0, 0.0], [5.0, 0.0], [5.0, 6.0], [1.0, 6.0]], "mu_peak": 0.25, "mu_slide": 0.2}]
 PLANT = dict(duration=4.0, disturbance=True, mass_scale=1.2, inertia_scale=1.2)
 # config/profiles/field.yaml spelled out by hand: a key added to the profile and not here fails the tests below
-FIELD_KEYS = dict(traction={"enabled": True}, motor={"enabled": True}, hitch_control={"enabled": True},
+FIELD_KEYS = dict(limits={"enabled": True}, traction={"enabled": True}, motor={"enabled": True}, hitch_control={"enabled": True},
                   traction_control={"enabled": True, "raise_rate": 10.0, "speed_floor": 0.3, "anti_windup": True,
-                                    "min_torque": 1.4},
+                                    "max_ground_accel": 1.0, "slip_target": 0.1, "min_torque": 1.4},
                   speed_governor={"enabled": True}, estimator={"slip": {"detect": True}})
 
 
@@ -27,8 +27,8 @@ def test_the_field_profile_is_its_keys_written_out():
     spelled = core.run_estimated(feedback="fused", patches=WET, **FIELD_KEYS, **PLANT)
     bare = core.run_estimated(feedback="ground_truth", traction=True, patches=WET, **PLANT)
     assert by_name["profile"] == "field" and bare["profile"] == ""
-    assert (by_name["feedback"], by_name["traction"], by_name["motor"], by_name["traction_control"],
-            by_name["speed_governor"], by_name["hitch_control"]) == ("fused", True, True, True, True, True)
+    assert (by_name["feedback"], by_name["traction"], by_name["motor"], by_name["limits"], by_name["traction_control"],
+            by_name["speed_governor"], by_name["hitch_control"]) == ("fused", True, True, True, True, True, True)
     assert bits(by_name["metrics"]) == bits(spelled["metrics"]) == bits(by_path["metrics"])
     assert bits(by_name["metrics"]) != bits(bare["metrics"])
     # the layers at work on the wet stretch, not only switched on

@@ -8,9 +8,9 @@
 // applied the fixes at another time gives other numbers (the printed differences say how far).
 // The drive train (issue 26) comes from the nodes' namespaces too: plant_sim's traction/ (+ field/patches) and
 // motor/, kinematic_controller's limits/, torque_controller's traction_control/, reference_generator's speed_governor/
-// (fused_field_lockstep.test:
-// sim.launch profile:=field on a wet stretch of the line). ~expect_drive_train: the in-process run must show the
-// traction control cutting and the governor slowing the target, so the comparison covers them at work.
+// (fused_field_lockstep.test: sim.launch profile:=field on a wet stretch of the line). ~expect_drive_train: the
+// in-process run must show the traction control cutting and the governor slowing the target, so the comparison
+// covers them at work.
 #include <gtest/gtest.h>
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
@@ -65,9 +65,8 @@ TEST(FusedLockstep, NodePipelineEqualsTheInProcessEstimatedLoop) {
   loadTable(torque, core::tractionControlTable(), cfg.traction_control);
   loadTable(torque, core::hitchControlTable(), cfg.hitch_control);  // inert here: no draft, no tool
   loadTable(reference, core::speedGovernorTable(), cfg.speed_governor);
-  ASSERT_EQ(core::firstError(
-                {plant.error(), estimator.error(), kinematic.error(), torque.error(), reference.error(), patch_error,
-                 cfg.validate()}),
+  ASSERT_EQ(core::firstError({plant.error(), estimator.error(), kinematic.error(), torque.error(), reference.error(),
+                              patch_error, cfg.validate()}),
             "");
   // The tool's draft needs the plan's rows and the URDF's tool point here too: not set up by this tester.
   ASSERT_EQ(traction.draft_force, 0.0) << "this tester compares runs without the tool's draft";

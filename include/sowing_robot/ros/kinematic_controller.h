@@ -40,8 +40,8 @@ class KinematicController {
   std::unique_ptr<core::OuterController> outer_;
   std::unique_ptr<core::CommandLimiter> limiter_;  // limits/ (passes the command unchanged when off)
   double period_ = 0.0;                            // [s] between two states: the limiter's dt (run/control_rate)
-  core::Kanayama* kanayama_ = nullptr;         // outer_'s Kanayama when outer is kanayama, else null
-  core::PurePursuit* pure_pursuit_ = nullptr;  // outer_'s (R)PP when outer is pure_pursuit or rpp, else null
+  core::Kanayama* kanayama_ = nullptr;             // outer_'s Kanayama when outer is kanayama, else null
+  core::PurePursuit* pure_pursuit_ = nullptr;      // outer_'s (R)PP when outer is pure_pursuit or rpp, else null
   ros::Subscriber odom_sub_, ref_sub_;
   ros::Publisher desired_pub_, error_pub_;
   bool grid_reported_ = false;  // a control_rate mismatch is reported once

@@ -13,12 +13,15 @@ const ParamTable<CommandLimitsParams>& commandLimitsTable() {
       flag("limits/enabled", &P::enabled, false,
            "bound the outer loop's velocity command (value and change per second) before the inner loop; false: "
            "the command passes unchanged"),
-      number("limits/max_v", &P::max_v, 1.5, Limits::positive(), "m/s", "bound on |v| of the command"),
-      number("limits/max_omega", &P::max_omega, 1.5, Limits::positive(), "rad/s", "bound on |omega| of the command"),
-      number("limits/max_acceleration", &P::max_acceleration, 1.0, Limits::positive(), "m/s^2",
-             "bound on how fast the commanded v changes"),
-      number("limits/max_angular_accel", &P::max_angular_accel, 2.0, Limits::positive(), "rad/s^2",
-             "bound on how fast the commanded omega changes"),
+      // The defaults are the field profile's (docs/drive_train.md, "Command limits": why these).
+      number("limits/max_v", &P::max_v, 2.0, Limits::positive(), "m/s",
+             "bound on |v| of the command (room to catch up a 1 m/s reference, below the motors' 2.9 m/s no-load rim "
+             "speed)"),
+      number("limits/max_omega", &P::max_omega, 3.0, Limits::positive(), "rad/s", "bound on |omega| of the command"),
+      number("limits/max_acceleration", &P::max_acceleration, 0.6, Limits::positive(), "m/s^2",
+             "bound on how fast the commanded v changes (about half what wet soil, mu 0.3, carries with the draft)"),
+      number("limits/max_angular_accel", &P::max_angular_accel, 6.0, Limits::positive(), "rad/s^2",
+             "bound on how fast the commanded omega changes (below ~3 Kanayama's field gains weave about the line)"),
   });
   return table;
 }

@@ -177,12 +177,18 @@ std::string describeRealism(const BenchScenario& b) {
   } else {
     out += "no slip";
   }
-  out += std::string("; motors ") +
-         (c.motor.enabled ? "on (current limit " + shortNumber(c.motor.current_limit) + " N·m, no-load " +
-                                shortNumber(c.motor.no_load_speed) + " rad/s)"
-                          : "off") +
-         ", traction control " + (c.traction_control.enabled ? "on" : "off") + ", speed governor " +
-         (c.speed_governor.enabled ? "on" : "off") + ", hitch control " + (c.hitch_control.enabled ? "on" : "off");
+  out +=
+      std::string("; motors ") +
+      (c.motor.enabled ? "on (current limit " + shortNumber(c.motor.current_limit) + " N·m, no-load " +
+                             shortNumber(c.motor.no_load_speed) + " rad/s)"
+                       : "off") +
+      ", command limits " +
+      (c.limits.enabled ? "on (v " + shortNumber(c.limits.max_v) + " m/s, " + shortNumber(c.limits.max_acceleration) +
+                              " m/s^2; omega " + shortNumber(c.limits.max_omega) + " rad/s, " +
+                              shortNumber(c.limits.max_angular_accel) + " rad/s^2)"
+                        : "off") +
+      ", traction control " + (c.traction_control.enabled ? "on" : "off") + ", speed governor " +
+      (c.speed_governor.enabled ? "on" : "off") + ", hitch control " + (c.hitch_control.enabled ? "on" : "off");
   out += "; feedback " + std::string(feedbackName(c.feedback)) +
          " (sensors: " + std::to_string(c.sensors.encoder.ticks_per_turn) + " ticks/turn, gyro noise " +
          shortNumber(c.sensors.imu.noise) + " rad/s bias " + shortNumber(c.sensors.imu.bias) + " rad/s, fix " +

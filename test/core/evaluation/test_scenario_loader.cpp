@@ -428,6 +428,37 @@ TEST(ScenarioLoader, TheHitchControlBlockIsRead) {
   }
 }
 
+// The command limits' block (kinematic_controller's limits/) in a scenario or a profile, through its table; the
+// field profile turns them on with the table's bounds.
+TEST(ScenarioLoader, TheCommandLimitsBlockIsRead) {
+  const BenchScenario wet = bench::loadScenario("wet_line", kSuite, kSource + "/config/profiles/field.yaml");
+  ASSERT_TRUE(wet.realism);
+  EXPECT_TRUE(wet.realism->limits.enabled);
+  EXPECT_EQ(wet.realism->limits.max_acceleration, core::CommandLimitsParams().max_acceleration);
+  EXPECT_FALSE(bench::loadScenario("wet_line", kSuite).realism->limits.enabled);
+  TempDir dir;
+  const std::string prof =
+      dir.write("p.yaml", "profile: {name: p}\nkinematic_controller: {limits: {enabled: true, max_v: 1.2}}\n");
+  const BenchScenario b = bench::loadScenario("thesis_line", kSuite, prof);  // a scenario without blocks
+  ASSERT_TRUE(b.realism);
+  EXPECT_TRUE(b.realism->limits.enabled);
+  EXPECT_EQ(b.realism->limits.max_v, 1.2);
+  for (const char* body : {"kinematic_controller: {limits: {max_v: 0}}", "kinematic_controller: {limits: {max_vv: 1}}",
+                           "kinematic_controller: {kx: 2.0}"}) {
+    const std::string bad = dir.write("bad.yaml", std::string("profile: {name: bad}\n") + body + "\n");
+    try {
+      bench::loadScenario("wet_line", kSuite, bad);
+      ADD_FAILURE() << "not refused: " << body;
+    } catch (const std::invalid_argument& e) {
+      const std::string what = e.what();
+      EXPECT_TRUE(what.find("limits/max_v") != std::string::npos ||
+                  what.find("kinematic_controller/kx") != std::string::npos)
+          << what;
+      EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+    }
+  }
+}
+
 // A speed governor that slows the path's own time: a robot at its slowed target, short of the path's
 // end when the run ends, has not finished (the finish check reads the reference's last time).
 TEST(ScenarioLoader, ARunWhoseGovernedTargetHasNotReachedTheEndIsNotFinished) {
