@@ -197,24 +197,24 @@ constexpr ProfileBlock kProfileBlocks[] = {{"kinematic_controller", "limits"},
 /// into the scenario's block of that name (the profile's value wins), profile/feedback over the feedback.
 void applyProfile(YAML::Node& root, const std::string& profile) {
   const YAML::Node prof = loadYaml(profile);
-  onlyKeys(
-      prof,
-      {"profile", "kinematic_controller", "plant_sim", "torque_controller", "reference_generator", "state_estimator"},
-      profile, "");
+  std::set<std::string> nodes;  // the nodes of kProfileBlocks
+  for (const ProfileBlock& b : kProfileBlocks) nodes.insert(b.node);
+  std::set<std::string> top = nodes;
+  top.insert("profile");
+  onlyKeys(prof, top, profile, "");
   const YAML::Node own = required(prof, "profile", profile, "");
   onlyKeys(own, {"name", "description", "feedback"}, profile, "profile/");
-  for (const char* node :
-       {"kinematic_controller", "plant_sim", "torque_controller", "reference_generator", "state_estimator"}) {
+  for (const std::string& node : nodes) {
     const YAML::Node blocks = prof[node];
     if (!blocks) continue;
     std::set<std::string> allowed;
     for (const ProfileBlock& b : kProfileBlocks)
-      if (std::string(b.node) == node) allowed.insert(b.block);
-    onlyKeys(blocks, allowed, profile, std::string(node) + "/");
+      if (b.node == node) allowed.insert(b.block);
+    onlyKeys(blocks, allowed, profile, node + "/");
     for (const std::string& block : allowed) {
       const YAML::Node from = blocks[block];
       if (!from) continue;
-      if (!from.IsMap()) fail(profile, std::string(node) + "/" + block + " must be a mapping");
+      if (!from.IsMap()) fail(profile, node + "/" + block + " must be a mapping");
       if (!root[block]) root[block] = YAML::Node(YAML::NodeType::Map);
       for (const auto& kv : from) root[block][kv.first.as<std::string>()] = YAML::Clone(kv.second);
     }
@@ -222,9 +222,12 @@ void applyProfile(YAML::Node& root, const std::string& profile) {
   if (own["feedback"]) root["feedback"] = YAML::Clone(own["feedback"]);
 }
 
-/// The blocks that put a scenario on the estimated loop (traction:, sensors:, estimator:, feedback:, motor:,
-/// limits:, traction_control:, speed_governor:, hitch_control:), each through the nodes' parameter table, onto
-/// `traction` and `cfg` (what they do not set stays).
+/// The blocks that put a scenario on the estimated loop: applyLoopBlocks reads each of them.
+constexpr const char* kLoopBlocks[] = {"traction", "sensors",          "estimator",      "feedback",     "motor",
+                                       "limits",   "traction_control", "speed_governor", "hitch_control"};
+
+/// The blocks of kLoopBlocks, each through the nodes' parameter table, onto `traction` and `cfg` (what they do not
+/// set stays).
 void applyLoopBlocks(const YAML::Node& root, const std::string& path, core::TractionParams& traction,
                      core::EstimatedRunConfig& cfg) {
   const YAML::Node sensors = root["sensors"], feedback = root["feedback"];
@@ -257,12 +260,11 @@ void applyLoopBlocks(const YAML::Node& root, const std::string& path, core::Trac
 core::BenchScenario loadScenarioFileImpl(const std::string& path, const std::string& profile) {
   YAML::Node root = loadYaml(path);
   if (!profile.empty()) applyProfile(root, profile);
-  onlyKeys(
-      root,
-      {"name",      "description", "track", "duration", "control_rate",     "start",          "line",         "sine",
-       "field",     "plant",       "draws", "success",  "envelope_period",  "requires",       "traction",     "sensors",
-       "estimator", "feedback",    "motor", "limits",   "traction_control", "speed_governor", "hitch_control"},
-      path, "");
+  std::set<std::string> known = {
+      "name", "description", "track", "duration", "control_rate", "start",           "line",
+      "sine", "field",       "plant", "draws",    "success",      "envelope_period", "requires"};
+  known.insert(std::begin(kLoopBlocks), std::end(kLoopBlocks));
+  onlyKeys(root, known, path, "");
   core::BenchScenario b;
   std::vector<PatchSpec> patch_specs;
   b.name = required(root, "name", path, "").as<std::string>();
@@ -359,13 +361,10 @@ core::BenchScenario loadScenarioFileImpl(const std::string& path, const std::str
   // what the controllers are fed (feedback:), each block through the nodes' parameter table with the nodes'
   // keys (traction/..., sensors/..., estimator/...), so a key, a range and an error read as plant_sim's and
   // state_estimator's. Any of them puts the scenario on the estimated loop (core/evaluation/estimated_bench.h).
-  // The drive train's layers (motor:, traction_control:, speed_governor:) likewise, through their tables.
-  const YAML::Node traction = root["traction"], sensors = root["sensors"], estimator = root["estimator"],
-                   feedback = root["feedback"], motor = root["motor"], traction_control = root["traction_control"],
-                   speed_governor = root["speed_governor"], hitch_control = root["hitch_control"],
-                   limits = root["limits"];
-  if (traction || sensors || estimator || feedback || motor || traction_control || speed_governor || hitch_control ||
-      limits) {
+  // The drive train's layers (motor:, limits:, traction_control:, speed_governor:, hitch_control:) likewise,
+  // through their tables: any block of kLoopBlocks.
+  if (std::any_of(std::begin(kLoopBlocks), std::end(kLoopBlocks),
+                  [&root](const char* block) { return static_cast<bool>(root[block]); })) {
     core::EstimatedRunConfig cfg;
     core::TractionParams t;
     applyLoopBlocks(root, path, t, cfg);
