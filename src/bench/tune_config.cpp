@@ -13,7 +13,7 @@
 #include "sowing_robot/bench/scenario_loader.h"
 #include "sowing_robot/bench/yaml_reading.h"
 #include "sowing_robot/core/common/validation.h"
-#include "sowing_robot/core/control/controllers.h"
+#include "sowing_robot/core/control/controller_factory.h"
 #include "sowing_robot/core/model/plant.h"
 #include "sowing_robot/core/settings/node_settings.h"
 

@@ -1,7 +1,6 @@
 #include "sowing_robot/ros/kinematic_controller.h"
 
 #include "sowing_robot/core/common/validation.h"
-#include "sowing_robot/core/simulation/runner.h"
 #include "sowing_robot/ros/common/component_params.h"
 #include "sowing_robot/ros/common/msg_checks.h"
 #include "sowing_robot/ros/common/reconfigure_bridge.h"
@@ -17,21 +16,18 @@ KinematicController::KinematicController(ros::NodeHandle nh, ros::NodeHandle pnh
   input_timeout_ = settings.input_timeout;
   limiter_ = std::make_unique<core::CommandLimiter>(settings.limits);  // validated above: does not throw
   period_ = core::secondsFromNanos(run.periodNs());                    // the in-process loop's dt, to the bit
-  // Live gains of the controller in use (reconfigure_bridge.h; one server on the private namespace).
-  if (settings.outer == core::OuterKind::kanayama) {
-    auto kanayama = std::make_unique<core::OuterAdapter<core::Kanayama>>(core::Kanayama(settings.gains));
+  // The factory builds the controller; the live gains (reconfigure_bridge.h; one server on the private
+  // namespace) are served for the controllers that have a .cfg.
+  outer_ = core::makeOuterController(settings.controllers());  // validated above: does not throw
+  if (auto* kanayama = dynamic_cast<core::OuterAdapter<core::Kanayama>*>(outer_.get())) {
     kanayama_ = &kanayama->controller();
-    outer_ = std::move(kanayama);
     kanayama_reconfigure_ =
         startReconfigure<KinematicControllerConfig>(pnh, core::kanayamaTable(), settings.gains, [this](auto& c) {
           applyReconfigure("kinematic_controller", core::kanayamaTable(), kanayama_->gains(), c,
                            [this](const core::KanayamaGains& g) { kanayama_->setGains(g); });
         });
-  } else {  // validated above, so the constructor does not throw
-    auto pp = std::make_unique<core::OuterAdapter<core::PurePursuit>>(
-        core::PurePursuit(settings.pure_pursuit, settings.outer == core::OuterKind::rpp));
+  } else if (auto* pp = dynamic_cast<core::OuterAdapter<core::PurePursuit>*>(outer_.get())) {
     pure_pursuit_ = &pp->controller();
-    outer_ = std::move(pp);
     pure_pursuit_reconfigure_ =
         startReconfigure<PurePursuitConfig>(pnh, core::purePursuitTable(), settings.pure_pursuit, [this](auto& c) {
           applyReconfigure("kinematic_controller", core::purePursuitTable(), pure_pursuit_->params(), c,

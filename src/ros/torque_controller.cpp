@@ -28,18 +28,14 @@ TorqueController::TorqueController(ros::NodeHandle nh, ros::NodeHandle pnh) {
   input_timeout_ = settings.input_timeout;
   lockstep_ = run.lockstep;  // lockstep: wait for the paired desired velocity, never time out
   dt_ = core::secondsFromNanos(run.periodNs());
-  // Validated above, so the constructors do not throw.
-  if (settings.inner == core::InnerKind::pid) {
-    auto pid = std::make_unique<core::InnerAdapter<core::WheelPid>>(core::WheelPid(settings.pid, robot));
-    pid_ = &pid->controller();
-    inner_ = std::move(pid);
-  } else {
-    auto smc =
-        std::make_unique<core::InnerAdapter<core::SlidingModeController>>(core::SlidingModeController(params, robot));
+  // Validated above, so the factory does not throw.
+  inner_ = core::makeInnerController(settings.controllers(), robot);
+  if (auto* smc = dynamic_cast<core::InnerAdapter<core::SlidingModeController>*>(inner_.get()))
     smc_ = &smc->controller();
-    inner_ = std::move(smc);
-  }
+  else if (auto* pid = dynamic_cast<core::InnerAdapter<core::WheelPid>*>(inner_.get()))
+    pid_ = &pid->controller();
   // The brake at a stop (validated above), at the motor's limit.
+  hold_max_torque_ = params.max_torque;
   hold_ = std::make_unique<core::StandstillHold>(settings.hold, robot, params.max_torque);
   logSettings("torque_controller", core::TorqueControllerSettings::table(), settings);
   logSettings("torque_controller", core::tractionControlTable(), traction);
@@ -55,13 +51,14 @@ TorqueController::TorqueController(ros::NodeHandle nh, ros::NodeHandle pnh) {
   ROS_INFO("torque_controller: inner controller %s; m0_hat starts at %.4f kg, I0_hat at %.5f kg m^2; %.0f Hz",
            settings.innerName().c_str(), inner_->m0Hat(), inner_->i0Hat(), 1.0 / dt_);
   state_.mode = settings.innerName();
-  // Live gains of the controller in use (one server: both would be on the node's private namespace).
+  // Live gains of the controller in use, for the controllers that have a .cfg (one server: both would be
+  // on the node's private namespace).
   if (smc_) {
     smc_reconfigure_ = startReconfigure<TorqueControllerConfig>(pnh, core::slidingModeTable(), params, [this](auto& c) {
       applyReconfigure("torque_controller", core::slidingModeTable(), smc_->params(), c,
                        [this](const core::SlidingModeParams& p) { smc_->setParams(p); });
     });
-  } else {
+  } else if (pid_) {
     pid_reconfigure_ = startReconfigure<WheelPidConfig>(pnh, core::wheelPidTable(), settings.pid, [this](auto& c) {
       applyReconfigure("torque_controller", core::wheelPidTable(), pid_->params(), c,
                        [this](const core::WheelPidParams& p) { pid_->setParams(p); });
@@ -192,7 +189,10 @@ void TorqueController::compute() {
   publishShared(torque_pub_, torque_);
   if (out.saturated)
     ROS_WARN_THROTTLE(2.0, "torque_controller: wheel torque saturated at %.4g N m (%ld periods so far)",
-                      smc_ ? smc_->params().max_torque : pid_->params().max_torque, ++saturated_);
+                      smc_   ? smc_->params().max_torque
+                      : pid_ ? pid_->params().max_torque
+                             : hold_max_torque_,
+                      ++saturated_);
 
   state_.header.stamp = odom.header.stamp;
   state_.e_v = out.e_v;

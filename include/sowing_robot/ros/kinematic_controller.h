@@ -18,7 +18,7 @@
 #include "sowing_robot/ReferenceState.h"
 #include "sowing_robot/TrackingError.h"
 #include "sowing_robot/core/control/command_limits.h"
-#include "sowing_robot/core/control/controllers.h"
+#include "sowing_robot/core/control/controller_factory.h"
 #include "sowing_robot/core/control/kanayama.h"
 #include "sowing_robot/core/control/pure_pursuit.h"
 #include "sowing_robot/ros/common/ready_roster.h"

@@ -35,7 +35,7 @@
 #include "sowing_robot/TractionControlState.h"
 #include "sowing_robot/WheelPidConfig.h"
 #include "sowing_robot/WheelTorque.h"
-#include "sowing_robot/core/control/controllers.h"
+#include "sowing_robot/core/control/controller_factory.h"
 #include "sowing_robot/core/control/hitch_control.h"
 #include "sowing_robot/core/control/sliding_mode.h"
 #include "sowing_robot/core/control/standstill_hold.h"
@@ -69,6 +69,7 @@ class TorqueController {
   std::unique_ptr<core::InnerController> inner_;
   core::SlidingModeController* smc_ = nullptr;  // inner_'s sliding-mode controller (live gains), else null
   core::WheelPid* pid_ = nullptr;               // inner_'s PID, else null
+  double hold_max_torque_ = 0.0;                // max_torque: the motors' limit, whichever controller runs
   std::unique_ptr<core::StandstillHold> hold_;  // the brake at a stop (desired_velocity's hold)
   bool holding_ = false;                        // the last period was a hold
   double dt_ = 0.001;

@@ -76,12 +76,9 @@ namespace {
 
 const char* const kKinematicNode = "kinematic_controller";
 const char* const kTorqueNode = "torque_controller";
-// The baselines' parameters sit flat under their node, beside Kanayama's and the sliding-mode
-// controller's (the nodes' keys: kinematic_controller/lookahead_dist, torque_controller/kp), so a gains
-// YAML loads into the nodes as it is (sim.launch gains:=). No key of one table is in the other's, except
-// max_torque: the motor's one limit, which sets both (as in the torque_controller node).
-const char* const kPurePursuitPrefix = "";
-const char* const kPidPrefix = "";
+// Every controller's parameters sit flat under its node (the nodes' keys: kinematic_controller/lookahead_dist,
+// torque_controller/kp), so a gains YAML loads into the nodes as it is (sim.launch gains:=). No key of one
+// table is in another's of the same slot, except max_torque: the motor's one limit, which sets both.
 
 /// A tunable gain of the scenario's pair: its table entry, node, key prefix and the struct it sets.
 struct GainRef {
@@ -92,41 +89,19 @@ struct GainRef {
   std::function<double(const Scenario&)> get;
 };
 
-/// Whether a `tunable` mark acts in this pair (the rates only adapt in ATSMC; the min radius only
-/// regulates in RPP).
-bool actsInPair(const Scenario& sc, const std::string& key) {
-  if (key == "rate_m" || key == "rate_i") return sc.inner == InnerKind::sliding_mode && sc.sliding.adaptive;
-  if (key == "regulated_linear_scaling_min_radius") return sc.outer == OuterKind::rpp;
-  return true;
-}
-
-template <typename S>
-void collect(const ParamTable<S>& table, S Scenario::*member, const char* node, const char* prefix, const Scenario& sc,
-             std::vector<GainRef>& out) {
-  for (const auto& e : table.entries()) {
-    if (!e.info.tunable || !actsInPair(sc, e.info.key)) continue;
-    GainRef g;
-    g.info = &e.info;
-    g.node = node;
-    g.prefix = prefix;
-    const ParamEntry<S>* entry = &e;  // the tables are static: the pointer outlives the scenario
-    g.set = [entry, member](Scenario& s, double v) { entry->set(s.*member, v); };
-    g.get = [entry, member](const Scenario& s) { return std::get<double>(entry->get(s.*member)); };
-    out.push_back(std::move(g));
-  }
-}
-
-/// Every tunable gain of the scenario's pair, outer's then inner's, in table order.
+/// Every tunable gain of the scenario's pair that acts in it (controller_factory.h), outer's then inner's,
+/// in table order.
 std::vector<GainRef> pairGains(const Scenario& sc) {
   std::vector<GainRef> out;
-  if (sc.outer == OuterKind::kanayama)
-    collect(kanayamaTable(), &Scenario::kanayama, kKinematicNode, "", sc, out);
-  else
-    collect(purePursuitTable(), &Scenario::pure_pursuit, kKinematicNode, kPurePursuitPrefix, sc, out);
-  if (sc.inner == InnerKind::sliding_mode)
-    collect(slidingModeTable(), &Scenario::sliding, kTorqueNode, "", sc, out);
-  else
-    collect(wheelPidTable(), &Scenario::pid, kTorqueNode, kPidPrefix, sc, out);
+  for (const ControllerParam& p : chosenControllerParams(sc)) {
+    if (!p.info->tunable || !p.acts(sc, p.info->key)) continue;
+    GainRef g;
+    g.info = p.info;
+    g.node = p.slot == ControllerParam::Slot::outer ? kKinematicNode : kTorqueNode;
+    g.set = [set = p.set](Scenario& s, double v) { set(s, v); };
+    g.get = [get = p.get](const Scenario& s) { return std::get<double>(get(s)); };
+    out.push_back(std::move(g));
+  }
   return out;
 }
 
@@ -169,21 +144,6 @@ const std::vector<GainBounds>& searchBoundsList() {
 }
 
 /// Set one entry of `table` (in `params`) from a key and a value: "" or the reason.
-template <typename S>
-std::string setEntry(const ParamTable<S>& table, S& params, const std::string& node, const std::string& key,
-                     const ParamValue& value) {
-  const ParamEntry<S>* e = table.find(key);
-  if (!e) return node + "/" + key + " is no controller parameter";
-  ParamValue v = value;
-  // An integer where the table wants a double (YAML "2" for 2.0) is that double.
-  if (std::holds_alternative<int>(v) && std::holds_alternative<double>(e->info.default_value))
-    v = static_cast<double>(std::get<int>(v));
-  const std::string error = e->info.check(v, node + "/");
-  if (!error.empty()) return error;
-  e->set(params, v);
-  return "";
-}
-
 }  // namespace
 
 std::vector<std::string> tunableGainNames(const Scenario& sc) {
@@ -220,19 +180,27 @@ double getGain(const Scenario& sc, const std::string& name) {
 }
 
 std::string setControllerParam(Scenario& sc, const std::string& node, const std::string& key, const ParamValue& value) {
-  if (node == kKinematicNode) {
-    if (kanayamaTable().find(key)) return setEntry(kanayamaTable(), sc.kanayama, node, key, value);
-    return setEntry(purePursuitTable(), sc.pure_pursuit, node, key, value);
+  ControllerParam::Slot slot;
+  if (node == kKinematicNode)
+    slot = ControllerParam::Slot::outer;
+  else if (node == kTorqueNode)
+    slot = ControllerParam::Slot::inner;
+  else
+    return "unknown controller node '" + node + "' (kinematic_controller, torque_controller)";
+  // Every table of the slot that has the key: max_torque, the motors' one limit, is in both inner tables.
+  bool found = false;
+  for (const ControllerParam& p : slotParams(slot)) {
+    if (p.info->key != key) continue;
+    ParamValue v = value;
+    // An integer where the table wants a double (YAML "2" for 2.0) is that double.
+    if (std::holds_alternative<int>(v) && std::holds_alternative<double>(p.info->default_value))
+      v = static_cast<double>(std::get<int>(v));
+    const std::string error = p.info->check(v, node + "/");
+    if (!error.empty()) return error;
+    p.set(sc, v);
+    found = true;
   }
-  if (node == kTorqueNode) {
-    if (key == "max_torque") {
-      const std::string e = setEntry(slidingModeTable(), sc.sliding, node, key, value);
-      return e.empty() ? setEntry(wheelPidTable(), sc.pid, node, key, value) : e;
-    }
-    if (slidingModeTable().find(key)) return setEntry(slidingModeTable(), sc.sliding, node, key, value);
-    return setEntry(wheelPidTable(), sc.pid, node, key, value);
-  }
-  return "unknown controller node '" + node + "' (kinematic_controller, torque_controller)";
+  return found ? "" : node + "/" + key + " is no controller parameter";
 }
 
 GainBounds gainSearchBounds(const std::string& name) {

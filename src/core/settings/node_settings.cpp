@@ -121,8 +121,7 @@ const ParamTable<KinematicControllerSettings>& KinematicControllerSettings::tabl
   using S = KinematicControllerSettings;
   static const ParamTable<S> table = [] {
     ParamTable<S> t({
-        choice("outer", &S::outer, OuterKind::kanayama,
-               {{"kanayama", OuterKind::kanayama}, {"pure_pursuit", OuterKind::pure_pursuit}, {"rpp", OuterKind::rpp}},
+        choice("outer", &S::outer, OuterKind::kanayama, outerChoices(),
                "the outer controller: Kanayama (eqs 4.1-4.2), pure pursuit, or nav2's Regulated Pure Pursuit; "
                "the parameters of the others are checked but inert"),
         number("input_timeout", &S::input_timeout, 0.05, Limits::positive(), "s",
@@ -141,6 +140,14 @@ const ParamTable<KinematicControllerSettings>& KinematicControllerSettings::tabl
 
 KinematicControllerSettings::KinematicControllerSettings() { table().applyDefaults(*this); }
 
+ControllerPair KinematicControllerSettings::controllers() const {
+  ControllerPair pair;
+  pair.outer = outer;
+  pair.kanayama = gains;
+  pair.pure_pursuit = pure_pursuit;
+  return pair;
+}
+
 std::string KinematicControllerSettings::validate() const {
   return firstError({table().checkRanges(*this), pure_pursuit.validate(), limits.validate()});
 }
@@ -149,8 +156,7 @@ const ParamTable<TorqueControllerSettings>& TorqueControllerSettings::table() {
   using S = TorqueControllerSettings;
   static const ParamTable<S> table = [] {
     ParamTable<S> t({
-        choice("inner", &S::inner, InnerKind::sliding_mode,
-               {{"sliding_mode", InnerKind::sliding_mode}, {"pid", InnerKind::pid}},
+        choice("inner", &S::inner, InnerKind::sliding_mode, innerChoices(),
                "the inner controller: the sliding-mode controller (atsmc or tsmc by `mode`) or the wheel-velocity "
                "PID; the parameters of the other are checked but inert"),
         number("input_timeout", &S::input_timeout, 0.1, Limits::positive(), "s",
@@ -179,6 +185,14 @@ const ParamTable<TorqueControllerSettings>& TorqueControllerSettings::table() {
 }
 
 TorqueControllerSettings::TorqueControllerSettings() { table().applyDefaults(*this); }
+
+ControllerPair TorqueControllerSettings::controllers() const {
+  ControllerPair pair;
+  pair.inner = inner;
+  pair.sliding = sliding;
+  pair.pid = pid;
+  return pair;
+}
 
 std::string TorqueControllerSettings::validate() const {
   return firstError({table().checkRanges(*this), sliding.validate(), pid.validate(), hold.validate()});

@@ -12,13 +12,8 @@ constexpr double kUnknown = 1e6;  // covariance of what a planar sensor does not
 
 PlantSensors::PlantSensors(ros::NodeHandle nh, const core::SensorParams& params, const core::RobotParams& nominal,
                            const core::State& initial, const std::string& odom_frame, const std::string& base_frame)
-    : params_(params), encoders_(params, nominal.R, nominal.L), gyro_(params), fix_(params) {
-  encoders_.reset({initial[core::X], initial[core::Y], initial[core::THETA]}, initial[core::PHI_R],
-                  initial[core::PHI_L]);
-  gyro_.reset();
-  fix_.reset(0.0);
-  fix_.sample(0.0, {initial[core::X], initial[core::Y], initial[core::THETA]});
-  yaw_rate_ = gyro_.measure(initial[core::OMEGA]);
+    : params_(params), sensors_(params, nominal) {
+  sensors_.start(initial);
 
   odom_pub_ = nh.advertise<nav_msgs::Odometry>("odom", kLockstepQueue);
   imu_pub_ = nh.advertise<sensor_msgs::Imu>("imu", kLockstepQueue);
@@ -30,7 +25,7 @@ PlantSensors::PlantSensors(ros::NodeHandle nh, const core::SensorParams& params,
   odom_msg_.pose.covariance[14] = odom_msg_.pose.covariance[21] = odom_msg_.pose.covariance[28] = kUnknown;
   // Twist: one increment's quantisation and jitter over the velocity window.
   const double window = std::max(params.encoder.velocity_window, 1e-3);
-  const double var_v = encoders_.incrementVariance() / (window * window);
+  const double var_v = sensors_.encoders().incrementVariance() / (window * window);
   odom_msg_.twist.covariance[0] = 0.5 * var_v;
   odom_msg_.twist.covariance[35] = 2.0 * var_v / (4.0 * nominal.L * nominal.L);
   odom_msg_.twist.covariance[7] = odom_msg_.twist.covariance[14] = kUnknown;
@@ -54,13 +49,11 @@ PlantSensors::PlantSensors(ros::NodeHandle nh, const core::SensorParams& params,
 
 void PlantSensors::update(double t, const core::State& s, double dt) {
   time_ = t;
-  encoders_.update(s[core::PHI_R], s[core::PHI_L], dt);
-  yaw_rate_ = gyro_.measure(s[core::OMEGA]);
-  fix_.sample(t, {s[core::X], s[core::Y], s[core::THETA]});
+  sensors_.update(t, s, dt);
 }
 
 void PlantSensors::publish(const ros::Time& stamp) {
-  const core::Odometry2D& o = encoders_.last();
+  const core::Odometry2D& o = sensors_.odometry();
   odom_msg_.header.stamp = stamp;
   odom_msg_.pose.pose.position.x = o.pose.x;
   odom_msg_.pose.pose.position.y = o.pose.y;
@@ -73,10 +66,10 @@ void PlantSensors::publish(const ros::Time& stamp) {
   publishShared(odom_pub_, odom_msg_);
 
   imu_msg_.header.stamp = stamp;
-  imu_msg_.angular_velocity.z = yaw_rate_;
+  imu_msg_.angular_velocity.z = sensors_.yawRate();
   publishShared(imu_pub_, imu_msg_);
 
-  for (const core::FixMeasurement& m : fix_.due(stamp.toSec())) {
+  for (const core::FixMeasurement& m : sensors_.dueFixes(stamp.toSec())) {
     fix_msg_.header.stamp.fromNSec(static_cast<std::uint64_t>(std::llround(m.stamp * 1e9)));
     fix_msg_.pose.pose.position.x = m.xy.x();
     fix_msg_.pose.pose.position.y = m.xy.y();

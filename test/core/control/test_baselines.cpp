@@ -116,7 +116,7 @@ TEST(Baselines, TheRunTimeInterfacesGiveTheTemplatedLoopsNumbers) {
     LineReference ref;
     const RunResult fast = runClosedLoop(sc, ref, false);
     auto outer = makeOuterController(sc);
-    auto inner = makeInnerController(sc);
+    auto inner = makeInnerController(sc, sc.robot);
     const RunResult generic = runClosedLoop(sc, ref, *outer, *inner, false);
     EXPECT_EQ(fast.final_state, generic.final_state) << pair;
     for (int k = 0; k < AXIS_COUNT; ++k) EXPECT_EQ(fast.metrics[k].itae, generic.metrics[k].itae) << pair;

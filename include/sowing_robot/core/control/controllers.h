@@ -1,4 +1,4 @@
-// The two controller slots of the cascade and what fills them (issue 17):
+// The two controller slots of the cascade and what fills them:
 //   outer (kinematic): reference + measured pose, v, omega -> VelocityCommand (v, omega, v_dot, omega_dot)
 //     kanayama | pure_pursuit | rpp
 //   inner (torque): desired VelocityCommand + measured v, omega + dt -> wheel torques (clipping reported)
@@ -6,8 +6,9 @@
 // A pair is named "outer+inner", e.g. "kanayama+atsmc", "rpp+pid".
 //
 // OuterController / InnerController are the run-time interfaces (virtual) for code that picks a
-// controller by name; OuterAdapter / InnerAdapter wrap the concrete classes. runClosedLoop does not go
-// through them: it is a template over the concrete types, so the hot loop has no virtual call.
+// controller by name; OuterAdapter / InnerAdapter wrap the concrete classes. Which controllers exist,
+// their names and how each is built: controller_factory.h. The in-process loop does not go through the
+// interfaces for the controllers the factory hands it as concrete types, so its hot loop has no virtual call.
 #pragma once
 
 #include <string>
@@ -21,17 +22,6 @@
 
 namespace sowing_robot {
 namespace core {
-
-enum class OuterKind { kanayama, pure_pursuit, rpp };
-enum class InnerKind { sliding_mode, pid };  ///< sliding_mode: atsmc or tsmc by SlidingModeParams::adaptive
-
-/// "kanayama", "pure_pursuit", "rpp".
-const char* outerName(OuterKind k);
-/// "atsmc", "tsmc" (sliding_mode by `adaptive`), "pid".
-const char* innerName(InnerKind k, bool adaptive);
-/// Parse "outer+inner". On success sets outer, inner and adaptive (untouched for pid) and returns "";
-/// otherwise one line naming what is wrong and the allowed names.
-std::string parseControllerPair(const std::string& name, OuterKind& outer, InnerKind& inner, bool& adaptive);
 
 /// The inner loop's output record, common to every inner controller: fields a controller has no
 /// equivalent of stay 0 (the PID has no sliding variables s_v, s_omega; its u1 = u_r + u_l and

@@ -11,7 +11,7 @@
 #include "sowing_robot/core/common/param_table.h"
 #include "sowing_robot/core/common/types.h"
 #include "sowing_robot/core/control/command_limits.h"
-#include "sowing_robot/core/control/controllers.h"
+#include "sowing_robot/core/control/controller_factory.h"
 #include "sowing_robot/core/control/kanayama.h"
 #include "sowing_robot/core/control/sliding_mode.h"
 #include "sowing_robot/core/control/standstill_hold.h"
@@ -65,6 +65,8 @@ struct KinematicControllerSettings {
   CommandLimitsParams limits;  ///< limits/: bounds on the command handed on (whichever controller runs)
   /// Ranges (the table), then the pure pursuit's min <= L <= max (checked even when not selected).
   std::string validate() const;
+  /// The outer slot's choice and parameters, for the controller factory (the inner slot's defaults).
+  ControllerPair controllers() const;
   static const ParamTable<KinematicControllerSettings>& table();
 };
 
@@ -82,6 +84,8 @@ struct TorqueControllerSettings {
   std::string validate() const;
   /// "atsmc", "tsmc" or "pid": the pair's inner name.
   std::string innerName() const { return core::innerName(inner, sliding.adaptive); }
+  /// The inner slot's choice and parameters, for the controller factory (the outer slot's defaults).
+  ControllerPair controllers() const;
   static const ParamTable<TorqueControllerSettings>& table();
 };
 

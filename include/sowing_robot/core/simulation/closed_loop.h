@@ -3,7 +3,8 @@
 // the in-process runs and the nodes give the same numbers. Every in-process run goes through it:
 // runClosedLoop (runner.h: the no-slip plant, fed its own state), runEstimatedLoop (estimated_run.h:
 // either plant, fed the state, the encoders or the EKF), and through them the benchmark, the tuner, the
-// field runs and the Python module.
+// field runs and the Python module. Its types are loop_types.h's, its feedback sources sensor_feeds.h's;
+// it includes none of its callers.
 //
 // Period k, t_k = k * period (secondsFromNanos, as ros::Time::toSec):
 //   1. the state; a non-finite one ends the run as diverged;
@@ -23,7 +24,7 @@
 //
 // The parts are template parameters, so the per-period calls are direct:
 //   Plant: NoSlipPlant or SlipPlant (below); Feed: StateFeed (the plant's state, no sensors) or the
-//   sensors with the fed pose chosen at run time (estimated_run.cpp's SensorFeed); Outer/Inner: the concrete
+//   sensors with the fed pose chosen at run time (SensorFeed; both in sensor_feeds.h); Outer/Inner: the concrete
 //   controllers or the run-time interfaces of controllers.h; Trace: an empty std::function, a std::function of
 //   LoopSample or EstimatedSample, or a RunTally (its add() inlined, and what it does not read never built).
 #pragma once
@@ -41,8 +42,8 @@
 #include "sowing_robot/core/model/traction.h"
 #include "sowing_robot/core/planning/speed_governor.h"
 #include "sowing_robot/core/planning/tool_engagement.h"
-#include "sowing_robot/core/simulation/estimated_run.h"
-#include "sowing_robot/core/simulation/runner.h"
+#include "sowing_robot/core/simulation/loop_types.h"
+#include "sowing_robot/core/simulation/sensor_feeds.h"
 
 namespace sowing_robot {
 namespace core {
@@ -75,23 +76,6 @@ struct SlipPlant {
   double wheelSpeed(Wheel w) const { return R * plant.wheelRate(w); }
   void setToolDown(bool down) { plant.setToolDown(down); }
   double R;  ///< the plant's wheel radius [m]
-};
-
-/// What the controllers are fed in one period.
-struct Fed {
-  Pose2D pose;  ///< yaw through the quaternion round trip
-  double v, omega;
-  WheelGroundSpeeds speeds;  ///< what the traction control measures: the wheels' R W, the ground twist
-};
-
-/// Feedback: the plant's own state (perfect sensing: the wheels' true speeds too; no sensors run).
-struct StateFeed {
-  void start(const State&) {}
-  Fed observe(double, const State& s, const Pose2D& truth, double wheel_right, double wheel_left) {
-    return {truth, s[V], s[OMEGA], {wheel_right, wheel_left, s[V], s[OMEGA]}};
-  }
-  void afterStep(std::int64_t, const State&) {}
-  void finish(EstimatedRunResult&) const {}
 };
 
 /// The tool rule of the traction plant with a draft (tool_engagement.h), on the true tool point.
@@ -167,7 +151,7 @@ EstimatedRunResult closedLoop(const Scenario& sc, PlantT& plant, Feed& feed, Out
   metrics.reserve(static_cast<std::size_t>(n + 1));
   EstimatedRunResult out;
   RunResult& result = out.run;
-  StandstillHold hold(sc.hold, sc.robot, sc.inner == InnerKind::pid ? sc.pid.max_torque : sc.sliding.max_torque);
+  StandstillHold hold(sc.hold, sc.robot, sc.innerMaxTorque());
   bool holding = false;
 
   std::int64_t last = n;  // the last period: n, or later by the time a governor took back (governed_time_back)

@@ -1,5 +1,6 @@
-// plant_sim's sensors (issue 16, item 3): the core's seeded sensors (core/model/sensors.h) fed with the
-// plant's true state, and their messages. Topics (relative, contract16.md):
+// plant_sim's sensors: the core's sensor suite (core/simulation/sensor_feeds.h: the seeded sensors of
+// core/model/sensors.h, read on the plant's true state exactly as the in-process loop reads them), and their
+// messages. Topics (relative, contract16.md):
 //   odom  nav_msgs/Odometry                    encoder dead reckoning (nominal R, L), every step; its
 //                                              pose covariance grows; odom -> base_link tf from it
 //   imu   sensor_msgs/Imu                      yaw rate (omega + bias + noise), every step
@@ -21,6 +22,7 @@
 #include "sowing_robot/core/model/plant.h"
 #include "sowing_robot/core/model/robot_params.h"
 #include "sowing_robot/core/model/sensors.h"
+#include "sowing_robot/core/simulation/sensor_feeds.h"
 
 namespace sowing_robot {
 
@@ -43,11 +45,8 @@ class PlantSensors {
 
  private:
   core::SensorParams params_;
-  core::EncoderOdometry encoders_;
-  core::YawRateSensor gyro_;
-  core::PositionFixSensor fix_;
+  core::SensorSuite sensors_;
   double time_ = 0.0;
-  double yaw_rate_ = 0.0;  // the gyro's last reading
   ros::Publisher odom_pub_, imu_pub_, fix_pub_;
   nav_msgs::Odometry odom_msg_;
   sensor_msgs::Imu imu_msg_;
