@@ -1,4 +1,4 @@
-"""Figures and the comparison table of a `benchmark` output directory (issue 17, items 3 and 6).
+"""Figures and the comparison table of a `benchmark` output directory.
 
 Reads DIR/runs.csv (one row per run) and DIR/envelopes.csv (per scenario, controller and time: quantiles
 of the cross-track error over the runs, computed by the C++ benchmark from each run's cross-track sampled

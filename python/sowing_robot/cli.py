@@ -1,4 +1,4 @@
-"""--help and unknown options for the package's Python commands (issue 27 item 5), as for the C++ ones
+"""--help and unknown options for the package's Python commands, as for the C++ ones
 (include/sowing_robot/cli/usage.h) and the bash ones (scripts/lib/cli.bash):
 
   --help / -h    the command's usage: its docstring (the description) and argparse's options, exit 0

@@ -1,4 +1,4 @@
-# --help and unknown options for the package's bash commands (issue 27 item 5); sourced, not run.
+# --help and unknown options for the package's bash commands, alike for every command; sourced, not run.
 # A command's usage is its header comment (line 2 up to the first line that is not a comment): --help / -h
 # prints it to stdout and exits 0 before any work; an unknown option is one line on stderr and exit 2.
 # The command sets ROOT (the repo) before sourcing this file.

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Velocity mode (sim.launch input:=cmd_vel) in lockstep, for the rostests and the tracking figures of
-docs/interfaces.md: a schedule of stamped twists, the driver that publishes it on cmd_vel_stamped and
+results/cmd_vel.md: a schedule of stamped twists, the driver that publishes it on cmd_vel_stamped and
 records what the loop did, and the figures of a step.
 
 As a module: SCHEDULES, bad_twists(), Driver (publish + record, inside a rospy node), reach_time(),
@@ -43,7 +43,7 @@ STEP_AT = 0.5        # [s] when the step starts, in both schedules
 FLIP_AT = 3.0        # [s] reverse: astern -> ahead
 LAST_TELEOP = 3.9    # [s] step: the last twist of the teleop
 STEP = (0.3, 0.2)    # [m/s], [rad/s]
-BAND = 0.05          # settled: within 5 % of the step (the ATSMC leaves ~2 % on omega, docs/interfaces.md)
+BAND = 0.05          # settled: within 5 % of the step (the ATSMC leaves ~2 % on omega, docs/cmd_vel.md)
 
 
 def bad_twists():

@@ -4,7 +4,7 @@ the same step schedule (cmd_vel_drive.py); the second run also gets twists that 
 infinite v, omega or linear.y, |v| or |omega| beyond the limits, a NaN after the last good twist, which
 must not keep that command fresh, and a plain Twist, which lockstep ignores). The two runs must record
 the same ground_truth and desired_velocity, bit for bit, and the second must warn about the drops.
-Verified to fail with the feature broken: docs/interfaces.md, "Tests"."""
+Verified to fail with the feature broken: docs/cmd_vel.md, "Tests"."""
 import os
 import subprocess
 import tempfile

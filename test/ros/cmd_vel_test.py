@@ -12,7 +12,7 @@ Both: every bound (value, acceleration, jerk) holds throughout, in both directio
 handed to the inner loop are the derivatives of the velocities.
 
 The tracking figures (rise, settling, overshoot, steady error) are printed on one line each, for
-docs/interfaces.md. Verified to fail with the feature broken: see docs/interfaces.md, "Tests".
+results/cmd_vel.md. Verified to fail with the feature broken: see docs/cmd_vel.md, "Tests".
 """
 import unittest
 

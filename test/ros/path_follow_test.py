@@ -10,7 +10,7 @@ from reference_generator's ~progress (PathProgress) and ground_truth.
   the robot has done 3 m of it, the replacement (0, 1) -> (12, 1) (a lane change 1 m to the left, starting behind
   the robot) is joined from the robot's progress: the robot never drives back (beyond BACK, its settling onto
   the goal), and reaches (12, 1) within the tolerance with the same bounds.
-The figures are printed on one line, for docs/interfaces.md."""
+The figures are printed on one line, for results/path_following.md."""
 import math
 import threading
 import time

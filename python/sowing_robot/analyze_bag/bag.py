@@ -13,7 +13,7 @@ AXES = ("x", "y", "theta")
 TOPICS = {
     "/tracking_error": "sowing_robot/TrackingError",
     "/odom": "nav_msgs/Odometry",
-    # the true state (issue 16; before it /odom was the truth). After /odom: in an old bag the type match
+    # the true state (before the sensors were modelled /odom was the truth). After /odom: in an old bag the type match
     # below finds only /odom, which /odom has taken, so ground_truth stays absent and truth() falls back.
     "/ground_truth": "nav_msgs/Odometry",
     "/reference": "sowing_robot/ReferenceState",
@@ -171,7 +171,7 @@ class BagData(object):
         return self.series.get(topic) or Series(topic)
 
     def truth(self):
-        """The robot's true state: /ground_truth, or in a bag recorded before it existed (issue 16) /odom,
+        """The robot's true state: /ground_truth, or in a bag recorded before it existed /odom,
         which carried the true state then (truth_from_odom() says so)."""
         s = self.get("/ground_truth")
         return s if len(s) else self.get("/odom")

@@ -98,7 +98,7 @@ def run(argv):
     print("\n\n".join(summaries))
     for d in datas:
         if d.truth_from_odom():
-            sys.stderr.write("%s: warning: %s: no /ground_truth (a bag recorded before issue 16): the robot's path "
+            sys.stderr.write("%s: warning: %s: no /ground_truth (a bag recorded before the sensors were modelled): the robot's path "
                              "and velocities are read from /odom, which was the true state then\n" % (PROG, d.path))
         missing, ngaps = gaps(d.get("/tracking_error").stamps)
         if ngaps:

@@ -1,6 +1,6 @@
 // The slip-aware EKF (ekf.h with estimator/slip/detect; slip_detector.h, slip_aware_step.h): its pieces, its
 // consistency while one wheel and while both wheels spin (NEES, the slip case of test_ekf's
-// EkfWithSensors.NeesWithinChiSquareBounds), the bound of docs/estimator.md for a stalled robot whose wheels
+// EkfWithSensors.NeesWithinChiSquareBounds), the bound of docs/slip_aware_estimator.md for a stalled robot whose wheels
 // spin for 60 s, and the recovery after the slip ends. The NEES and bound tests also run the filter without
 // the feature (today's defaults: slip/inflation and re-anchoring) and check that it fails them.
 #include <gtest/gtest.h>
@@ -426,7 +426,7 @@ TEST(EkfSlip, TheFedSpeedIsTheGroundSpeedWhileBothWheelsSpin) {
   EXPECT_GT(mean[0], 0.3);
 }
 
-// The bound of docs/estimator.md: a robot that stalls with both wheels spinning at the motors' no-load
+// The bound of docs/slip_aware_estimator.md: a robot that stalls with both wheels spinning at the motors' no-load
 // speed for 60 s, fixes at 10 Hz: the estimate stays within 0.25 m of the truth; through a 10 s fix
 // dropout inside the stall it drifts at the speed error the fixes left, within 0.3 m/s (the encoders
 // count 2.9 m/s: 29 m). Without the slip-aware filter the estimate runs off by metres.
@@ -448,7 +448,7 @@ TEST(EkfSlip, AStalledRobotWithSpinningWheelsStaysWithinTheBound) {
   EXPECT_GT(worst_dropout[0], 3.0);
 }
 
-// The recovery of docs/estimator.md: the fixes drop out over the stall's last 10 s and come back as the
+// The recovery of docs/slip_aware_estimator.md: the fixes drop out over the stall's last 10 s and come back as the
 // wheels grip again (65 s, the robot speeding up at 1 m/s²): within 1.5 s the error is below 5 cm for good
 // (the slips re-acquired, the ground speed taken from the fixes until they are). Today's filter gets there
 // as soon (its encoders are right again and re-anchoring takes the fix): what it lacks is the time before,

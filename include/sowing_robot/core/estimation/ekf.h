@@ -50,7 +50,7 @@
 // in place of slip/inflation). A loose wheel's encoder is left out, from slip/window x 4 before the test
 // fired (the history is propagated again); when it is plausible again its slip is re-acquired (its
 // variance opened). The verdicts are stored with the steps, so a late fix re-propagates through the same
-// ones. Re-anchoring works as above. docs/estimator.md has the design, the bound and the recovery time.
+// ones. Re-anchoring works as above. docs/slip_aware_estimator.md has the design, the bound and the recovery time.
 #pragma once
 
 #include <Eigen/Core>

@@ -2,10 +2,10 @@
 // joint_states and the travelled path; consumes wheel torques.
 //
 // Modes: realtime (paced to the wall clock, zero-order hold of the latest torque, torque timeout ->
-// zero torque; plant_sim_realtime.h) and lockstep (publish the state at t_k, advance only when the
+// zero torque; plant_sim/realtime.h) and lockstep (publish the state at t_k, advance only when the
 // torque stamped t_k has arrived; a late or missing torque is reported, never skipped;
-// plant_sim_lockstep.h, its protocol in core/simulation/lockstep.h). Both step and publish through one
-// SimulatedPlant (plant_sim_plant.h).
+// plant_sim/lockstep.h, its protocol in core/simulation/lockstep.h). Both step and publish through one
+// SimulatedPlant (plant_sim/simulated_plant.h).
 #pragma once
 
 #include <ros/ros.h>
