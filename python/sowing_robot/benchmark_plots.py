@@ -1,19 +1,23 @@
 """Figures and the comparison table of a `benchmark` output directory.
 
-Reads DIR/runs.csv (one row per run) and DIR/envelopes.csv (per scenario, controller and time: quantiles
-of the cross-track error over the runs, computed by the C++ benchmark from each run's cross-track sampled
-every envelope_period) and writes, into the output directory:
+Reads DIR/runs.csv (one row per run), DIR/metrics.json (the benchmark's metric registry, core/evaluation/
+run_metrics.h: each metric's name, unit, label, which figures it gets, how runs aggregate and which direction is
+better) and DIR/envelopes.csv (per scenario, controller and time: quantiles of the cross-track error over the
+runs, computed by the C++ benchmark from each run's cross-track sampled every envelope_period) and writes, into
+the output directory:
 
-- box_<metric>.png: one panel per scenario, one box per controller (runs whose value is not finite, i.e.
-  diverged, are left out of the box and counted in the panel's title);
+- box_<metric>.png for every metric whose plots include "box": one panel per scenario, one box per controller
+  (runs whose value is not finite, i.e. diverged, are left out of the box and counted in the panel's title; a
+  metric no run has, e.g. min_clearance without obstacles, gets no figure);
 - envelope_<scenario>.png: per controller, the median cross-track and its 25-75 % and 5-95 % bands over time;
-- sweep_<scenario>.png for scenarios named *sweep*: ITAE y and the worst cross-track against the drawn
+- sweep_<scenario>.png for scenarios named *sweep*: the metrics whose plots include "sweep" against the drawn
   disturbance amplitude, one colour per controller;
 - comparison.md: per scenario, where the reference pair (kanayama+atsmc) is worse than another pair by more
-  than --margin (5 %): success rate, medians of the tracking, effort and chattering figures, mean time at the
-  torque limit; the raw material of a reading.
+  than --margin (5 %) in a compared metric: a share (success rate) by at least one run, the others by their
+  aggregation over the runs (median, or mean for the time at the torque limit); the raw material of a reading.
 """
 import csv
+import json
 import math
 import os
 import sys
@@ -23,29 +27,6 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from sowing_robot.cli import Parser  # noqa: E402
-
-# The metrics that get a box plot, with their labels; min_clearance only where there are obstacles.
-BOX_METRICS = [
-    ("itae_y", "ITAE y [m·s²]"),
-    ("ise_y", "ISE y [m²·s]"),
-    ("iae_theta", "IAE θ [rad·s]"),
-    ("worst_cross_track", "worst |cross-track| after settling [m]"),
-    ("final_cross_track", "final |cross-track| [m]"),
-    ("effort", "effort ∫τ² [N²·m²·s]"),
-    ("chattering", "chattering Σ|Δτ| [N·m]"),
-    ("time_at_limit", "time at the torque limit [s]"),
-    ("min_clearance", "smallest body clearance [m]"),
-]
-# Comparison: (column, label, better) with better "low" or "high"; success is compared as a rate.
-COMPARED = [
-    ("itae_y", "median ITAE y", "low"),
-    ("worst_cross_track", "median worst cross-track", "low"),
-    ("iae_theta", "median IAE θ", "low"),
-    ("effort", "median effort", "low"),
-    ("chattering", "median chattering", "low"),
-    ("time_at_limit", "mean time at limit", "low"),
-]
-
 
 def _float(text):
     try:
@@ -66,6 +47,25 @@ def read_runs(path):
             if k not in text_cols:
                 r[k] = _float(v)
     return rows
+
+
+def read_metrics(path):
+    """metrics.json (written by benchmark beside runs.csv) as a list of dicts, one per metric."""
+    with open(path) as f:
+        metrics = json.load(f)
+    for m in metrics:
+        for k in ("name", "unit", "label", "aggregation", "better", "compared", "plots"):
+            if k not in m:
+                raise ValueError(f"{path}: metric without '{k}'")
+    return metrics
+
+
+def _plotted(metrics, kind):
+    return [m for m in metrics if kind in m["plots"]]
+
+
+def _title(m):
+    return f"{m['label']} [{m['unit']}]"
 
 
 def read_envelopes(path):
@@ -107,12 +107,13 @@ def _save(fig, out_dir, name, title, written, **title_style):
     written.append(name)
 
 
-def box_plots(rows, out_dir):
-    """One PNG per metric; returns the file names written."""
+def box_plots(rows, metrics, out_dir):
+    """One PNG per metric whose plots include "box" (metrics: read_metrics()); returns the file names written."""
     scenarios = _ordered(r["scenario"] for r in rows)
     controllers = _ordered(r["controller"] for r in rows)
     written = []
-    for metric, label in BOX_METRICS:
+    for m in _plotted(metrics, "box"):
+        metric, label = m["name"], _title(m)
         if metric not in rows[0]:
             continue
         panels = [s for s in scenarios if any(math.isfinite(r[metric]) for r in rows if r["scenario"] == s)]
@@ -169,20 +170,24 @@ def envelope_plots(envelopes, out_dir):
     return written
 
 
-def sweep_plots(rows, out_dir):
-    """For scenarios named *sweep*: ITAE y and worst cross-track against the drawn amplitude."""
+def sweep_plots(rows, metrics, out_dir):
+    """For scenarios named *sweep*: the metrics whose plots include "sweep" against the drawn amplitude."""
     written = []
+    swept = [m for m in _plotted(metrics, "sweep") if m["name"] in rows[0]]
+    if not swept:
+        return written
     for s in _ordered(r["scenario"] for r in rows):
         if "sweep" not in s:
             continue
-        fig, axes = plt.subplots(1, 2, figsize=(10, 3.6))
+        fig, axes = plt.subplots(1, len(swept), figsize=(5 * len(swept), 3.6), squeeze=False)
+        axes = axes[0]
         for c in _ordered(r["controller"] for r in rows if r["scenario"] == s):
             pts = [r for r in rows if r["scenario"] == s and r["controller"] == c]
-            for ax, m in zip(axes, ("itae_y", "worst_cross_track")):
-                ax.scatter([r["amplitude"] for r in pts], [r[m] for r in pts], s=8, label=c)
-        for ax, m in zip(axes, ("ITAE y [m·s²]", "worst |cross-track| [m]")):
+            for ax, m in zip(axes, swept):
+                ax.scatter([r["amplitude"] for r in pts], [r[m["name"]] for r in pts], s=8, label=c)
+        for ax, m in zip(axes, swept):
             ax.set_xlabel("disturbance amplitude A [N·m]")
-            ax.set_ylabel(m)
+            ax.set_ylabel(_title(m))
             ax.set_yscale("log")
         axes[0].legend(fontsize=7)
         _save(fig, out_dir, f"sweep_{s}.png", s, written)
@@ -193,22 +198,30 @@ def _fmt(v):
     return "inf" if v == math.inf else f"{v:.4g}"
 
 
-def comparison(rows, reference="kanayama+atsmc", margin=0.05):
-    """Markdown: per scenario and other pair, every figure where `reference` is worse by more than `margin`
-    (relative; the success rate by more than one run), with both values. Smaller differences are ties."""
+def comparison(rows, metrics, reference="kanayama+atsmc", margin=0.05):
+    """Markdown: per scenario and other pair, every compared metric (metrics: read_metrics()) where `reference`
+    is worse by more than `margin` (relative; a share, e.g. the success rate, by at least one run), with both
+    values. Smaller differences are ties. Shares come first, then the others in the registry's order."""
     lines = [f"Where **{reference}** is worse than another pair by more than {100 * margin:g} % (generated from "
              "runs.csv by benchmark_plots; success: by at least one run):", ""]
     any_loss = False
+    compared = [m for m in metrics if m["compared"] and m["name"] in rows[0]]
+    compared = ([m for m in compared if m["aggregation"] == "share"] +
+                [m for m in compared if m["aggregation"] != "share"])
 
-    def figure(runs, col):
-        if col == "success":
-            return 100.0 * sum(1 for r in runs if r["success"] == 1) / len(runs)
-        vals = [r[col] for r in runs]
-        if col == "time_at_limit":
+    def figure(runs, m):
+        vals = [r[m["name"]] for r in runs]
+        if m["aggregation"] == "share":
+            return 100.0 * sum(1 for v in vals if v == 1) / len(vals)
+        if m["aggregation"] == "mean":
             return sum(vals) / len(vals)
         return _median([v if not math.isnan(v) else math.inf for v in vals])
 
-    def worse(a, b):  # a (reference) worse than b, lower being better
+    def worse(a, b, m, runs):  # a (reference) worse than b
+        if m["better"] == "higher":
+            a, b = b, a
+        if m["aggregation"] == "share":
+            return a - b >= 100.0 / max(len(runs), 1) - 1e-9
         if a == b or math.isnan(a) or math.isnan(b):
             return False
         if b == 0.0:
@@ -228,13 +241,14 @@ def comparison(rows, reference="kanayama+atsmc", margin=0.05):
             if c == reference:
                 continue
             losses = []
-            ra, rb = figure(ref, "success"), figure(runs, "success")
-            if rb - ra >= 100.0 / max(len(runs), 1) - 1e-9:
-                losses.append(f"success {_fmt(ra)} % vs {_fmt(rb)} %")
-            for col, label, _ in COMPARED:
-                a, b = figure(ref, col), figure(runs, col)
-                if worse(a, b):
-                    losses.append(f"{label} {_fmt(a)} vs {_fmt(b)}")
+            for m in compared:
+                a, b = figure(ref, m), figure(runs, m)
+                if not worse(a, b, m, runs):
+                    continue
+                if m["aggregation"] == "share":
+                    losses.append(f"{m['label']} {_fmt(a)} % vs {_fmt(b)} %")
+                else:
+                    losses.append(f"{m['aggregation']} {m['label']} {_fmt(a)} vs {_fmt(b)}")
             if losses:
                 per_pair.append(f"vs {c}: " + ", ".join(losses))
         lines.append(f"- **{s}**: " + ("; ".join(per_pair) if per_pair else "nowhere"))
@@ -247,7 +261,7 @@ def comparison(rows, reference="kanayama+atsmc", margin=0.05):
 
 def main(argv=None):
     p = Parser(__doc__, prog="benchmark_plots")
-    p.add_argument("dir", help="a benchmark --output directory (runs.csv, envelopes.csv)")
+    p.add_argument("dir", help="a benchmark --output directory (runs.csv, metrics.json, envelopes.csv)")
     p.add_argument("--output", help="where the PNGs and comparison.md go (default: DIR)")
     p.add_argument("--reference", default="kanayama+atsmc", help="the pair compared against the others")
     p.add_argument("--margin", type=float, default=0.05, help="relative difference below which figures tie")
@@ -256,14 +270,15 @@ def main(argv=None):
     os.makedirs(out, exist_ok=True)
     try:
         rows = read_runs(os.path.join(a.dir, "runs.csv"))
+        metrics = read_metrics(os.path.join(a.dir, "metrics.json"))
     except (OSError, ValueError, KeyError) as e:
         print(f"benchmark_plots: {e}", file=sys.stderr)
         return 2
-    files = box_plots(rows, out)
+    files = box_plots(rows, metrics, out)
     files += envelope_plots(read_envelopes(os.path.join(a.dir, "envelopes.csv")), out)
-    files += sweep_plots(rows, out)
+    files += sweep_plots(rows, metrics, out)
     with open(os.path.join(out, "comparison.md"), "w") as f:
-        f.write(comparison(rows, a.reference, a.margin))
+        f.write(comparison(rows, metrics, a.reference, a.margin))
     files.append("comparison.md")
     print(f"benchmark_plots: {len(files)} files in {out}")
     return 0

@@ -5,7 +5,8 @@
 // atsmc|tsmc|pid). A pair's gains come from TUNED_DIR/OUTER+INNER.yaml when that file exists (default the
 // package's config/tuned), else from the parameter tables' defaults; the report says which.
 // Writes DIR/runs.csv (one row per run: scenario, controller, seed, the values drawn, every metric, contacts,
-// success and the failure reason), DIR/envelopes.csv (per scenario, controller and time: quantiles of the
+// success and the failure reason), DIR/metrics.json (what each metric column is: core/evaluation/run_metrics.h,
+// read by benchmark_plots), DIR/envelopes.csv (per scenario, controller and time: quantiles of the
 // cross-track error over the runs) and DIR/report.md (overview, then per scenario and controller: success
 // rate with reasons, mean, std, p95 and worst of every metric). The files do not depend on --threads.
 // Everything is loaded and checked before the first run, and written only when every run is done: an unknown
@@ -33,6 +34,7 @@
 #include "sowing_robot/cli/usage.h"
 #include "sowing_robot/core/evaluation/benchmark.h"
 #include "sowing_robot/core/evaluation/estimated_bench.h"
+#include "sowing_robot/core/evaluation/run_metrics.h"
 #include "sowing_robot/core/simulation/runner.h"
 #include "sowing_robot/farm/farm.h"
 
@@ -48,7 +50,8 @@ const char* const kUsage =
     "usage: benchmark --seeds N --output DIR [--scenarios A,B] [--controllers X,Y] [--threads K]\n"
     "                 [--scenario-dir DIR] [--tuned-dir DIR] [--base-seed S] [--profile FILE]\n"
     "Monte-Carlo statistics of controller pairs over the scenario suite, in-process (no ROS master).\n"
-    "Writes DIR/runs.csv, DIR/envelopes.csv and DIR/report.md (the same whatever --threads).\n\n"
+    "Writes DIR/runs.csv, DIR/metrics.json (its metric columns: name, unit, meaning, aggregation),\n"
+    "DIR/envelopes.csv and DIR/report.md (the same whatever --threads).\n\n"
     "Options:\n"
     "  --seeds N            seeded runs per scenario and controller (required, >= 1)\n"
     "  --output DIR         where the files go (required)\n"
@@ -358,7 +361,10 @@ int run(sowing_robot::farm::Farm& farm, int argc, char** argv) {
   report += "\n## Overview\n\n" + summary + "\n" + sections;
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::string error;
-  if (!writeAll(output, {{"runs.csv", &csv}, {"envelopes.csv", &envelopes}, {"report.md", &report}}, error))
+  const std::string metrics = runMetricsJson();
+  if (!writeAll(output,
+                {{"runs.csv", &csv}, {"metrics.json", &metrics}, {"envelopes.csv", &envelopes}, {"report.md", &report}},
+                error))
     return fail(error);
   farm.stop();
   if (farm.active()) {

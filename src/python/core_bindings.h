@@ -26,31 +26,31 @@ using namespace sowing_robot::core;
 using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
 using Metrics = std::array<AxisMetrics, AXIS_COUNT>;
 
-inline const char* const kAxes[AXIS_COUNT] = {"x", "y", "theta"};
-
+/// A metrics dict's fields: the figures of the table and the YAML (axisFigures(), simulation/metrics.h), then
+/// the peak.
 struct Field {
   const char* name;
   double AxisMetrics::*member;
 };
-// Table order (metricsTable's rows), then the peak.
-inline const Field kFields[] = {{"ise", &AxisMetrics::ise},
-                                {"itse", &AxisMetrics::itse},
-                                {"iae", &AxisMetrics::iae},
-                                {"itae", &AxisMetrics::itae},
-                                {"rise_time", &AxisMetrics::rise_time},
-                                {"settling_time", &AxisMetrics::settling_time},
-                                {"overshoot", &AxisMetrics::overshoot},
-                                {"peak", &AxisMetrics::peak}};
+inline const std::vector<Field>& dictFields() {
+  static const std::vector<Field> fields = [] {
+    std::vector<Field> f;
+    for (const AxisFigure& a : axisFigures()) f.push_back({a.name, a.member});
+    f.push_back({"peak", &AxisMetrics::peak});
+    return f;
+  }();
+  return fields;
+}
 
 inline py::dict axisToDict(const AxisMetrics& m) {
   py::dict d;
-  for (const auto& f : kFields) d[f.name] = m.*f.member;
+  for (const auto& f : dictFields()) d[f.name] = m.*f.member;
   return d;
 }
 
 inline py::dict metricsToDict(const Metrics& m) {
   py::dict d;
-  for (int a = 0; a < AXIS_COUNT; ++a) d[kAxes[a]] = axisToDict(m[a]);
+  for (int a = 0; a < AXIS_COUNT; ++a) d[axisName(a)] = axisToDict(m[a]);
   return d;
 }
 
@@ -58,13 +58,13 @@ inline py::dict metricsToDict(const Metrics& m) {
 inline Metrics metricsFromDict(const py::dict& d) {
   Metrics m{};
   for (int a = 0; a < AXIS_COUNT; ++a) {
-    if (!d.contains(kAxes[a])) throw py::key_error(std::string("metrics without axis '") + kAxes[a] + "'");
-    const py::dict axis = d[kAxes[a]].cast<py::dict>();
-    for (const auto& f : kFields) {
+    if (!d.contains(axisName(a))) throw py::key_error(std::string("metrics without axis '") + axisName(a) + "'");
+    const py::dict axis = d[axisName(a)].cast<py::dict>();
+    for (const auto& f : dictFields()) {
       if (axis.contains(f.name))
         m[a].*f.member = axis[f.name].cast<double>();
       else if (std::string(f.name) != "peak")
-        throw py::key_error(std::string("metrics of axis '") + kAxes[a] + "' without '" + f.name + "'");
+        throw py::key_error(std::string("metrics of axis '") + axisName(a) + "' without '" + f.name + "'");
     }
   }
   return m;

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core_bindings.h"
+#include "sowing_robot/core/evaluation/run_metrics.h"
 
 namespace py = pybind11;
 using namespace sowing_robot::core;
@@ -145,10 +146,19 @@ run_monitor, run_scenario and the PSO tuner, so they are equal (==) to theirs.
 
 Closed loop (include/sowing_robot/core/simulation/runner.h): run_closed_loop() steps plant, Kanayama and the
 sliding-mode controller on the thesis's line, as the lockstep node pipeline does.)doc";
-  m.attr("AXES") = py::make_tuple("x", "y", "theta");
-  py::list fields;
-  for (const auto& f : kFields) fields.append(f.name);
+  py::list axes, fields, table_fields;
+  for (int a = 0; a < AXIS_COUNT; ++a) axes.append(axisName(a));
+  m.attr("AXES") = py::tuple(axes);
+  for (const auto& f : dictFields()) fields.append(f.name);
   m.attr("FIELDS") = py::tuple(fields);
+  // The figures of metrics_table and of run_monitor's metrics YAML (FIELDS without the peak).
+  for (const AxisFigure& f : axisFigures()) table_fields.append(f.name);
+  m.attr("TABLE_FIELDS") = py::tuple(table_fields);
+  m.def(
+      "run_metrics", []() { return py::module_::import("json").attr("loads")(runMetricsJson()); },
+      "The benchmark's per-run metrics (core/evaluation/run_metrics.h), as the benchmark writes them to "
+      "metrics.json: a list of dicts with name (the runs.csv column), unit, label, meaning, format, group, "
+      "aggregation, better, compared, plots, report_table, overview.");
 
   py::class_<MetricsAccumulator>(m, "MetricsAccumulator",
                                  "core::MetricsAccumulator: errors added sample by sample (time order).")

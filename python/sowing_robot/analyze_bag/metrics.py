@@ -15,8 +15,9 @@ THESIS = {
         "theta": (2.101, 13.79, 5.33, 48.87, 4.711, 6.337, 7.0),
     },
 }
-# The table's rows (core::metricsTable), also the keys written by --yaml (run_monitor's metrics_output).
-TABLE_FIELDS = ("ise", "itse", "iae", "itae", "rise_time", "settling_time", "overshoot")
+# The table's rows (core::metricsTable), also the keys written by --yaml (run_monitor's metrics_output): the
+# core's axisFigures() (core/simulation/metrics.h).
+TABLE_FIELDS = core.TABLE_FIELDS
 
 
 def bag_metrics(data, until=None):

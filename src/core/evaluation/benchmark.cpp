@@ -16,6 +16,7 @@
 #include "sowing_robot/core/common/validation.h"
 #include "sowing_robot/core/evaluation/bench_row.h"
 #include "sowing_robot/core/evaluation/estimated_bench.h"
+#include "sowing_robot/core/evaluation/run_metrics.h"
 
 namespace sowing_robot {
 namespace core {
@@ -300,38 +301,20 @@ T fromBits(double d) {
   return v;
 }
 
-constexpr double kRowMagic = 30.0;  ///< first entry of a packed row (its format's version)
+constexpr double kRowMagic = 31.0;  ///< first entry of a packed row (its format's version)
 
 }  // namespace
 
+// The draws, then every registry metric in its order (counts and flags are exact as doubles), then what no
+// metric holds: the axes' peaks, the realism flag, the failure text and the cross-track series.
 std::vector<double> packRow(const RunRow& r) {
   std::vector<double> p{kRowMagic};
   const RunDraw& d = r.draw;
   p.insert(p.end(), {bits(d.index), d.mass_scale, d.inertia_scale, d.amplitude, d.phase, bits(d.noise_seed), d.start_x,
                      d.start_y, d.start_theta, bits(d.sensor_seed)});
-  for (const AxisMetrics& m : r.metrics)
-    p.insert(p.end(), {m.ise, m.itse, m.iae, m.itae, m.rise_time, m.settling_time, m.overshoot, m.peak});
-  p.insert(p.end(), {r.effort,
-                     r.chattering,
-                     r.time_at_limit,
-                     r.worst_cross_track,
-                     r.final_cross_track,
-                     bits(static_cast<std::uint64_t>(r.contacts)),
-                     r.min_clearance,
-                     r.end_distance,
-                     r.diverged ? 1.0 : 0.0,
-                     r.success ? 1.0 : 0.0,
-                     r.realism ? 1.0 : 0.0,
-                     r.max_slip,
-                     r.tool_down_time,
-                     r.fed_error_rms,
-                     r.fed_error_max,
-                     r.odometry_error_max,
-                     bits(static_cast<std::int64_t>(r.fixes_applied)),
-                     bits(static_cast<std::int64_t>(r.fixes_refused)),
-                     r.high_slip_share,
-                     r.unsown_distance,
-                     r.seeds_unsown});
+  for (const RunMetric& m : runMetrics()) p.push_back(m.get(r));
+  for (const AxisMetrics& m : r.metrics) p.push_back(m.peak);
+  p.push_back(r.realism ? 1.0 : 0.0);
   p.push_back(static_cast<double>(r.failure.size()));
   for (char c : r.failure) p.push_back(static_cast<double>(static_cast<unsigned char>(c)));
   p.push_back(static_cast<double>(r.cross_track_series.size()));
@@ -363,30 +346,9 @@ RunRow unpackRow(const std::vector<double>& p) {
   d.start_y = next();
   d.start_theta = next();
   d.sensor_seed = fromBits<std::uint64_t>(next());
-  for (AxisMetrics& m : r.metrics)
-    for (double* f : {&m.ise, &m.itse, &m.iae, &m.itae, &m.rise_time, &m.settling_time, &m.overshoot, &m.peak})
-      *f = next();
-  r.effort = next();
-  r.chattering = next();
-  r.time_at_limit = next();
-  r.worst_cross_track = next();
-  r.final_cross_track = next();
-  r.contacts = static_cast<std::size_t>(fromBits<std::uint64_t>(next()));
-  r.min_clearance = next();
-  r.end_distance = next();
-  r.diverged = next() != 0.0;
-  r.success = next() != 0.0;
+  for (const RunMetric& m : runMetrics()) m.set(r, next());
+  for (AxisMetrics& m : r.metrics) m.peak = next();
   r.realism = next() != 0.0;
-  r.max_slip = next();
-  r.tool_down_time = next();
-  r.fed_error_rms = next();
-  r.fed_error_max = next();
-  r.odometry_error_max = next();
-  r.fixes_applied = static_cast<long>(fromBits<std::int64_t>(next()));
-  r.fixes_refused = static_cast<long>(fromBits<std::int64_t>(next()));
-  r.high_slip_share = next();
-  r.unsown_distance = next();
-  r.seeds_unsown = next();
   r.failure.resize(count());
   for (char& c : r.failure) c = static_cast<char>(static_cast<unsigned char>(next()));
   r.cross_track_series.resize(count());
@@ -467,11 +429,8 @@ Statistic statistic(std::vector<double> v) {
 const std::vector<std::string>& metricColumns() {
   static const std::vector<std::string> columns = [] {
     std::vector<std::string> c;
-    for (const char* axis : {"x", "y", "theta"})
-      for (const char* m : {"ise", "itse", "iae", "itae", "rise_time", "settling_time", "overshoot"})
-        c.push_back(std::string(m) + "_" + axis);
-    for (const char* m : {"effort", "chattering", "time_at_limit", "worst_cross_track", "final_cross_track"})
-      c.push_back(m);
+    for (const RunMetric& m : runMetrics())
+      if (m.report_table) c.push_back(m.name);
     return c;
   }();
   return columns;
@@ -480,18 +439,40 @@ const std::vector<std::string>& metricColumns() {
 std::vector<double> metricValues(const RunRow& r) {
   std::vector<double> v;
   v.reserve(metricColumns().size());
-  for (const AxisMetrics& m : r.metrics)
-    for (double x : {m.ise, m.itse, m.iae, m.itae, m.rise_time, m.settling_time, m.overshoot}) v.push_back(x);
-  for (double x : {r.effort, r.chattering, r.time_at_limit, r.worst_cross_track, r.final_cross_track}) v.push_back(x);
+  for (const RunMetric& m : runMetrics())
+    if (m.report_table) v.push_back(m.get(r));
   return v;
 }
 
+namespace {
+/// A metric's runs.csv field: %.17g, an integer or 0/1; a realism column of a row without realism is "nan"
+/// (a number) or empty.
+std::string csvField(const RunMetric& m, const RunRow& r) {
+  if (m.group == MetricGroup::realism && !r.realism) return m.format == MetricFormat::number ? "nan" : "";
+  const double v = m.get(r);
+  switch (m.format) {
+    case MetricFormat::number: return csvNumber(v);
+    case MetricFormat::count: return std::to_string(static_cast<long long>(v));
+    case MetricFormat::flag: return v != 0.0 ? "1" : "0";
+  }
+  return "";
+}
+}  // namespace
+
+// The columns: who ran and what was drawn, the metrics of every run, the failure, then (realism) the sensors'
+// seed and the realism metrics (runsCsvIdentityColumns() lists the ones that are not metrics).
 std::string runsCsvHeader(bool realism) {
   std::string h =
       "scenario,controller,seed,mass_scale,inertia_scale,amplitude,phase,noise_seed,start_x,start_y,start_theta";
-  for (const auto& c : metricColumns()) h += "," + c;
-  return h + ",contacts,min_clearance,end_distance,diverged,success,failure" + (realism ? estimatedCsvHeader() : "") +
-         "\n";
+  for (const RunMetric& m : runMetrics())
+    if (m.group == MetricGroup::always) h += "," + m.name;
+  h += ",failure";
+  if (realism) {
+    h += ",sensor_seed";
+    for (const RunMetric& m : runMetrics())
+      if (m.group == MetricGroup::realism) h += "," + m.name;
+  }
+  return h + "\n";
 }
 
 std::string runsCsvLines(const std::string& scenario, const std::string& controller, const std::vector<RunRow>& rows,
@@ -503,10 +484,15 @@ std::string runsCsvLines(const std::string& scenario, const std::string& control
            csvNumber(d.inertia_scale) + "," + csvNumber(d.amplitude) + "," + csvNumber(d.phase) + "," +
            std::to_string(d.noise_seed) + "," + csvNumber(d.start_x) + "," + csvNumber(d.start_y) + "," +
            csvNumber(d.start_theta);
-    for (double x : metricValues(r)) out += "," + csvNumber(x);
-    out += "," + std::to_string(r.contacts) + "," + csvNumber(r.min_clearance) + "," + csvNumber(r.end_distance);
-    out += std::string(",") + (r.diverged ? "1" : "0") + "," + (r.success ? "1" : "0") + "," + r.failure;
-    out += (realism ? estimatedCsvFields(r) : "") + "\n";
+    for (const RunMetric& m : runMetrics())
+      if (m.group == MetricGroup::always) out += "," + csvField(m, r);
+    out += "," + r.failure;
+    if (realism) {
+      out += "," + (r.realism ? std::to_string(d.sensor_seed) : std::string());
+      for (const RunMetric& m : runMetrics())
+        if (m.group == MetricGroup::realism) out += "," + csvField(m, r);
+    }
+    out += "\n";
   }
   return out;
 }
@@ -562,24 +548,34 @@ std::string reportSection(const std::string& scenario, const std::string& contro
   }
   if (!rows.empty() && rows.front().realism) out += estimatedReportLine(rows);
   out += "| metric | mean | std | p95 | worst |\n|---|---:|---:|---:|---:|\n";
-  const auto& cols = metricColumns();
-  std::vector<std::vector<double>> values(cols.size());
-  for (const RunRow& r : rows) {
-    const std::vector<double> v = metricValues(r);
-    for (std::size_t c = 0; c < cols.size(); ++c) values[c].push_back(v[c]);
-  }
-  for (std::size_t c = 0; c < cols.size(); ++c) {
-    const Statistic s = statistic(values[c]);
-    out += "| " + cols[c] + " | " + shortNumber(s.mean) + " | " + shortNumber(s.std) + " | " + shortNumber(s.p95) +
+  for (const RunMetric& m : runMetrics()) {
+    if (!m.report_table) continue;
+    const Statistic s = statistic(column(rows, m.get));
+    out += "| " + m.name + " | " + shortNumber(s.mean) + " | " + shortNumber(s.std) + " | " + shortNumber(s.p95) +
            " | " + shortNumber(s.worst) + " |\n";
   }
   return out + "\n";
 }
 
+namespace {
+/// The metrics of the report's overview, in its column order.
+std::vector<const RunMetric*> overviewMetrics() {
+  std::vector<const RunMetric*> out;
+  for (const RunMetric& m : runMetrics())
+    if (m.overview_column > 0) out.push_back(&m);
+  std::stable_sort(out.begin(), out.end(),
+                   [](const RunMetric* a, const RunMetric* b) { return a->overview_column < b->overview_column; });
+  return out;
+}
+}  // namespace
+
 std::string summaryHeader() {
-  return "| scenario | controller | runs | success % | failures | ITAE y mean | worst cross-track mean / p95 [m] | "
-         "effort mean [N²m²s] | chattering mean [N·m] | time at limit mean [s] |\n"
-         "|---|---|---:|---:|---|---:|---:|---:|---:|---:|\n";
+  std::string h = "| scenario | controller | runs | success % | failures |", rule = "|---|---|---:|---:|---|";
+  for (const RunMetric* m : overviewMetrics()) {
+    h += " " + m->label + (m->overview_p95 ? " mean / p95" : " mean") + " [" + m->unit + "] |";
+    rule += "---:|";
+  }
+  return h + "\n" + rule + "\n";
 }
 
 std::string summaryLine(const std::string& scenario, const std::string& controller, const std::vector<RunRow>& rows) {
@@ -589,15 +585,13 @@ std::string summaryLine(const std::string& scenario, const std::string& controll
     for (const RunRow& r : rows) n += failedFor(r, reason);
     if (n > 0) failures += (failures.empty() ? "" : ", ") + std::string(reason) + " " + std::to_string(n);
   }
-  const Statistic itae = statistic(column(rows, [](const RunRow& r) { return r.metrics[AXIS_Y].itae; }));
-  const Statistic worst = statistic(column(rows, [](const RunRow& r) { return r.worst_cross_track; }));
-  const Statistic effort = statistic(column(rows, [](const RunRow& r) { return r.effort; }));
-  const Statistic chat = statistic(column(rows, [](const RunRow& r) { return r.chattering; }));
-  const Statistic limit = statistic(column(rows, [](const RunRow& r) { return r.time_at_limit; }));
-  return "| " + scenario + " | " + controller + " | " + std::to_string(rows.size()) + " | " +
-         shortNumber(successRate(rows)) + " | " + (failures.empty() ? "-" : failures) + " | " + shortNumber(itae.mean) +
-         " | " + shortNumber(worst.mean) + " / " + shortNumber(worst.p95) + " | " + shortNumber(effort.mean) + " | " +
-         shortNumber(chat.mean) + " | " + shortNumber(limit.mean) + " |\n";
+  std::string line = "| " + scenario + " | " + controller + " | " + std::to_string(rows.size()) + " | " +
+                     shortNumber(successRate(rows)) + " | " + (failures.empty() ? "-" : failures) + " |";
+  for (const RunMetric* m : overviewMetrics()) {
+    const Statistic s = statistic(column(rows, m->get));
+    line += " " + shortNumber(s.mean) + (m->overview_p95 ? " / " + shortNumber(s.p95) : "") + " |";
+  }
+  return line + "\n";
 }
 
 }  // namespace core

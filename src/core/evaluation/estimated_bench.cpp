@@ -99,19 +99,6 @@ RunRow estimatedBenchRow(const BenchScenario& bench, std::int64_t index) {
                   });
 }
 
-std::string estimatedCsvHeader() {
-  return ",sensor_seed,max_slip,tool_down_time,fed_error_rms,fed_error_max,odometry_error_max,fixes_applied,"
-         "fixes_refused,high_slip_share,unsown_distance,seeds_unsown";
-}
-
-std::string estimatedCsvFields(const RunRow& r) {
-  if (!r.realism) return ",,nan,nan,nan,nan,nan,,,nan,nan,nan";
-  return "," + std::to_string(r.draw.sensor_seed) + "," + csvNumber(r.max_slip) + "," + csvNumber(r.tool_down_time) +
-         "," + csvNumber(r.fed_error_rms) + "," + csvNumber(r.fed_error_max) + "," + csvNumber(r.odometry_error_max) +
-         "," + std::to_string(r.fixes_applied) + "," + std::to_string(r.fixes_refused) + "," +
-         csvNumber(r.high_slip_share) + "," + csvNumber(r.unsown_distance) + "," + csvNumber(r.seeds_unsown);
-}
-
 std::string estimatedReportLine(const std::vector<RunRow>& rows) {
   std::vector<double> slip, high, rms, mx, odo;
   long applied = 0, refused = 0;

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <iomanip>
 #include <limits>
@@ -81,6 +82,32 @@ void timeDomainMetrics(const std::vector<double>& t, const std::vector<double>& 
   m.overshoot = 100.0 * worst / E;
 }
 
+const std::vector<AxisFigure>& axisFigures() {
+  static const std::vector<AxisFigure> figures{
+      {"ise", "ISE", "E²·s", "integral of e^2 (trapezoids on the sample times)", &AxisMetrics::ise},
+      {"itse", "ITSE", "E²·s²", "integral of t e^2", &AxisMetrics::itse},
+      {"iae", "IAE", "E·s", "integral of |e|", &AxisMetrics::iae},
+      {"itae", "ITAE", "E·s²", "integral of t |e|", &AxisMetrics::itae},
+      {"rise_time", "rise time", "s", "from |e| <= 0.9 E to |e| <= 0.1 E after the peak E = max |e| (NaN if never)",
+       &AxisMetrics::rise_time},
+      {"settling_time", "settling time", "s", "last time |e| > 0.02 E, from t = 0", &AxisMetrics::settling_time},
+      {"overshoot", "overshoot", "%", "largest error of opposite sign after the first zero crossing, over E",
+       &AxisMetrics::overshoot}};
+  return figures;
+}
+
+const char* axisName(int axis) {
+  static const char* const names[AXIS_COUNT] = {"x", "y", "theta"};
+  return names[axis];
+}
+
+std::string axisUnit(const AxisFigure& figure, int axis) {
+  std::string unit;
+  for (const char* c = figure.unit; *c != '\0'; ++c)
+    unit += *c == 'E' ? std::string(axis == AXIS_THETA ? "rad" : "m") : std::string(1, *c);
+  return unit;
+}
+
 std::string metricsTable(const std::vector<std::string>& names,
                          const std::vector<std::array<AxisMetrics, AXIS_COUNT>>& runs) {
   std::string s = "| metric | axis |";
@@ -88,28 +115,19 @@ std::string metricsTable(const std::vector<std::string>& names,
   s += "\n|---|---|";
   for (std::size_t i = 0; i < names.size(); ++i) s += "---:|";
   s += "\n";
-  const char* axes[AXIS_COUNT] = {"x", "y", "theta"};
-  struct Row {
-    const char* name;
-    double AxisMetrics::*field;
-  };
-  const Row rows[] = {{"ISE", &AxisMetrics::ise},
-                      {"ITSE", &AxisMetrics::itse},
-                      {"IAE", &AxisMetrics::iae},
-                      {"ITAE", &AxisMetrics::itae},
-                      {"rise time [s]", &AxisMetrics::rise_time},
-                      {"settling time [s]", &AxisMetrics::settling_time},
-                      {"overshoot [%]", &AxisMetrics::overshoot}};
   char buf[64];
-  for (const auto& row : rows)
+  for (const AxisFigure& f : axisFigures()) {
+    // The unit in the label where the axes share it (times, %); the integrals' differ by axis.
+    const std::string label = std::string(f.label) + (std::strchr(f.unit, 'E') ? "" : std::string(" [") + f.unit + "]");
     for (int a = 0; a < AXIS_COUNT; ++a) {
-      s += std::string("| ") + row.name + " | " + axes[a] + " |";
+      s += "| " + label + " | " + axisName(a) + " |";
       for (const auto& r : runs) {
-        std::snprintf(buf, sizeof buf, " %.4g |", r[a].*row.field);
+        std::snprintf(buf, sizeof buf, " %.4g |", r[a].*f.member);
         s += buf;
       }
       s += "\n";
     }
+  }
   return s;
 }
 
@@ -117,11 +135,14 @@ bool writeMetricsYaml(const std::string& path, const std::string& label, const s
   std::ofstream f(path);
   if (!f) return false;
   f << std::setprecision(17) << label << ":\n";
-  const char* axes[] = {"x", "y", "theta"};
   for (int a = 0; a < AXIS_COUNT; ++a) {
-    f << "  " << axes[a] << ": {ise: " << m[a].ise << ", itse: " << m[a].itse << ", iae: " << m[a].iae
-      << ", itae: " << m[a].itae << ", rise_time: " << m[a].rise_time << ", settling_time: " << m[a].settling_time
-      << ", overshoot: " << m[a].overshoot << "}\n";
+    f << "  " << axisName(a) << ": {";
+    const char* sep = "";
+    for (const AxisFigure& fig : axisFigures()) {
+      f << sep << fig.name << ": " << m[a].*fig.member;
+      sep = ", ";
+    }
+    f << "}\n";
   }
   return static_cast<bool>(f);
 }

@@ -5,10 +5,14 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <set>
+#include <sstream>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "sowing_robot/core/evaluation/benchmark.h"
+#include "sowing_robot/core/evaluation/run_metrics.h"
 
 using namespace sowing_robot::core;
 
@@ -299,4 +303,119 @@ TEST(Benchmark, EnvelopeQuantilesAreNearestRankPerSampleTime) {
   EXPECT_EQ(e.p05[1], -3.0);
   EXPECT_EQ(e.max_abs[1], 3.0);
   EXPECT_EQ(e.p50[2], 7.0);
+}
+
+namespace {
+std::vector<std::string> splitCsv(const std::string& line) {
+  std::vector<std::string> out;
+  std::stringstream in(line);
+  std::string field;
+  while (std::getline(in, field, ',')) out.push_back(field);
+  if (!line.empty() && line.back() == ',') out.push_back("");
+  return out;
+}
+std::vector<std::string> lines(const std::string& text) {
+  std::vector<std::string> out;
+  std::stringstream in(text);
+  std::string line;
+  while (std::getline(in, line)) out.push_back(line);
+  return out;
+}
+/// A row with every field set, realism included: what the farm must carry across ranks.
+RunRow fullRow() {
+  RunRow r;
+  r.draw = drawRun(MonteCarloSpec{}, Scenario{}, 7);
+  double v = 0.125;
+  for (AxisMetrics& m : r.metrics)
+    for (double* f : {&m.ise, &m.itse, &m.iae, &m.itae, &m.rise_time, &m.settling_time, &m.overshoot, &m.peak})
+      *f = (v *= 1.7);
+  r.metrics[AXIS_X].rise_time = std::numeric_limits<double>::quiet_NaN();
+  r.effort = 1.0 / 3.0;
+  r.chattering = std::numeric_limits<double>::infinity();
+  r.time_at_limit = 0.004;
+  r.worst_cross_track = 0.01;
+  r.final_cross_track = 0.002;
+  r.contacts = 3;
+  r.min_clearance = -0.01;
+  r.end_distance = 0.3;
+  r.diverged = false;
+  r.success = false;
+  r.failure = "no traction at (1.5 3): slip";
+  r.cross_track_series = {0.5, -0.25, 1e-9};
+  r.realism = true;
+  r.max_slip = 0.7;
+  r.high_slip_share = 0.04;
+  r.tool_down_time = 12.5;
+  r.fed_error_rms = 0.02;
+  r.fed_error_max = 0.05;
+  r.odometry_error_max = 0.9;
+  r.fixes_applied = 41;
+  r.fixes_refused = 2;
+  r.unsown_distance = 1.25;
+  r.seeds_unsown = 25.0;
+  return r;
+}
+}  // namespace
+
+// The registry (run_metrics.h) is what names a metric: one entry per name, each with a unit, a label and
+// a meaning, and no name that is also an identity column of runs.csv.
+TEST(RunMetrics, NamesAreUniqueAndEachHasAUnitALabelAndAMeaning) {
+  std::set<std::string> names(runsCsvIdentityColumns().begin(), runsCsvIdentityColumns().end());
+  ASSERT_EQ(names.size(), runsCsvIdentityColumns().size());
+  ASSERT_FALSE(runMetrics().empty());
+  for (const RunMetric& m : runMetrics()) {
+    EXPECT_TRUE(names.insert(m.name).second) << m.name << " twice, or also an identity column";
+    EXPECT_FALSE(m.unit.empty()) << m.name;
+    EXPECT_FALSE(m.label.empty()) << m.name;
+    EXPECT_FALSE(m.meaning.empty()) << m.name;
+    EXPECT_EQ(m.meaning.find('\n'), std::string::npos) << m.name << ": one line";
+    EXPECT_TRUE(m.get && m.set) << m.name;
+    EXPECT_EQ(m.name.find(','), std::string::npos) << m.name;
+  }
+  // The report's table is the registry's report_table entries.
+  EXPECT_EQ(metricColumns().size(), 26u);
+  EXPECT_EQ(metricColumns().front(), "ise_x");
+  EXPECT_EQ(metricColumns().back(), "final_cross_track");
+}
+
+// Every column of runs.csv (a tiny benchmark, and the realism columns) is a registry entry or one of the
+// documented identity columns (who ran, what was drawn, why it failed), and every row has one value per column.
+TEST(RunMetrics, EveryRunsCsvColumnIsARegistryEntryOrAnIdentityColumn) {
+  std::set<std::string> known(runsCsvIdentityColumns().begin(), runsCsvIdentityColumns().end());
+  for (const RunMetric& m : runMetrics()) known.insert(m.name);
+  LineReference line(1.0, 3.0, 0.0);
+  const std::vector<RunRow> rows = runMonteCarlo(shortLine("kanayama+atsmc"), line, shortSpec(), 2, 1);
+  for (bool realism : {false, true}) {
+    std::vector<RunRow> all = rows;
+    if (realism) all.push_back(fullRow());
+    const std::vector<std::string> header = splitCsv(lines(runsCsvHeader(realism)).at(0));
+    std::set<std::string> seen;
+    for (const std::string& column : header) {
+      EXPECT_TRUE(known.count(column)) << "runs.csv column " << column << " has no entry in runMetrics()";
+      EXPECT_TRUE(seen.insert(column).second) << column << " twice";
+    }
+    for (const RunMetric& m : runMetrics())
+      EXPECT_EQ(seen.count(m.name), m.group == MetricGroup::always || realism ? 1u : 0u) << m.name;
+    for (const std::string& row : lines(runsCsvLines("s", "c", all, realism)))
+      EXPECT_EQ(splitCsv(row).size(), header.size()) << row;
+  }
+}
+
+// The farm's packed row carries every field: unpacking gives the same CSV line, peaks, flags and series.
+TEST(RunMetrics, APackedRowUnpacksToTheSameRow) {
+  for (bool realism : {false, true}) {
+    RunRow r = fullRow();
+    r.realism = realism;
+    const RunRow back = unpackRow(packRow(r));
+    EXPECT_EQ(runsCsvLines("s", "c", {back}, true), runsCsvLines("s", "c", {r}, true));
+    EXPECT_EQ(back.realism, realism);
+    EXPECT_EQ(back.failure, r.failure);
+    EXPECT_EQ(back.cross_track_series, r.cross_track_series);
+    EXPECT_EQ(back.contacts, r.contacts);
+    EXPECT_EQ(back.fixes_applied, r.fixes_applied);
+    for (int a = 0; a < AXIS_COUNT; ++a) EXPECT_EQ(back.metrics[a].peak, r.metrics[a].peak) << a;
+  }
+  std::vector<double> packed = packRow(fullRow());
+  packed.pop_back();
+  EXPECT_THROW(unpackRow(packed), std::invalid_argument);
 }

@@ -176,8 +176,9 @@ void checkBenchmark(const BenchScenario& bench, std::int64_t runs);
 /// same, so a row is the same bits wherever it ran.
 std::function<RunRow(std::int64_t)> benchmarkWorker(const BenchScenario& bench);
 
-/// A row as doubles (integers and flags bit-cast, the failure text one character per double) and back,
-/// exactly: what the MPI farm sends. unpackRow throws std::invalid_argument on a malformed array.
+/// A row as doubles (the draws' integers bit-cast, every metric of runMetrics() in its order, the failure
+/// text one character per double) and back, exactly: what the MPI farm sends. unpackRow throws std::invalid_argument on
+/// a malformed array.
 std::vector<double> packRow(const RunRow& row);
 RunRow unpackRow(const std::vector<double>& packed);
 
@@ -200,21 +201,22 @@ struct Statistic {
 };
 Statistic statistic(std::vector<double> values);
 
-/// The names of the per-run metric columns, in CSV order, and their values for a row.
+/// The names of the metrics of the report's per-metric table (run_metrics.h: report_table), in runs.csv's
+/// order, and their values for a row.
 const std::vector<std::string>& metricColumns();
 std::vector<double> metricValues(const RunRow& row);
 
-/// Tidy CSV: header line, then one line per row: scenario, controller, seed, the draws, every metric.
-/// realism: the columns of scenarios with sensors or traction appended (estimated_bench.h; NaN on rows
-/// without them); false gives today's columns, byte for byte.
+/// Tidy CSV: header line, then one line per row: scenario, controller, seed, the draws, every metric of
+/// runMetrics() (run_metrics.h) of the group always, the failure. realism: then sensor_seed and the metrics of
+/// the group realism (scenarios with sensors or traction; NaN or empty on rows without them).
 std::string runsCsvHeader(bool realism = false);
 std::string runsCsvLines(const std::string& scenario, const std::string& controller, const std::vector<RunRow>& rows,
                          bool realism = false);
 /// Markdown section for one scenario and controller: success rate with failure reasons, then per metric
-/// mean, std, p95 and worst.
+/// (run_metrics.h: report_table) mean, std, p95 and worst.
 std::string reportSection(const std::string& scenario, const std::string& controller, const std::vector<RunRow>& rows);
 /// Markdown table header and one line of the overview (one line per scenario and controller): success rate,
-/// contacts, mean ITAE y, mean and p95 of the worst cross-track, mean effort, chattering, time at the limit.
+/// failures, then the mean (or mean / p95) of each metric with an overview in run_metrics.h.
 std::string summaryHeader();
 std::string summaryLine(const std::string& scenario, const std::string& controller, const std::vector<RunRow>& rows);
 

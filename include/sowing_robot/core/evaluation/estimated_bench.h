@@ -23,9 +23,6 @@ RunRow estimatedBenchRow(const BenchScenario& bench, std::int64_t index);
 /// BenchScenario::validate()'s part for realism and requires_models: "" or one line.
 std::string estimatedBenchCheck(const BenchScenario& bench);
 
-/// runs.csv's extra columns (",sensor_seed,max_slip,..."), and a row's values for them (NaN/empty without).
-std::string estimatedCsvHeader();
-std::string estimatedCsvFields(const RunRow& row);
 /// A report line (Markdown paragraph) of a realism scenario's rows: slip, fed-pose error, fixes.
 std::string estimatedReportLine(const std::vector<RunRow>& rows);
 /// A sentence for the report's scenario list: plant, sensors and feedback of bench.realism ("" unset).

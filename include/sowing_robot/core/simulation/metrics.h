@@ -149,6 +149,24 @@ class MetricsAccumulator {
   std::array<StreamingTimeDomain, AXIS_COUNT> time_domain_{};
 };
 
+/// One figure of AxisMetrics as everything that names it does: the rows of metricsTable, the keys of the
+/// metrics YAML (run_monitor's metrics_output, run_scenario --yaml, analyze_bag --yaml), the Python metrics
+/// dicts (sowing_robot.core) and the benchmark's runs.csv columns NAME_AXIS (evaluation/run_metrics.h).
+struct AxisFigure {
+  const char* name;     ///< YAML and dict key
+  const char* label;    ///< metricsTable's row (followed by " [unit]" where the unit is the same on every axis)
+  const char* unit;     ///< E stands for the error's unit: m on x and y, rad on theta (axisUnit)
+  const char* meaning;  ///< one line
+  double AxisMetrics::*member;
+};
+/// The figures of the table, the YAML and runs.csv, in their order. AxisMetrics::peak is not one of them (the
+/// Python dicts add it).
+const std::vector<AxisFigure>& axisFigures();
+/// "x", "y", "theta": the YAML's and dicts' axis keys, runs.csv's column suffix.
+const char* axisName(int axis);
+/// `figure`'s unit on `axis` (its E replaced by m or rad).
+std::string axisUnit(const AxisFigure& figure, int axis);
+
 /// Time-domain figures of one series (the definitions above).
 void timeDomainMetrics(const std::vector<double>& t, const std::vector<double>& e, AxisMetrics& m);
 
