@@ -30,7 +30,7 @@
 #include "sowing_robot/core/model/traction.h"
 #include "sowing_robot/core/planning/field.h"
 #include "sowing_robot/core/settings/node_settings.h"
-#include "sowing_robot/core/simulation/estimated_run.h"
+#include "sowing_robot/core/simulation/runner.h"
 
 namespace sowing_robot {
 namespace bench {
@@ -229,7 +229,7 @@ constexpr const char* kLoopBlocks[] = {"traction", "sensors",          "estimato
 /// The blocks of kLoopBlocks, each through the nodes' parameter table, onto `traction` and `cfg` (what they do not
 /// set stays).
 void applyLoopBlocks(const YAML::Node& root, const std::string& path, core::TractionParams& traction,
-                     core::EstimatedRunConfig& cfg) {
+                     core::LoopConfig& cfg) {
   const YAML::Node sensors = root["sensors"], feedback = root["feedback"];
   if (const YAML::Node block = root["traction"])
     applyTableBlock(core::tractionTable(), block, traction, path, "traction");
@@ -365,7 +365,7 @@ core::BenchScenario loadScenarioFileImpl(const std::string& path, const std::str
   // through their tables: any block of kLoopBlocks.
   if (std::any_of(std::begin(kLoopBlocks), std::end(kLoopBlocks),
                   [&root](const char* block) { return static_cast<bool>(root[block]); })) {
-    core::EstimatedRunConfig cfg;
+    core::LoopConfig cfg;
     core::TractionParams t;
     applyLoopBlocks(root, path, t, cfg);
     if (t.enabled) {
@@ -410,7 +410,7 @@ std::string profilePath(const std::string& name_or_path, const std::string& dir)
   return path;
 }
 
-void applyProfileTo(const std::string& profile, core::EstimatedRunConfig& cfg) {
+void applyProfileTo(const std::string& profile, core::LoopConfig& cfg) {
   try {
     YAML::Node root(YAML::NodeType::Map);
     applyProfile(root, profile);  // exactly as on a scenario's blocks: here on none

@@ -23,7 +23,6 @@
 
 #include "sowing_robot/cli/usage.h"
 #include "sowing_robot/core/common/validation.h"
-#include "sowing_robot/core/simulation/estimated_run.h"
 #include "sowing_robot/core/simulation/field_run.h"
 #include "sowing_robot/core/simulation/runner.h"
 
@@ -235,9 +234,9 @@ int main(int argc, char** argv) {
     const auto t0 = std::chrono::steady_clock::now();
     for (int k = 0; k < repeat; ++k) {
       if (traction.enabled) {
-        EstimatedRunConfig plant;  // the traction plant, fed the truth
+        LoopConfig plant;  // the traction plant, fed the truth
         plant.traction = traction;
-        const EstimatedRunResult er = runEstimatedLoop(sc, plant, ref);
+        const LoopResult er = runClosedLoop(sc, plant, ref);
         r = er.run;
         max_slip = er.max_abs_slip;
       } else {

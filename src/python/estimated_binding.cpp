@@ -1,4 +1,4 @@
-// sowing_robot.core.run_estimated: core::runEstimatedLoop (core/simulation/estimated_run.h) from Python: the closed
+// sowing_robot.core.run_estimated: core::runClosedLoop (core/simulation/runner.h) from Python: the closed
 // loop with the traction plant, the seeded sensors and the controllers fed the truth, the encoder odometry or the EKF's
 // estimate, scored on the truth. Its blocks take the nodes' keys (plant_sim's traction/ and sensors/, state_estimator's
 // estimator/), checked by the same tables, so a key or a range reads as the node's. profile= applies a profile file
@@ -10,7 +10,7 @@
 
 #include "core_bindings.h"
 #include "sowing_robot/bench/scenario_loader.h"
-#include "sowing_robot/core/simulation/estimated_run.h"
+#include "sowing_robot/core/simulation/runner.h"
 
 namespace py_core {
 namespace {
@@ -121,7 +121,7 @@ py::dict runEstimatedPy(const std::string& controller, const py::object& params,
   const Scenario sc = buildScenario(
       controller, params, gains,
       {duration, control_period_ns, disturbance, mass_scale, inertia_scale, noise_std, seed, start, disturbance_phase});
-  EstimatedRunConfig cfg;
+  LoopConfig cfg;
   std::string e = parseFeedback(feedback, cfg.feedback);
   if (!e.empty()) throw py::value_error(e);
   if (!traction.is_none()) {
@@ -163,16 +163,15 @@ py::dict runEstimatedPy(const std::string& controller, const py::object& params,
 
   LineReference reference = lineOf(line);
   EstimatedTrace columns;
-  EstimatedRunResult r;
+  LoopResult r;
   {
     py::gil_scoped_release no_gil;  // pure C++ from here; the trace is collected in C++ vectors
     try {
       if (trace) {
         columns.reserve(static_cast<std::size_t>(sc.steps() + 1));
-        r = runEstimatedLoop(sc, cfg, reference, keep_samples,
-                             [&columns](const EstimatedSample& s) { columns.add(s); });
+        r = runClosedLoop(sc, cfg, reference, keep_samples, [&columns](const EstimatedSample& s) { columns.add(s); });
       } else {
-        r = runEstimatedLoop(sc, cfg, reference, keep_samples);
+        r = runClosedLoop(sc, cfg, reference, keep_samples);
       }
     } catch (const std::invalid_argument& ex) {
       py::gil_scoped_acquire gil;
@@ -215,7 +214,7 @@ void bindEstimated(py::module& m) {
           py::arg("traction_control") = py::none(), py::arg("speed_governor") = py::none(),
           py::arg("hitch_control") = py::none(), py::arg("profile") = py::none(), plant...,
           py::arg("keep_samples") = true, py::arg("trace") = false,
-          R"doc(core::runEstimatedLoop: run() with an estimate in the loop, scored on the truth (as run_monitor).
+          R"doc(core::runClosedLoop: run() with an estimate in the loop, scored on the truth (as run_monitor).
 
 feedback: what the controllers are fed: "ground_truth" (then equal to run(), bit for bit), "odometry" (the
 wheel encoders' dead reckoning) or "fused" (the EKF of state_estimator: encoders, yaw rate, late fix).

@@ -25,7 +25,7 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
   loadTable(p, core::speedGovernorTable(), governor);
   std::string error = core::firstError({settings.validate(), governor.validate()});
   // The governor acts on the traction control's verdicts: without it none would come (in lockstep the loop
-  // would wait for them), so it is refused, as the in-process loop refuses it (EstimatedRunConfig::validate).
+  // would wait for them), so it is refused, as the in-process loop refuses it (LoopConfig::validate).
   bool traction_control = false;
   nh.param("torque_controller/traction_control/enabled", traction_control, false);
   if (error.empty() && governor.enabled && !traction_control)

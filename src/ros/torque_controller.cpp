@@ -20,7 +20,7 @@ TorqueController::TorqueController(ros::NodeHandle nh, ros::NodeHandle pnh) {
   core::HitchControlParams hitch;  // hitch_control/...: off by default
   loadTable(p, core::hitchControlTable(), hitch);
   std::string hitch_error = hitch.validate();
-  if (hitch_error.empty() && hitch.enabled && !traction.enabled)  // as EstimatedRunConfig::validate()
+  if (hitch_error.empty() && hitch.enabled && !traction.enabled)  // as LoopConfig::validate()
     hitch_error = "hitch_control/enabled needs traction_control/enabled (the hitch acts on its grip verdict)";
   requireValid(
       p, robot_error.empty() ? core::firstError({settings.validate(), traction.validate(), hitch_error}) : robot_error);
@@ -107,7 +107,7 @@ void TorqueController::encoderCallback(const nav_msgs::Odometry::ConstPtr& msg) 
 
 void TorqueController::feed(const nav_msgs::Odometry& fed, const nav_msgs::Odometry& encoders) {
   if (traction_control_) {
-    // R W of each wheel as the in-process loop forms it from the encoders' odometry (estimated_run.cpp).
+    // R W of each wheel as the in-process loop forms it from the encoders' odometry (configured_run.cpp).
     const double v = encoders.twist.twist.linear.x, w = encoders.twist.twist.angular.z;
     wheel_speeds_.push_back({fed.header.stamp, v + L_ * w, v - L_ * w});
     if (wheel_speeds_.size() > 32) wheel_speeds_.pop_front();

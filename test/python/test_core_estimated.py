@@ -1,4 +1,4 @@
-"""sowing_robot.core.run_estimated (core::runEstimatedLoop through pybind11): fed the truth it is run() to the bit;
+"""sowing_robot.core.run_estimated (core::runClosedLoop through pybind11): fed the truth it is run() to the bit;
 fed the EKF's estimate it is the benchmark's estimated-pose run to the bit (the same scenario through the
 `benchmark` executable's runs.csv, 17 digits); its blocks take the nodes' keys and refuse bad ones by name."""
 import csv

@@ -1,6 +1,6 @@
 // rostest (fused_lockstep.test): the node pipeline in lockstep with feedback:=fused (plant_sim's sensors,
 // state_estimator, the controllers on odometry/filtered) against the in-process loop with the EKF in it
-// (core/simulation/estimated_run.h) on the same parameters, read from the nodes' own namespaces (the scenario and the
+// (core/simulation/runner.h) on the same parameters, read from the nodes' own namespaces (the scenario and the
 // controller pair as pipeline_tester reads them; plant_sim's sensors/..., state_estimator's estimator/...).
 // Every period's true pose (ground_truth) and estimate (odometry/filtered) must equal the in-process ones
 // bit for bit. Fails without what it protects: an in-process loop that fed the controllers at another step,
@@ -20,7 +20,7 @@
 #include <map>
 
 #include "sowing_robot/core/common/validation.h"
-#include "sowing_robot/core/simulation/estimated_run.h"
+#include "sowing_robot/core/simulation/runner.h"
 #include "sowing_robot/ros/common/component_params.h"
 #include "sowing_robot/ros/common/msg_checks.h"
 #include "sowing_robot/ros/common/param_reader.h"
@@ -46,7 +46,7 @@ TEST(FusedLockstep, NodePipelineEqualsTheInProcessEstimatedLoop) {
   double duration = 0;
   const std::string err = loadPipelineScenario(sc, duration);
   ASSERT_TRUE(err.empty()) << err;
-  core::EstimatedRunConfig cfg;
+  core::LoopConfig cfg;
   cfg.feedback = core::Feedback::fused;
   ParamReader plant(ros::NodeHandle("/plant_sim")), estimator(ros::NodeHandle("/state_estimator")),
       torque(ros::NodeHandle("/torque_controller")), reference(ros::NodeHandle("/reference_generator")),
@@ -105,26 +105,25 @@ TEST(FusedLockstep, NodePipelineEqualsTheInProcessEstimatedLoop) {
   core::LineReference ref(1.0, 3.0, 0.0);
   double truth_diff = 0.0, estimate_diff = 0.0, fed_max = 0.0;
   std::int64_t compared = 0, unequal = 0, missing = 0;
-  const core::EstimatedRunResult in_process =
-      core::runEstimatedLoop(sc, cfg, ref, false, [&](const core::EstimatedSample& s) {
-        const std::uint64_t k = static_cast<std::uint64_t>(std::llround(s.loop->t * 1e9));
-        const auto t = rec.truth.find(k);
-        const auto e = rec.estimate.find(k);
-        if (t == rec.truth.end() || e == rec.estimate.end()) {
-          ++missing;
-          return;
-        }
-        const core::State& x = *s.loop->state;
-        const double dt = std::max({std::fabs(t->second.x - x[core::X]), std::fabs(t->second.y - x[core::Y]),
-                                    std::fabs(t->second.theta - core::yawThroughQuaternion(x[core::THETA]))});
-        const double de = std::max({std::fabs(e->second.x - s.fed.x), std::fabs(e->second.y - s.fed.y),
-                                    std::fabs(e->second.theta - s.fed.theta)});
-        truth_diff = std::max(truth_diff, dt);
-        estimate_diff = std::max(estimate_diff, de);
-        fed_max = std::max(fed_max, std::hypot(s.fed.x - x[core::X], s.fed.y - x[core::Y]));
-        unequal += (dt != 0.0 || de != 0.0);
-        ++compared;
-      });
+  const core::LoopResult in_process = core::runClosedLoop(sc, cfg, ref, false, [&](const core::EstimatedSample& s) {
+    const std::uint64_t k = static_cast<std::uint64_t>(std::llround(s.loop->t * 1e9));
+    const auto t = rec.truth.find(k);
+    const auto e = rec.estimate.find(k);
+    if (t == rec.truth.end() || e == rec.estimate.end()) {
+      ++missing;
+      return;
+    }
+    const core::State& x = *s.loop->state;
+    const double dt = std::max({std::fabs(t->second.x - x[core::X]), std::fabs(t->second.y - x[core::Y]),
+                                std::fabs(t->second.theta - core::yawThroughQuaternion(x[core::THETA]))});
+    const double de = std::max(
+        {std::fabs(e->second.x - s.fed.x), std::fabs(e->second.y - s.fed.y), std::fabs(e->second.theta - s.fed.theta)});
+    truth_diff = std::max(truth_diff, dt);
+    estimate_diff = std::max(estimate_diff, de);
+    fed_max = std::max(fed_max, std::hypot(s.fed.x - x[core::X], s.fed.y - x[core::Y]));
+    unequal += (dt != 0.0 || de != 0.0);
+    ++compared;
+  });
   std::printf(
       "fused lockstep: %lld periods compared (%lld missing), %lld unequal; largest difference node - in-process: "
       "truth %.3g, estimate %.3g; estimate error %.4f m\n",

@@ -11,7 +11,6 @@
 #include <vector>
 
 #include "sowing_robot/core/evaluation/benchmark.h"
-#include "sowing_robot/core/simulation/estimated_run.h"
 #include "sowing_robot/core/simulation/runner.h"
 
 namespace sowing_robot {
@@ -33,7 +32,7 @@ core::BenchScenario loadScenarioFile(const std::string& path, const std::string&
 /// each block key by key through its table over what `cfg` holds (plant_sim/traction/enabled true puts the
 /// traction plant in, with cfg's traction parameters if it had them), profile/feedback over cfg.feedback.
 /// Throws std::invalid_argument "FILE: what is wrong".
-void applyProfileTo(const std::string& profile, core::EstimatedRunConfig& cfg);
+void applyProfileTo(const std::string& profile, core::LoopConfig& cfg);
 
 /// A profile's file: `name_or_path` as it is when it is a path (contains '/' or ends with .yaml), else
 /// DIR/NAME.yaml (config/profiles: "field"); an unknown name lists the known ones (std::invalid_argument).

@@ -20,15 +20,15 @@ const std::vector<std::string>& availableModels() {
 
 namespace {
 
-/// benchmark.cpp's measure() over runEstimatedLoop: the same figures (RowMeter; a truth-fed run without
+/// benchmark.cpp's measure() over runClosedLoop: the same figures (RowMeter; a truth-fed run without
 /// traction gives its row bit for bit: test_estimated_run), plus the loop's own.
-RunRow measureEstimated(const Scenario& sc, const EstimatedRunConfig& cfg, ReferenceSource& reference,
+RunRow measureEstimated(const Scenario& sc, const LoopConfig& cfg, ReferenceSource& reference,
                         const MonteCarloSpec& spec, const RunDraw& draw, const RunExtras& extras) {
   RunRow row;
   row.draw = draw;
   RowMeter meter(row, sc, spec, extras);
-  const EstimatedRunResult er =
-      runEstimatedLoop(sc, cfg, reference, true, [&](const EstimatedSample& es) { meter.add(*es.loop); });
+  const LoopResult er =
+      runClosedLoop(sc, cfg, reference, true, [&](const EstimatedSample& es) { meter.add(*es.loop); });
   meter.finish(er.run);
   // No traction is why the run ended early: it comes before a cross-track failure (and the finish check,
   // which leaves it be), after a divergence or a contact.
@@ -72,7 +72,7 @@ RunRow estimatedBenchRow(const BenchScenario& bench, std::int64_t index) {
   const MonteCarloSpec& spec = bench.spec;
   const RunDraw draw = drawRun(spec, bench.base, index);
   Scenario sc = applyDraw(bench.base, spec, draw);
-  EstimatedRunConfig cfg = *bench.realism;
+  LoopConfig cfg = *bench.realism;
   cfg.sensors.seed = draw.sensor_seed;
   RunExtras extras;
   extras.series_every = seriesEvery(bench);
@@ -142,7 +142,7 @@ std::string estimatedReportLine(const std::vector<RunRow>& rows) {
 
 std::string describeRealism(const BenchScenario& b) {
   if (!b.realism) return "";
-  const EstimatedRunConfig& c = *b.realism;
+  const LoopConfig& c = *b.realism;
   std::string out = "  Plant: ";
   if (c.traction) {
     out += "traction (mu_peak " + shortNumber(c.traction->mu_peak) + ", mu_slide " + shortNumber(c.traction->mu_slide) +

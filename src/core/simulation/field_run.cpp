@@ -6,7 +6,7 @@
 #include <stdexcept>
 
 #include "sowing_robot/core/planning/field_path_follower.h"
-#include "sowing_robot/core/simulation/estimated_run.h"
+#include "sowing_robot/core/simulation/runner.h"
 
 namespace sowing_robot {
 namespace core {
@@ -67,13 +67,13 @@ FieldRunReport runField(const FieldRunSetup& setup) {
   };
   // The plant fed its own state; with setup.traction the wheel-soil plant, whose tool rule lowers the tool
   // on the field's rows (as plant_sim's TractionModel).
-  EstimatedRunConfig plant;
+  LoopConfig plant;
   plant.traction = setup.traction;
   plant.patches = setup.patches;
   plant.tool = setup.tool;
   plant.tool_rows = rowsOf(setup.field);
   plant.seeding = setup.seeding;
-  const EstimatedRunResult er = runEstimatedLoop(setup.scenario, plant, reference, false, trace);
+  const LoopResult er = runClosedLoop(setup.scenario, plant, reference, false, trace);
   const RunResult& run = er.run;
   rep.max_slip = er.max_abs_slip;
   rep.tool_down_time = er.tool_down_time;

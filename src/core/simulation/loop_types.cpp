@@ -37,7 +37,7 @@ std::string parseFeedback(const std::string& name, Feedback& out) {
   return "feedback '" + name + "' is none of ground_truth, odometry, fused";
 }
 
-std::string EstimatedRunConfig::validate() const {
+std::string LoopConfig::validate() const {
   std::string e =
       firstError({sensors.validate(), estimator.validate(), traction ? traction->validate() : "", motor.validate(),
                   traction_control.validate(), speed_governor.validate(), hitch_control.validate()});

@@ -64,7 +64,7 @@ PlantSim::PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh) {
                         traction.traction.validate(), patch_error, tool_error, sensors.validate(), motor.validate()});
   if (error.empty() && p.error().empty() && traction.traction.enabled) {
     // Motors that cannot move the robot against the worst soil's rolling resistance and the draft are refused,
-    // as the in-process loop refuses them (core::runEstimatedLoop).
+    // as the in-process loop refuses them (core::runClosedLoop).
     double rolling = traction.traction.rolling_resistance;
     for (const core::SoilPatch& patch : patches) rolling = std::max(rolling, patch.rolling_resistance);
     error =

@@ -373,7 +373,7 @@ TEST(ScenarioLoader, AProfileGoesOnTopOfTheScenariosBlocks) {
 TEST(ScenarioLoader, AProfileAppliesToAnInProcessConfiguration) {
   const std::string field = bench::profilePath("field", kSource + "/config/profiles");
   EXPECT_EQ(field, kSource + "/config/profiles/field.yaml");
-  core::EstimatedRunConfig cfg;
+  core::LoopConfig cfg;
   core::TractionParams wet;
   wet.mu_peak = 0.25;
   wet.mu_slide = 0.2;
@@ -388,7 +388,7 @@ TEST(ScenarioLoader, AProfileAppliesToAnInProcessConfiguration) {
   EXPECT_TRUE(cfg.speed_governor.enabled);
   EXPECT_EQ(cfg.feedback, core::Feedback::fused);
   EXPECT_EQ(cfg.validate(), "");
-  core::EstimatedRunConfig bare;  // no traction of its own: the profile's with the defaults
+  core::LoopConfig bare;  // no traction of its own: the profile's with the defaults
   bench::applyProfileTo(field, bare);
   ASSERT_TRUE(bare.traction);
   EXPECT_EQ(bare.traction->mu_peak, core::TractionParams().mu_peak);

@@ -9,7 +9,7 @@
 #include "sowing_robot/core/model/motor.h"
 #include "sowing_robot/core/model/plant.h"
 #include "sowing_robot/core/model/traction.h"
-#include "sowing_robot/core/simulation/estimated_run.h"
+#include "sowing_robot/core/simulation/runner.h"
 
 using namespace sowing_robot::core;
 
@@ -124,13 +124,13 @@ TEST(Motor, BadParametersAndMotorsThatCannotMoveTheRobotAreRefused) {
   // The loop refuses such a set-up before it starts.
   Scenario sc;
   sc.duration = 0.1;
-  EstimatedRunConfig cfg;
+  LoopConfig cfg;
   cfg.traction = TractionParams{};
   cfg.traction->draft_force = 10.0;
   cfg.motor = m;
   LineReference line;
   try {
-    runEstimatedLoop(sc, cfg, line);
+    runClosedLoop(sc, cfg, line);
     ADD_FAILURE() << "not refused";
   } catch (const std::invalid_argument& ex) {
     EXPECT_NE(std::string(ex.what()).find("cannot move the robot"), std::string::npos) << ex.what();

@@ -22,8 +22,8 @@ namespace {
 
 /// The one closed loop (closed_loop.h) on the traction plant, fed its own state, with Kanayama and the
 /// sliding mode; tool_down: the tool held down (its draft acting) the whole run.
-EstimatedRunResult tractionRun(const Scenario& sc, const TractionParams& t, ReferenceSource& ref,
-                               const std::function<void(const LoopSample&)>& trace = {}, bool tool_down = false) {
+LoopResult tractionRun(const Scenario& sc, const TractionParams& t, ReferenceSource& ref,
+                       const std::function<void(const LoopSample&)>& trace = {}, bool tool_down = false) {
   SlipPlant plant{TractionPlant(sc.robot, sc.disturbance, t), sc.robot.R};
   plant.plant.setToolDown(tool_down);
   StateFeed feed;
@@ -158,7 +158,7 @@ TEST(Traction, ThesisLoopOnSoilAndIceStaysFiniteAndReportsSaturation) {
     TractionParams t;
     t.mu_peak = mu;
     t.mu_slide = 0.75 * mu;
-    const EstimatedRunResult r = tractionRun(sc, t, line);
+    const LoopResult r = tractionRun(sc, t, line);
     EXPECT_FALSE(r.run.diverged) << mu;
     EXPECT_TRUE(r.run.final_state.allFinite()) << mu;
     EXPECT_EQ(r.run.periods, sc.steps()) << mu;
@@ -178,7 +178,7 @@ TEST(Traction, ThesisLoopTracksOnLooseSoilWithASoilSizedTorqueLimit) {
   sc.sliding.max_torque = 4.0;
   LineReference line;
   double late = 0.0;
-  const EstimatedRunResult r = tractionRun(sc, TractionParams{}, line, [&](const LoopSample& s) {
+  const LoopResult r = tractionRun(sc, TractionParams{}, line, [&](const LoopSample& s) {
     if (s.t > 15.0) late = std::max(late, std::fabs(s.ey));
   });
   std::printf("max_torque 4: ISE y %.3f, max |ey| after 15 s %.4f m, saturated %lld periods\n",
@@ -250,7 +250,7 @@ TEST(Traction, ThesisLineMetricsApproachTodaysAsGripGrows) {
               today.metrics[AXIS_Y].itae, today.metrics[AXIS_THETA].ise);
   std::vector<double> rel;
   for (const Soil& s : soils) {
-    const EstimatedRunResult r = tractionRun(sc, grip(s.mu, s.k), line);
+    const LoopResult r = tractionRun(sc, grip(s.mu, s.k), line);
     ASSERT_FALSE(r.run.diverged) << s.name;
     const double d = std::fabs(r.run.metrics[AXIS_Y].ise - today.metrics[AXIS_Y].ise) / today.metrics[AXIS_Y].ise;
     std::printf("| %s | %g | %g | %.6g | %.6g | %.6g | %.3g | %.2e |\n", s.name, s.mu, s.k, r.run.metrics[AXIS_Y].ise,
@@ -575,7 +575,7 @@ TEST(TractionDraft, ClosedLoopAgainstAnInsurmountableDraftEndsAndReportsSaturati
   LineReference line;
   TractionParams t;
   t.draft_force = 300.0;
-  const EstimatedRunResult r = tractionRun(sc, t, line, {}, true);
+  const LoopResult r = tractionRun(sc, t, line, {}, true);
   EXPECT_FALSE(r.run.diverged);
   EXPECT_TRUE(r.run.final_state.allFinite());
   EXPECT_EQ(r.run.periods, sc.steps());

@@ -11,7 +11,7 @@
 #include "sowing_robot/core/evaluation/benchmark.h"
 #include "sowing_robot/core/evaluation/estimated_bench.h"
 #include "sowing_robot/core/simulation/closed_loop.h"
-#include "sowing_robot/core/simulation/estimated_run.h"
+#include "sowing_robot/core/simulation/runner.h"
 
 using namespace sowing_robot::core;
 
@@ -65,8 +65,8 @@ TEST(EstimatedRun, FedTheTruthItIsRunClosedLoopBitForBit) {
     SCOPED_TRACE(sc.controllerName());
     LineReference ref;
     const RunResult today = runClosedLoop(sc, ref, true);
-    EstimatedRunConfig cfg;  // ground_truth, no traction; the sensors run and are not looked at
-    const EstimatedRunResult est = runEstimatedLoop(sc, cfg, ref, true);
+    LoopConfig cfg;  // ground_truth, no traction; the sensors run and are not looked at
+    const LoopResult est = runClosedLoop(sc, cfg, ref, true);
     expectSameRun(est.run, today);
     EXPECT_TRUE(sameBits(est.run.metrics[AXIS_Y].settling_time, today.metrics[AXIS_Y].settling_time));
     EXPECT_LT(est.fed_error_max, 1e-12);  // the truth itself
@@ -93,28 +93,28 @@ TEST(EstimatedRun, FedTheTruthOnTheTractionPlantItIsTheLoopOnThePlantsOwnStateBi
   Kanayama outer(sc.kanayama);
   SlidingModeController inner(sc.sliding, sc.robot);
   const std::function<void(const LoopSample&)> no_trace;
-  const EstimatedRunResult today = closedLoop(sc, plant, state_feed, outer, inner, ref, true, no_trace, RunStop{});
-  EstimatedRunConfig cfg;
+  const LoopResult today = closedLoop(sc, plant, state_feed, outer, inner, ref, true, no_trace, RunStop{});
+  LoopConfig cfg;
   cfg.traction = t;
   cfg.patches = {wet};
-  const EstimatedRunResult est = runEstimatedLoop(sc, cfg, ref, true);
+  const LoopResult est = runClosedLoop(sc, cfg, ref, true);
   expectSameRun(est.run, today.run);
   EXPECT_TRUE(sameBits(est.max_abs_slip, today.max_abs_slip));
   EXPECT_GT(est.max_abs_slip, 0.0);
   // The patch is on the ground (without it the run differs).
-  EstimatedRunConfig bare = cfg;
+  LoopConfig bare = cfg;
   bare.patches.clear();
-  EXPECT_FALSE(sameBits(runEstimatedLoop(sc, bare, ref, true).run.metrics[AXIS_X].ise, today.run.metrics[AXIS_X].ise));
+  EXPECT_FALSE(sameBits(runClosedLoop(sc, bare, ref, true).run.metrics[AXIS_X].ise, today.run.metrics[AXIS_X].ise));
 }
 
 TEST(EstimatedRun, FedTheEkfOnTheLineItsErrorStaysBounded) {
   const Scenario sc = line(OuterKind::kanayama, InnerKind::sliding_mode, true, 0.0);
   Scenario longer = sc;
   longer.duration = 25.0;
-  EstimatedRunConfig cfg;
+  LoopConfig cfg;
   cfg.feedback = Feedback::fused;
   LineReference ref;
-  const EstimatedRunResult est = runEstimatedLoop(longer, cfg, ref, false);
+  const LoopResult est = runClosedLoop(longer, cfg, ref, false);
   ASSERT_FALSE(est.run.diverged);
   // The fix (sigma 2 cm at 10 Hz) bounds the estimate: a few centimetres, not metres.
   EXPECT_LT(est.fed_error_rms, 0.03) << est.fed_error_max;
@@ -132,44 +132,44 @@ TEST(EstimatedRun, OdometryDriftsUnderSlipAndNotWithout) {
   Scenario sc = line(OuterKind::kanayama, InnerKind::sliding_mode, true, 0.0);
   sc.duration = 10.0;
   LineReference ref;
-  EstimatedRunConfig dry;  // no-slip plant: only the quantisation
-  const EstimatedRunResult a = runEstimatedLoop(sc, dry, ref, false);
+  LoopConfig dry;  // no-slip plant: only the quantisation
+  const LoopResult a = runClosedLoop(sc, dry, ref, false);
   EXPECT_LT(a.odometry_error_max, 0.02);
-  EstimatedRunConfig wet;
+  LoopConfig wet;
   TractionParams t;
   t.enabled = true;
   t.mu_peak = 0.2;
   t.mu_slide = 0.15;
   wet.traction = t;
-  const EstimatedRunResult b = runEstimatedLoop(sc, wet, ref, false);
+  const LoopResult b = runClosedLoop(sc, wet, ref, false);
   EXPECT_GT(b.max_abs_slip, 0.1);
   EXPECT_GT(b.odometry_error_max, 10.0 * a.odometry_error_max);
   EXPECT_GT(b.odometry_error_max, 0.05);
   // Fed that odometry, the loop sees it and the truth pays.
   wet.feedback = Feedback::odometry;
-  const EstimatedRunResult c = runEstimatedLoop(sc, wet, ref, false);
+  const LoopResult c = runClosedLoop(sc, wet, ref, false);
   EXPECT_GT(c.fed_error_max, 0.05);
 }
 
 TEST(EstimatedRun, TheSensorSeedChangesTheSensorNoiseOnly) {
   const Scenario sc = line(OuterKind::kanayama, InnerKind::sliding_mode, true, 0.0);
   LineReference ref;
-  EstimatedRunConfig cfg;
+  LoopConfig cfg;
   cfg.sensors.encoder.noise = 0.3;  // every sensor draws
   cfg.sensors.seed = 1;
-  const EstimatedRunResult t1 = runEstimatedLoop(sc, cfg, ref, false);
+  const LoopResult t1 = runClosedLoop(sc, cfg, ref, false);
   cfg.sensors.seed = 2;
-  const EstimatedRunResult t2 = runEstimatedLoop(sc, cfg, ref, false);
+  const LoopResult t2 = runClosedLoop(sc, cfg, ref, false);
   // Fed the truth: the run is the same whatever the sensors draw; the odometry is not.
   expectSameRun(t1.run, t2.run);
   EXPECT_FALSE(sameBits(t1.odometry_error_max, t2.odometry_error_max));
   // Fed the estimate: the seed changes the run, and the same seed repeats it to the bit.
   cfg.feedback = Feedback::fused;
   cfg.sensors.seed = 1;
-  const EstimatedRunResult f1 = runEstimatedLoop(sc, cfg, ref, false);
-  const EstimatedRunResult f1again = runEstimatedLoop(sc, cfg, ref, false);
+  const LoopResult f1 = runClosedLoop(sc, cfg, ref, false);
+  const LoopResult f1again = runClosedLoop(sc, cfg, ref, false);
   cfg.sensors.seed = 2;
-  const EstimatedRunResult f2 = runEstimatedLoop(sc, cfg, ref, false);
+  const LoopResult f2 = runClosedLoop(sc, cfg, ref, false);
   expectSameRun(f1.run, f1again.run);
   EXPECT_TRUE(sameBits(f1.fed_error_rms, f1again.fed_error_rms));
   EXPECT_FALSE(sameBits(f1.run.metrics[AXIS_Y].ise, f2.run.metrics[AXIS_Y].ise));
@@ -179,19 +179,19 @@ TEST(EstimatedRun, TheSensorSeedChangesTheSensorNoiseOnly) {
 TEST(EstimatedRun, BadParametersAreRefusedNamingTheKey) {
   const Scenario sc = line(OuterKind::kanayama, InnerKind::sliding_mode);
   LineReference ref;
-  EstimatedRunConfig cfg;
+  LoopConfig cfg;
   cfg.sensors.fix.sigma = -1.0;
   try {
-    runEstimatedLoop(sc, cfg, ref);
+    runClosedLoop(sc, cfg, ref);
     FAIL();
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("sensors/fix/sigma"), std::string::npos) << e.what();
   }
-  cfg = EstimatedRunConfig();
+  cfg = LoopConfig();
   TractionParams t;
   t.mu_slide = 0.9;  // > mu_peak
   cfg.traction = t;
-  EXPECT_THROW(runEstimatedLoop(sc, cfg, ref), std::invalid_argument);
+  EXPECT_THROW(runClosedLoop(sc, cfg, ref), std::invalid_argument);
   Feedback f;
   EXPECT_NE(parseFeedback("fusde", f).find("ground_truth, odometry, fused"), std::string::npos);
   EXPECT_EQ(parseFeedback("odometry", f), "");
@@ -240,7 +240,7 @@ TEST(EstimatedBench, ATruthFedRowWithoutTractionIsTodaysRow) {
   for (BenchScenario b : {benchLine(), benchField()}) {
     SCOPED_TRACE(b.name);
     const std::vector<RunRow> today = runBenchmark(b, 3, 2);
-    b.realism = EstimatedRunConfig();
+    b.realism = LoopConfig();
     const std::vector<RunRow> through = runBenchmark(b, 3, 2);
     expectSameRows(through, today);
     EXPECT_TRUE(through[0].realism);
@@ -259,7 +259,7 @@ TEST(EstimatedBench, TheSensorSeedIsANewDrawThatLeavesTheOthersAlone) {
   EXPECT_NE(d0.sensor_seed, d0.noise_seed);
   // Fused runs repeat alone from their draws, on one or two threads.
   BenchScenario f = benchLine();
-  EstimatedRunConfig cfg;
+  LoopConfig cfg;
   cfg.feedback = Feedback::fused;
   f.realism = cfg;
   f.requires_models = {"estimated_pose"};
@@ -268,12 +268,12 @@ TEST(EstimatedBench, TheSensorSeedIsANewDrawThatLeavesTheOthersAlone) {
   EXPECT_EQ(estimatedBenchRow(f, 2).fed_error_rms, one[2].fed_error_rms);
   // Run 2's sensors are seeded by its draw 8: the same run alone with that seed, not with the table's seed 1.
   const RunDraw d2 = drawRun(f.spec, f.base, 2);
-  EstimatedRunConfig alone = cfg;
+  LoopConfig alone = cfg;
   alone.sensors.seed = d2.sensor_seed;
   LineReference ref(f.line_v_r, f.line_y, f.line_x0);
-  EXPECT_EQ(runEstimatedLoop(applyDraw(f.base, f.spec, d2), alone, ref, false).fed_error_rms, one[2].fed_error_rms);
+  EXPECT_EQ(runClosedLoop(applyDraw(f.base, f.spec, d2), alone, ref, false).fed_error_rms, one[2].fed_error_rms);
   alone.sensors.seed = 1;
-  EXPECT_NE(runEstimatedLoop(applyDraw(f.base, f.spec, d2), alone, ref, false).fed_error_rms, one[2].fed_error_rms);
+  EXPECT_NE(runClosedLoop(applyDraw(f.base, f.spec, d2), alone, ref, false).fed_error_rms, one[2].fed_error_rms);
   EXPECT_GT(one[0].fed_error_rms, 0.0);
   EXPECT_NE(runsCsvLines("s", "c", one, true).find("," + std::to_string(d0.sensor_seed) + ","), std::string::npos);
 }
@@ -284,7 +284,7 @@ TEST(EstimatedBench, RequiredModelsMustBeSwitchedOn) {
   EXPECT_NE(b.validate().find("traction is not enabled"), std::string::npos) << b.validate();
   b.requires_models = {"estimated_pose"};
   EXPECT_NE(b.validate().find("feedback is ground_truth"), std::string::npos) << b.validate();
-  b.realism = EstimatedRunConfig();
+  b.realism = LoopConfig();
   b.realism->feedback = Feedback::fused;
   EXPECT_EQ(b.validate(), "");
   b.requires_models = {"dry_soil"};
@@ -294,7 +294,7 @@ TEST(EstimatedBench, RequiredModelsMustBeSwitchedOn) {
 TEST(EstimatedBench, ARobotThatStallsOnThePatchIsNotFinished) {
   BenchScenario b = benchField();
   b.obstacles.clear();
-  EstimatedRunConfig cfg;
+  LoopConfig cfg;
   TractionParams t;
   t.enabled = true;
   t.draft_force = 60.0;  // a furrow opener in heavy soil
@@ -319,8 +319,8 @@ TEST(EstimatedBench, ARobotThatStallsOnThePatchIsNotFinished) {
 }
 
 // The thesis line's soil made wet (mu 0.2 / 0.15) on the traction plant, with the motors on.
-EstimatedRunConfig wetLineWithMotors() {
-  EstimatedRunConfig cfg;
+LoopConfig wetLineWithMotors() {
+  LoopConfig cfg;
   TractionParams wet;
   wet.mu_peak = 0.2;
   wet.mu_slide = 0.15;
@@ -336,13 +336,13 @@ EstimatedRunConfig wetLineWithMotors() {
 TEST(EstimatedRun, TractionControlKeepsTheWheelsNearThePeak) {
   Scenario sc = line(OuterKind::kanayama, InnerKind::sliding_mode, true);
   sc.duration = 8.0;
-  EstimatedRunConfig cfg = wetLineWithMotors();
+  LoopConfig cfg = wetLineWithMotors();
   LineReference ref;
-  const EstimatedRunResult bare = runEstimatedLoop(sc, cfg, ref, false);
+  const LoopResult bare = runClosedLoop(sc, cfg, ref, false);
   cfg.traction_control.enabled = true;
-  const EstimatedRunResult tc = runEstimatedLoop(sc, cfg, ref, false);
+  const LoopResult tc = runClosedLoop(sc, cfg, ref, false);
   cfg.speed_governor.enabled = true;
-  const EstimatedRunResult governed = runEstimatedLoop(sc, cfg, ref, false);
+  const LoopResult governed = runClosedLoop(sc, cfg, ref, false);
   std::printf("max slip: bare %.3f, traction control %.3f (slipping %.2f s), governed %.3f (slowest rate %.2f)\n",
               bare.max_abs_slip, tc.max_abs_slip, tc.traction_control_time, governed.max_abs_slip,
               governed.governor_min_rate);
@@ -352,7 +352,7 @@ TEST(EstimatedRun, TractionControlKeepsTheWheelsNearThePeak) {
   EXPECT_EQ(bare.governor_min_rate, 1.0);
   EXPECT_LT(governed.governor_min_rate, 1.0);
   cfg.traction_control.enabled = false;
-  EXPECT_THROW(runEstimatedLoop(sc, cfg, ref, false), std::invalid_argument);  // a governor needs the control
+  EXPECT_THROW(runClosedLoop(sc, cfg, ref, false), std::invalid_argument);  // a governor needs the control
 }
 
 // governed_time_back (the benchmark's field runs): a run the governor slowed lasts until the governed path
@@ -361,13 +361,13 @@ TEST(EstimatedRun, TractionControlKeepsTheWheelsNearThePeak) {
 TEST(EstimatedRun, AGovernedRunGetsTheTimeTheGovernorTookBack) {
   Scenario sc = line(OuterKind::kanayama, InnerKind::sliding_mode, true);
   sc.duration = 8.0;
-  EstimatedRunConfig cfg = wetLineWithMotors();
+  LoopConfig cfg = wetLineWithMotors();
   cfg.traction_control.enabled = true;
   cfg.speed_governor.enabled = true;
   LineReference plain_ref, back_ref;
-  const EstimatedRunResult plain = runEstimatedLoop(sc, cfg, plain_ref, false);
+  const LoopResult plain = runClosedLoop(sc, cfg, plain_ref, false);
   cfg.governed_time_back = true;
-  const EstimatedRunResult back = runEstimatedLoop(sc, cfg, back_ref, false);
+  const LoopResult back = runClosedLoop(sc, cfg, back_ref, false);
   std::printf(
       "governed: slowest rate %.2f; periods %ld without, %ld with the time back (duration %ld); path time "
       "%.3f s / %.3f s\n",
@@ -389,7 +389,7 @@ TEST(EstimatedRun, AGovernedRunGetsTheTimeTheGovernorTookBack) {
 TEST(EstimatedRun, TheHitchControlLiftsTheToolThroughAPatchTheDraftCannotBePulledAcross) {
   Scenario sc = line(OuterKind::kanayama, InnerKind::pid);
   sc.duration = 14.0;
-  EstimatedRunConfig cfg;
+  LoopConfig cfg;
   TractionParams t;
   t.draft_force = 25.0;
   cfg.traction = t;
@@ -405,9 +405,9 @@ TEST(EstimatedRun, TheHitchControlLiftsTheToolThroughAPatchTheDraftCannotBePulle
   cfg.traction_control.enabled = true;
   cfg.traction_control.raise_rate = 10.0;
   LineReference ref;
-  const EstimatedRunResult down = runEstimatedLoop(sc, cfg, ref, false);
+  const LoopResult down = runClosedLoop(sc, cfg, ref, false);
   cfg.hitch_control.enabled = true;
-  const EstimatedRunResult hitch = runEstimatedLoop(sc, cfg, ref, false);
+  const LoopResult hitch = runClosedLoop(sc, cfg, ref, false);
   std::printf("end x: tool kept down %.2f m, hitch %.2f m (raised %d times, %.2f m unsown, tool down %.1f s)\n",
               down.run.final_state[X], hitch.run.final_state[X], hitch.hitch_raises, hitch.unsown_distance,
               hitch.tool_down_time);
@@ -420,14 +420,14 @@ TEST(EstimatedRun, TheHitchControlLiftsTheToolThroughAPatchTheDraftCannotBePulle
   EXPECT_LT(hitch.unsown_distance, 14.0);
   EXPECT_LT(hitch.tool_down_time, down.tool_down_time);
   cfg.traction_control.enabled = false;
-  EXPECT_THROW(runEstimatedLoop(sc, cfg, ref, false), std::invalid_argument);
+  EXPECT_THROW(runClosedLoop(sc, cfg, ref, false), std::invalid_argument);
 }
 
 // The traction control's anti-windup reaches the inner loop: with it the run differs (the integrators
 // hold while a torque is held back), without it the run is the one of today's layers bit for bit.
 TEST(EstimatedRun, TheTractionControlsAntiWindupReachesTheInnerLoop) {
   Scenario sc = line(OuterKind::kanayama, InnerKind::pid);
-  EstimatedRunConfig cfg;
+  LoopConfig cfg;
   TractionParams wet;
   wet.mu_peak = 0.2;
   wet.mu_slide = 0.15;
@@ -435,10 +435,10 @@ TEST(EstimatedRun, TheTractionControlsAntiWindupReachesTheInnerLoop) {
   cfg.motor.enabled = true;
   cfg.traction_control.enabled = true;
   LineReference ref;
-  const EstimatedRunResult plain = runEstimatedLoop(sc, cfg, ref, false);
-  const EstimatedRunResult again = runEstimatedLoop(sc, cfg, ref, false);
+  const LoopResult plain = runClosedLoop(sc, cfg, ref, false);
+  const LoopResult again = runClosedLoop(sc, cfg, ref, false);
   expectSameRun(plain.run, again.run);
   cfg.traction_control.anti_windup = true;
-  const EstimatedRunResult held = runEstimatedLoop(sc, cfg, ref, false);
+  const LoopResult held = runClosedLoop(sc, cfg, ref, false);
   EXPECT_FALSE(sameBits(plain.run.final_state[X], held.run.final_state[X]));
 }

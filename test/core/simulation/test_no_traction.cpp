@@ -11,8 +11,8 @@
 #include "sowing_robot/core/control/traction_monitor.h"
 #include "sowing_robot/core/evaluation/benchmark.h"
 #include "sowing_robot/core/evaluation/estimated_bench.h"
-#include "sowing_robot/core/simulation/estimated_run.h"
 #include "sowing_robot/core/simulation/field_run.h"
+#include "sowing_robot/core/simulation/runner.h"
 
 using namespace sowing_robot::core;
 
@@ -27,7 +27,7 @@ constexpr double kPatchStart = 10.0;  ///< the no-grip patch covers the row from
 struct NoGrip {
   Scenario scenario;
   FieldParams field;
-  EstimatedRunConfig config;
+  LoopConfig config;
   explicit NoGrip(const std::string& pair, bool disturbance = false) {
     FieldRunSetup s;
     scenario = s.scenario;
@@ -59,7 +59,7 @@ struct NoGrip {
 };
 
 struct Verdict {
-  EstimatedRunResult result;
+  LoopResult result;
   double entered = -1.0;      ///< when the axle reached the patch [s]
   double last_t = 0.0;        ///< the last period run [s]
   double moved_after = 0.0;   ///< largest distance from the pose at the verdict [m]
@@ -74,7 +74,7 @@ Verdict run(const NoGrip& g) {
     double t, x, y, phi_r, phi_l;
   };
   std::vector<Sample> samples;
-  v.result = runEstimatedLoop(g.scenario, g.config, reference, false, [&](const EstimatedSample& es) {
+  v.result = runClosedLoop(g.scenario, g.config, reference, false, [&](const EstimatedSample& es) {
     const State& x = *es.loop->state;
     samples.push_back({es.loop->t, x[X], x[Y], x[PHI_R], x[PHI_L]});
     if (v.entered < 0.0 && x[X] >= kPatchStart) v.entered = es.loop->t;

@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "sowing_robot/core/simulation/estimated_run.h"
 #include "sowing_robot/core/simulation/field_run.h"
+#include "sowing_robot/core/simulation/runner.h"
 
 using namespace sowing_robot::core;
 
@@ -60,13 +60,13 @@ struct HoldFigures {
   bool diverged = false;
 };
 
-HoldFigures runStop(const StopRun& run, const EstimatedRunConfig& config = {},
+HoldFigures runStop(const StopRun& run, const LoopConfig& config = {},
                     const std::function<void(double, FieldReference&)>& on_step = {}) {
   FieldReference reference(run.field, run.obstacles);
   HoldFigures f;
   Eigen::Vector2d settled(0.0, 0.0);
   bool has_settled = false;
-  const EstimatedRunResult r = runEstimatedLoop(run.scenario, config, reference, false, [&](const EstimatedSample& es) {
+  const LoopResult r = runClosedLoop(run.scenario, config, reference, false, [&](const EstimatedSample& es) {
     const LoopSample& s = *es.loop;
     const State& x = *s.state;
     if (on_step) on_step(s.t, reference);
@@ -150,7 +150,7 @@ TEST(StopHold, FedTheEstimateItHoldsToTheEncodersResolution) {
   const double quantum = 2.0 * M_PI * Scenario().robot.R / 2048 / 0.01;
   for (const char* pair : {"kanayama+atsmc", "rpp+pid"}) {
     const StopRun run(pair, {{kRow, 3.0, 0.3}});
-    EstimatedRunConfig fused;
+    LoopConfig fused;
     fused.feedback = Feedback::fused;
     expectStandsStill(runStop(run, fused), run, std::string(pair) + ", fused feedback", quantum, 0.015);
   }

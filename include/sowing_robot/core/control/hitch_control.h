@@ -14,7 +14,7 @@
 //   - raised and the robot has travelled lower_after metres since the verdict last stood: lower.
 // The robot's travel (|v| dt of the fed twist) rather than time decides the lowering, so a robot that
 // stands still does not lower the tool into a patch it could not pull through. The rows the tool misses
-// while raised are unsown: the closed loop counts that distance (EstimatedRunResult::unsown_distance);
+// while raised are unsown: the closed loop counts that distance (LoopResult::unsown_distance);
 // the seed drill keeps its spacing by distance, so the seeds after the stretch fall where they would.
 #pragma once
 

@@ -5,7 +5,7 @@
 // Reproducibility: run i's k-th draw is splitmix64(splitmix64(splitmix64(base_seed) + i) + k), its top
 // 53 bits mapped to [0, 1) (k: 0 mass, 1 inertia, 2 amplitude, 3 phase, 4 noise seed (>> 33: the seed parameter is a
 // 31-bit int), 5-7 start x, y, theta offsets, 8 the sensors' seed (>> 33, as 4; used by scenarios with sensors in the
-// loop, estimated_run.h)), a counter-based generator, so a run depends on (base_seed, i) only: the
+// loop, runner.h)), a counter-based generator, so a run depends on (base_seed, i) only: the
 // rows are bit-identical whatever the thread count and order, and any run can be repeated alone from its row.
 #pragma once
 
@@ -19,7 +19,6 @@
 
 #include "sowing_robot/core/common/reference.h"
 #include "sowing_robot/core/planning/sine_reference.h"
-#include "sowing_robot/core/simulation/estimated_run.h"
 #include "sowing_robot/core/simulation/field_run.h"
 #include "sowing_robot/core/simulation/metrics.h"
 #include "sowing_robot/core/simulation/runner.h"
@@ -139,9 +138,9 @@ struct BenchScenario {
   double finish_tolerance = 0.5;
   double envelope_period = 0.1;  ///< period of RunRow::cross_track_series [s] (> 0)
   /// Issue 16 in the benchmark (scenario keys traction:, sensors:, estimator:, feedback:): set, every run goes
-  /// through runEstimatedLoop with this plant, these sensors (their seed replaced by the run's draw 8) and
+  /// through runClosedLoop with this plant, these sensors (their seed replaced by the run's draw 8) and
   /// this feedback, scored on the truth (estimated_bench.h); unset, today's runClosedLoop.
-  std::optional<EstimatedRunConfig> realism;
+  std::optional<LoopConfig> realism;
   /// Models the scenario declares it needs (`requires:`): each must be one of availableModels() and be
   /// switched on by the scenario ("wet_soil": realism with traction; "estimated_pose": realism with
   /// feedback odometry or fused). The extension point for models not built yet: a name announced but

@@ -1,5 +1,5 @@
 // The benchmark's runs of scenarios with sensors, traction or an estimate in the loop (issue 17 item 2,
-// wet_soil and estimated_pose; BenchScenario::realism): one run of runBenchmark through runEstimatedLoop,
+// wet_soil and estimated_pose; BenchScenario::realism): one run of runBenchmark through runClosedLoop,
 // measured and judged as today's runs are (benchmark.cpp's measure(): effort, chattering, time at the
 // limit, cross-track after settle_time, body contacts and the finish check of a field), on the TRUTH,
 // plus the figures of the estimated loop (slip, the fed pose's error, the fixes). Kept beside
@@ -17,7 +17,7 @@ namespace sowing_robot {
 namespace core {
 
 /// Run `index` of `bench` (bench.realism set): the run's draws (benchmark.h; sensors/seed from draw 8),
-/// the scenario's track, runEstimatedLoop, the row. Throws std::invalid_argument for a bad scenario.
+/// the scenario's track, runClosedLoop, the row. Throws std::invalid_argument for a bad scenario.
 RunRow estimatedBenchRow(const BenchScenario& bench, std::int64_t index);
 
 /// BenchScenario::validate()'s part for realism and requires_models: "" or one line.

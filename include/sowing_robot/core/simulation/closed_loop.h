@@ -1,9 +1,9 @@
 // The one closed loop of the core: a plant, a feedback source, an outer and an inner controller and a
 // reference, stepped period by period in the order the node pipeline steps them in lockstep, so that
 // the in-process runs and the nodes give the same numbers. Every in-process run goes through it:
-// runClosedLoop (runner.h: the no-slip plant, fed its own state), runEstimatedLoop (estimated_run.h:
-// either plant, fed the state, the encoders or the EKF), and through them the benchmark, the tuner, the
-// field runs and the Python module. Its types are loop_types.h's, its feedback sources sensor_feeds.h's;
+// runClosedLoop (runner.h: the no-slip plant fed its own state, or with a LoopConfig either plant, fed the
+// state, the encoders or the EKF), and through it the benchmark, the tuner, the field runs and the Python
+// module. Its types are loop_types.h's, its feedback sources sensor_feeds.h's;
 // it includes none of its callers.
 //
 // Period k, t_k = k * period (secondsFromNanos, as ros::Time::toSec):
@@ -101,7 +101,7 @@ struct LoopLayers {
   HitchControl* hitch = nullptr;                ///< raises the tool on the traction control's grip verdict
   TractionMonitor* monitor = nullptr;           ///< the traction control's progress check (needs it)
   /// With the governor: the run lasts until the governed time has run the scenario's duration, at most twice
-  /// its duration (EstimatedRunConfig::governed_time_back).
+  /// its duration (LoopConfig::governed_time_back).
   bool governed_time_back = false;
   /// Traction plant: a period after which either wheel's |slip ratio| exceeds this counts to high_slip_time.
   double high_slip = std::numeric_limits<double>::infinity();
@@ -134,9 +134,9 @@ inline void emit(RunTally& tally, const LoopSample& s, const Fed&, double, doubl
 /// Runs scenario `sc` (its timing, start, disturbance phase) on `plant` (constructed, not yet reset) with
 /// the given feedback, controllers and reference; see the file comment for the order of a period.
 template <typename PlantT, typename Feed, typename Outer, typename Inner, typename Trace>
-EstimatedRunResult closedLoop(const Scenario& sc, PlantT& plant, Feed& feed, Outer& outer, Inner& inner,
-                              ReferenceSource& reference, bool keep_samples, Trace& trace, const RunStop& stop,
-                              const LoopLayers& layers = {}) {
+LoopResult closedLoop(const Scenario& sc, PlantT& plant, Feed& feed, Outer& outer, Inner& inner,
+                      ReferenceSource& reference, bool keep_samples, Trace& trace, const RunStop& stop,
+                      const LoopLayers& layers = {}) {
   plant.reset(startState(sc), phaseStartTime(sc));
   reference.reset();
   feed.start(plant.state());
@@ -149,7 +149,7 @@ EstimatedRunResult closedLoop(const Scenario& sc, PlantT& plant, Feed& feed, Out
   const double dt = secondsFromNanos(sc.control_period_ns);
   MetricsAccumulator metrics(keep_samples);
   metrics.reserve(static_cast<std::size_t>(n + 1));
-  EstimatedRunResult out;
+  LoopResult out;
   RunResult& result = out.run;
   StandstillHold hold(sc.hold, sc.robot, sc.innerMaxTorque());
   bool holding = false;

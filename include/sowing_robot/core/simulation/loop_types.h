@@ -1,8 +1,8 @@
 // The closed loop's types, a floor below everything that runs it: the scenario (Scenario), what one
 // period looks like to a trace (LoopSample, EstimatedSample), the per-period tally (RunTally), what a run
-// returns (RunResult, EstimatedRunResult), and what the loop adds to a scenario beyond the controllers
-// (EstimatedRunConfig: the plant, the sensors and the feedback source). closed_loop.h (the loop body),
-// runner.h and estimated_run.h (its entry points) and every caller include this header; it includes
+// returns (RunResult, LoopResult), and what the loop adds to a scenario beyond the controllers
+// (LoopConfig: the plant, the sensors and the feedback source). closed_loop.h (the loop body),
+// runner.h (its entry point) and every caller include this header; it includes
 // nothing of theirs.
 #pragma once
 
@@ -188,7 +188,7 @@ const char* feedbackName(Feedback f);
 std::string parseFeedback(const std::string& name, Feedback& out);
 
 /// Everything the estimated loop adds to a Scenario.
-struct EstimatedRunConfig {
+struct LoopConfig {
   Feedback feedback = Feedback::ground_truth;
   /// Set: the traction plant with these parameters (its `enabled` is not looked at); unset: the no-slip Plant.
   std::optional<TractionParams> traction;
@@ -235,7 +235,7 @@ struct EstimatedSample {
   const LoopLayers* layers = nullptr;
 };
 
-struct EstimatedRunResult {
+struct LoopResult {
   RunResult run;              ///< metrics on the truth
   double max_abs_slip = 0.0;  ///< traction: largest |slip ratio| of either wheel after a step
   /// Traction: time either wheel's |slip ratio| was above twice the friction peak's (traction/slip_peak) [s].

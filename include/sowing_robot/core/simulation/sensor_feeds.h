@@ -1,7 +1,7 @@
 // The closed loop's feedback sources (closed_loop.h's Feed): what the controllers are fed each period.
 //   StateFeed:  the plant's own state (perfect sensing, no sensors run).
 //   SensorFeed: the plant's sensors (SensorSuite) and state_estimator's filter: the controllers are fed the
-//               truth, the encoder odometry or the EKF's estimate (EstimatedRunConfig::feedback).
+//               truth, the encoder odometry or the EKF's estimate (LoopConfig::feedback).
 // SensorSuite is the set of sensors the plant carries (model/sensors.h), read on the true state: the same
 // class plant_sim publishes from (ros/plant_sim/sensors.h), so the in-process loop and the node pipeline
 // read them in one way. A new sensor: its class in model/sensors.*, a member of SensorSuite read in
@@ -36,7 +36,7 @@ struct StateFeed {
     return {truth, s[V], s[OMEGA], {wheel_right, wheel_left, s[V], s[OMEGA]}};
   }
   void afterStep(std::int64_t, const State&) {}
-  void finish(EstimatedRunResult&) const {}
+  void finish(LoopResult&) const {}
 };
 
 /// The sensors the plant carries, read on its true state: the wheel encoders' dead reckoning (nominal R,
@@ -83,7 +83,7 @@ class SensorSuite {
 /// against the truth.
 class SensorFeed {
  public:
-  SensorFeed(const Scenario& sc, const EstimatedRunConfig& cfg)
+  SensorFeed(const Scenario& sc, const LoopConfig& cfg)
       : cfg_(cfg),
         period_ns_(sc.control_period_ns),
         L_(sc.robot.L),
@@ -132,7 +132,7 @@ class SensorFeed {
     sensors_.update(secondsFromNanos(k * period_ns_), s, dt_);
   }
 
-  void finish(EstimatedRunResult& out) const {
+  void finish(LoopResult& out) const {
     out.odometry_error_final = odometry_error_final_;
     out.odometry_error_max = odometry_error_max_;
     out.fed_heading_error_max = fed_heading_error_max_;
@@ -176,7 +176,7 @@ class SensorFeed {
     last_odom_ = odom_pose;
   }
 
-  const EstimatedRunConfig& cfg_;
+  const LoopConfig& cfg_;
   const std::int64_t period_ns_;
   const double L_;  // nominal half track [m]
   const double dt_;

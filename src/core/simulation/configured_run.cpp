@@ -1,4 +1,4 @@
-#include "sowing_robot/core/simulation/estimated_run.h"
+#include "sowing_robot/core/simulation/runner.h"
 
 #include <algorithm>
 #include <cmath>
@@ -19,7 +19,7 @@ namespace {
 /// What the simulation knows beyond the measurements at a no-traction verdict: the grip budget of the soil
 /// under the robot there (no slip: nothing to say).
 template <typename PlantT>
-std::string gripDiagnosis(const Scenario& sc, const EstimatedRunConfig& cfg, const PlantT& plant, const Pose2D& where) {
+std::string gripDiagnosis(const Scenario& sc, const LoopConfig& cfg, const PlantT& plant, const Pose2D& where) {
   if constexpr (!PlantT::kTraction) {
     return "";
   } else {
@@ -29,8 +29,8 @@ std::string gripDiagnosis(const Scenario& sc, const EstimatedRunConfig& cfg, con
 }
 
 template <typename PlantT>
-EstimatedRunResult run(const Scenario& sc, const EstimatedRunConfig& cfg, PlantT& plant, ReferenceSource& reference,
-                       bool keep_samples, const std::function<void(const EstimatedSample&)>& trace) {
+LoopResult run(const Scenario& sc, const LoopConfig& cfg, PlantT& plant, ReferenceSource& reference, bool keep_samples,
+               const std::function<void(const EstimatedSample&)>& trace) {
   plant.plant.setMotor(cfg.motor);
   std::unique_ptr<OuterController> outer = makeOuterController(sc);
   std::unique_ptr<InnerController> inner = makeInnerController(sc, sc.robot);
@@ -64,8 +64,8 @@ EstimatedRunResult run(const Scenario& sc, const EstimatedRunConfig& cfg, PlantT
     layers.governor = &*governed;
     layers.governed_time_back = cfg.governed_time_back;
   }
-  EstimatedRunResult out = closedLoop(sc, plant, feed, *outer, *inner, governed ? *governed : reference, keep_samples,
-                                      trace, RunStop{}, layers);
+  LoopResult out = closedLoop(sc, plant, feed, *outer, *inner, governed ? *governed : reference, keep_samples, trace,
+                              RunStop{}, layers);
   if (hitch) out.hitch_raises = hitch->raises();
   if (out.no_traction.detected) out.no_traction.diagnosis = gripDiagnosis(sc, cfg, plant, out.no_traction.where);
   return out;
@@ -73,8 +73,8 @@ EstimatedRunResult run(const Scenario& sc, const EstimatedRunConfig& cfg, PlantT
 
 }  // namespace
 
-EstimatedRunResult runEstimatedLoop(const Scenario& sc, const EstimatedRunConfig& cfg, ReferenceSource& reference,
-                                    bool keep_samples, const std::function<void(const EstimatedSample&)>& trace) {
+LoopResult runClosedLoop(const Scenario& sc, const LoopConfig& cfg, ReferenceSource& reference, bool keep_samples,
+                         const std::function<void(const EstimatedSample&)>& trace) {
   std::string e = firstError({sc.validate(), cfg.validate()});
   if (e.empty() && cfg.traction) {  // the motors against the heaviest going: the worst soil's rolling resistance
     double rolling = cfg.traction->rolling_resistance;
