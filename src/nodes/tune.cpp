@@ -8,7 +8,7 @@
 //        [--progress FILE.csv] [--threads N] [--stop-after K]
 //   mpirun -np N tune --config FILE ...      (rosrun sowing_robot tune ... works the same)
 //
-// --config: config/tune.yaml's format (bench/tune_config.h: the pso_tuner block of config/pso.yaml plus the
+// --config: config/tune.yaml's format (scenario_file/tune_config.h: the pso_tuner block of config/pso.yaml plus the
 // base scenario; with a robust: block, robust tuning over a training set of benchmark scenarios,
 // core/evaluation/robust_tuning.h, whose runs the farm hands out one by one). --controller: the pair tuned,
 // in place of the file's pso_tuner/controller (scripts/tune_pairs --robust). --output: the gains YAML (default
@@ -33,11 +33,11 @@
 #include <string>
 #include <vector>
 
-#include "sowing_robot/bench/tune_config.h"
 #include "sowing_robot/cli/usage.h"
 #include "sowing_robot/core/evaluation/checkpoint.h"
 #include "sowing_robot/core/evaluation/tuning.h"
 #include "sowing_robot/farm/farm.h"
+#include "sowing_robot/scenario_file/tune_config.h"
 
 using namespace sowing_robot;
 using core::TuningCost;

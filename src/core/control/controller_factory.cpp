@@ -16,6 +16,7 @@ struct OuterEntry {
   OuterKind kind;
   std::unique_ptr<OuterController> (*make)(const ControllerPair&);
   std::vector<ControllerParam> (*params)();
+  std::string (*validate)(const ControllerPair&);  ///< its parameters' own checks beyond the table's ranges
 };
 
 struct InnerEntry {
@@ -23,6 +24,7 @@ struct InnerEntry {
   InnerKind kind;
   std::unique_ptr<InnerController> (*make)(const ControllerPair&, const RobotParams&);
   std::vector<ControllerParam> (*params)();
+  std::string (*validate)(const ControllerPair&);
 };
 
 bool always(const ControllerPair&, const std::string&) { return true; }
@@ -73,19 +75,20 @@ std::unique_ptr<InnerController> inner(Args&&... args) {
 
 const OuterEntry kOuter[] = {
     {"kanayama", OuterKind::kanayama, [](const ControllerPair& p) { return outer<Kanayama>(p.kanayama); },
-     kanayamaParams},
+     kanayamaParams, [](const ControllerPair& p) { return p.kanayama.validate(); }},
     {"pure_pursuit", OuterKind::pure_pursuit,
-     [](const ControllerPair& p) { return outer<PurePursuit>(p.pure_pursuit, false); }, purePursuitParams},
+     [](const ControllerPair& p) { return outer<PurePursuit>(p.pure_pursuit, false); }, purePursuitParams,
+     [](const ControllerPair& p) { return p.pure_pursuit.validate(); }},
     {"rpp", OuterKind::rpp, [](const ControllerPair& p) { return outer<PurePursuit>(p.pure_pursuit, true); },
-     purePursuitParams},
+     purePursuitParams, [](const ControllerPair& p) { return p.pure_pursuit.validate(); }},
 };
 
 const InnerEntry kInner[] = {
     {"sliding_mode", InnerKind::sliding_mode,
      [](const ControllerPair& p, const RobotParams& r) { return inner<SlidingModeController>(p.sliding, r); },
-     slidingParams},
+     slidingParams, [](const ControllerPair& p) { return p.sliding.validate(); }},
     {"pid", InnerKind::pid, [](const ControllerPair& p, const RobotParams& r) { return inner<WheelPid>(p.pid, r); },
-     pidParams},
+     pidParams, [](const ControllerPair& p) { return p.pid.validate(); }},
 };
 
 const OuterEntry& entry(OuterKind k) {
@@ -106,9 +109,8 @@ std::string ControllerPair::controllerName() const {
 }
 
 std::string ControllerPair::validateControllers() const {
-  return firstError({kanayama.validate(), sliding.validate(),
-                     outer == OuterKind::kanayama ? "" : pure_pursuit.validate(),
-                     inner == InnerKind::pid ? pid.validate() : ""});
+  return firstError(
+      {kanayama.validate(), sliding.validate(), entry(outer).validate(*this), entry(inner).validate(*this)});
 }
 
 const char* outerName(OuterKind k) {

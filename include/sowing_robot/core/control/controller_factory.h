@@ -82,23 +82,37 @@ std::unique_ptr<OuterController> makeOuterController(const ControllerPair& pair)
 std::unique_ptr<InnerController> makeInnerController(const ControllerPair& pair, const RobotParams& nominal);
 
 /// Calls f(outer, inner) with the pair's controllers as concrete types, so that a loop templated on them
-/// makes direct calls (the hot loop: simulation/runner.cpp); returns what f returns.
+/// makes direct calls (the hot loop: simulation/runner.cpp); returns what f returns. A registered controller
+/// without a case here is handed over behind its run-time interface (virtual calls, same numbers).
 template <typename F>
 decltype(auto) withControllers(const ControllerPair& pair, const RobotParams& nominal, F&& f) {
   auto with_inner = [&](auto& outer) -> decltype(auto) {
-    if (pair.inner == InnerKind::pid) {
-      InnerAdapter<WheelPid> pid{WheelPid(pair.pid, nominal)};
-      return f(outer, pid);
+    switch (pair.inner) {
+      case InnerKind::pid: {
+        InnerAdapter<WheelPid> pid{WheelPid(pair.pid, nominal)};
+        return f(outer, pid);
+      }
+      case InnerKind::sliding_mode: {
+        SlidingModeController smc(pair.sliding, nominal);
+        return f(outer, smc);
+      }
     }
-    SlidingModeController smc(pair.sliding, nominal);
-    return f(outer, smc);
+    const std::unique_ptr<InnerController> inner = makeInnerController(pair, nominal);
+    return f(outer, *inner);
   };
-  if (pair.outer == OuterKind::kanayama) {
-    Kanayama kanayama(pair.kanayama);
-    return with_inner(kanayama);
+  switch (pair.outer) {
+    case OuterKind::kanayama: {
+      Kanayama kanayama(pair.kanayama);
+      return with_inner(kanayama);
+    }
+    case OuterKind::pure_pursuit:
+    case OuterKind::rpp: {
+      PurePursuit pursuit(pair.pure_pursuit, pair.outer == OuterKind::rpp);
+      return with_inner(pursuit);
+    }
   }
-  PurePursuit pursuit(pair.pure_pursuit, pair.outer == OuterKind::rpp);
-  return with_inner(pursuit);
+  const std::unique_ptr<OuterController> outer = makeOuterController(pair);
+  return with_inner(*outer);
 }
 
 }  // namespace core

@@ -1,4 +1,4 @@
-// The benchmark's scenario files and tuned gains (bench/scenario_loader.h): every suite file loads, a typo or
+// The benchmark's scenario files and tuned gains (scenario_file/scenario_loader.h): every suite file loads, a typo or
 // a missing key is refused naming it, tuned gains go through the parameter tables, and a field scenario's
 // success counts the body's contacts with the obstacles (core::runBenchmark).
 #include <gtest/gtest.h>
@@ -12,14 +12,14 @@
 #include <stdexcept>
 #include <string>
 
-#include "sowing_robot/bench/scenario_loader.h"
 #include "sowing_robot/core/evaluation/bench_row.h"
+#include "sowing_robot/scenario_file/scenario_loader.h"
 
 using namespace sowing_robot;
 using core::BenchScenario;
 using core::TrackKind;
 
-#include "../../common/test_files.h"
+#include "../common/test_files.h"
 
 using sowing_robot::test::readFile;
 using sowing_robot::test::TempDir;

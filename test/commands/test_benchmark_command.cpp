@@ -13,7 +13,7 @@
 #include <regex>
 #include <string>
 
-#include "../../common/test_files.h"
+#include "../common/test_files.h"
 
 using sowing_robot::test::exists;
 using sowing_robot::test::readFile;

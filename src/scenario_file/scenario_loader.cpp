@@ -1,4 +1,4 @@
-#include "sowing_robot/bench/scenario_loader.h"
+#include "sowing_robot/scenario_file/scenario_loader.h"
 
 #include <sys/stat.h>
 
@@ -16,7 +16,6 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include "sowing_robot/bench/yaml_reading.h"
 #include "sowing_robot/core/common/validation.h"
 #include "sowing_robot/core/control/kanayama.h"
 #include "sowing_robot/core/control/pure_pursuit.h"
@@ -31,6 +30,7 @@
 #include "sowing_robot/core/planning/field.h"
 #include "sowing_robot/core/settings/node_settings.h"
 #include "sowing_robot/core/simulation/runner.h"
+#include "sowing_robot/scenario_file/yaml_reading.h"
 
 namespace sowing_robot {
 namespace bench {

@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "core_bindings.h"
-#include "sowing_robot/bench/scenario_loader.h"
 #include "sowing_robot/core/simulation/runner.h"
+#include "sowing_robot/scenario_file/scenario_loader.h"
 
 namespace py_core {
 namespace {

@@ -1,4 +1,4 @@
-#include "sowing_robot/bench/tune_config.h"
+#include "sowing_robot/scenario_file/tune_config.h"
 
 #include <yaml-cpp/yaml.h>
 
@@ -10,12 +10,12 @@
 #include <set>
 #include <stdexcept>
 
-#include "sowing_robot/bench/scenario_loader.h"
-#include "sowing_robot/bench/yaml_reading.h"
 #include "sowing_robot/core/common/validation.h"
 #include "sowing_robot/core/control/controller_factory.h"
 #include "sowing_robot/core/model/plant.h"
 #include "sowing_robot/core/settings/node_settings.h"
+#include "sowing_robot/scenario_file/scenario_loader.h"
+#include "sowing_robot/scenario_file/yaml_reading.h"
 
 namespace sowing_robot {
 namespace bench {
