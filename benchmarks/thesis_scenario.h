@@ -1,7 +1,5 @@
-// The thesis scenario shared by core_bench and alloc_check (same as pso_tuning_bench): 25 s at 1 kHz,
-// start (-1, 0, 0), line x = t, y = 3 at 1 m/s, sinusoidal wheel disturbance (A 2.75 N·m, w 3 rad/s),
-// plant 20 % heavier than the controllers' model; optionally the potential field with the thesis's
-// three obstacles (20, 3), (50, 3), (80, 3), radius 0.3 m (config/field_thesis.yaml).
+// A hand copy of the closed loop's body (without the standstill hold, command limiter and traction layers),
+// kept only for core_bench's BM_HandCopyRun25s: the real loop measured against it before the copy goes.
 #pragma once
 
 #include <vector>
@@ -12,21 +10,6 @@
 
 namespace sowing_robot {
 namespace bench {
-
-inline core::Scenario thesisScenario() {
-  core::Scenario sc;
-  sc.disturbance.sinusoidal = true;
-  sc.disturbance.mass_scale = sc.disturbance.inertia_scale = 1.2;
-  return sc;
-}
-
-inline core::LineReference thesisLine() { return core::LineReference(1.0, 3.0, 0.0); }
-
-inline core::PotentialField thesisPotentialField() {
-  core::RowLine row;  // x0 = 0, y0 = 3, heading 0, speed 1 m/s
-  return core::PotentialField(core::PotentialFieldParams{}, row,
-                              std::vector<core::Obstacle>{{20.0, 3.0, 0.3}, {50.0, 3.0, 0.3}, {80.0, 3.0, 0.3}});
-}
 
 /// The body of runClosedLoop's loop, with its state carried from one call to the next (restarts after
 /// the scenario's last step so the trajectory stays the thesis one however many steps are run).
