@@ -35,7 +35,6 @@
 #include "sowing_robot/core/model/plant.h"
 #include "sowing_robot/core/simulation/estimated_run.h"
 #include "sowing_robot/core/simulation/runner.h"
-#include "thesis_scenario.h"
 
 using namespace sowing_robot;
 using namespace sowing_robot::core;
@@ -95,19 +94,6 @@ void BM_ThesisRun25s(benchmark::State& state) {
   wholeRuns(state, sc, "itae_y", [&] { return runClosedLoop(sc, ref, false).metrics[AXIS_Y].itae; });
 }
 BENCHMARK(BM_ThesisRun25s)->Unit(benchmark::kMillisecond);
-
-// The hand copy of the loop's body the benchmarks used to measure (thesis_scenario.h), the same scenario and
-// number of plant steps: kept only to compare the real loop against it.
-void BM_HandCopyRun25s(benchmark::State& state) {
-  const Scenario sc = bench::thesisScenario();
-  LineReference ref = bench::thesisLine();
-  wholeRuns(state, sc, "x_end", [&] {
-    bench::ControlLoop loop(sc, ref);
-    for (std::int64_t k = 0; k < sc.steps(); ++k) loop.step();
-    return loop.plant().state()[X];
-  });
-}
-BENCHMARK(BM_HandCopyRun25s)->Unit(benchmark::kMillisecond);
 
 void BM_ThesisRun25sTally(benchmark::State& state) {
   const Scenario sc = bench::thesisScenario();
