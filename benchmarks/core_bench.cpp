@@ -1,36 +1,47 @@
-// core_bench: Google Benchmark figures of the ROS-free core (issue 8). Figures only, never a pass/fail.
+// core_bench: Google Benchmark figures of the ROS-free core. Figures only, never a pass/fail. Every run goes
+// through the product's entry points (runClosedLoop, runEstimatedLoop: the one loop of closed_loop.h).
 //   core_bench [--benchmark_min_time=0.2] [--benchmark_filter=Thesis] ...
 // BM_PlantRk4Step            one Plant::step (RK4, sinusoidal disturbance on)
-// BM_ControlStep             one period of runClosedLoop's loop: reference next + Kanayama + SMC + plant
-// BM_ThesisRun25s            runClosedLoop of the 25 s thesis scenario at 1 kHz (keep_samples = false);
+// BM_ThesisRun25s            runClosedLoop of the 25 s thesis scenario at 1 kHz, every layer off (the no-slip
+//                            plant fed its own state, no trace, keep_samples = false: the tuner's run);
 //                            items/s = control steps/s
-// BM_ThesisRun25sTimeDomain  same with the time-domain figures (keep_samples = true: streaming, O(1) memory)
+// BM_ThesisRun25sTally       the same as the benchmark command runs it: keep_samples = true and a RunTally
+// BM_ThesisRun25sTimeDomain  keep_samples = true (streaming time-domain figures), no trace
+// BM_ThesisRun25sEstimated   the same run through runEstimatedLoop, every layer off (no-slip plant, truth fed:
+//                            the sensors run unused, the controllers behind their run-time interfaces)
 // BM_MonteCarlo1000Runs/threads:N  runMonteCarlo of 1,000 seeded runs of the thesis line, kanayama+atsmc,
-//                            every metric (mc_benchmark's work without the files), N threads; wall time
-// BM_ThesisRun25sTraction    same with the traction plant (TractionParams defaults), issue 16's cost case
-// BM_ThesisRun25sDriveTrain/layers:N  the traction run with the DC motors (1) and traction control too (2)
-// BM_ThesisRunPotentialField same with the potential-field reference (obstacles (20,3), (50,3), (80,3))
+//                            every metric (the benchmark command's work without the files), N threads; wall time
+// BM_ThesisRun25sTraction    runEstimatedLoop on the traction plant (TractionParams defaults), truth fed back
+// BM_ThesisRun25sDriveTrain/layers:N  the traction run with the DC motors (1) and traction control too (2, the
+//                            table's; 3, the field profile's values)
+// BM_FieldProfileRun25s/feedback:F  the thesis run with config/profiles/field.yaml's layers read from the file
+//                            (traction plant, motors, command limits, traction control, speed governor, hitch
+//                            control) and its tuned gains; F 0: the profile's feedback (fused, slip-aware EKF),
+//                            1: the truth fed back (the layers alone)
+// BM_WetLineFieldProfileRow  one row of `benchmark --scenarios wet_line --profile field` (run 0): the seed
+//                            drill's tool down with a 10 N draft on wet soil, so the tool rule and hitch act
+// BM_ThesisRunPotentialField runClosedLoop with the potential-field reference (obstacles (20,3), (50,3), (80,3))
 // BM_PsoIteration/threads:N  one PSO iteration: 20 particles evaluated on the thesis scenario (ITAE,
 //                            default gain box), N evaluation threads; wall time (UseRealTime)
 #include <benchmark/benchmark.h>
 
-#include <optional>
 #include <vector>
 
+#include "scenarios.h"
 #include "sowing_robot/core/evaluation/benchmark.h"
+#include "sowing_robot/core/evaluation/estimated_bench.h"
 #include "sowing_robot/core/evaluation/pso.h"
 #include "sowing_robot/core/evaluation/tuning.h"
 #include "sowing_robot/core/model/plant.h"
-#include "sowing_robot/core/simulation/closed_loop.h"
+#include "sowing_robot/core/simulation/estimated_run.h"
 #include "sowing_robot/core/simulation/runner.h"
-#include "thesis_scenario.h"
 
 using namespace sowing_robot;
 using namespace sowing_robot::core;
 
 namespace {
 
-volatile double g_sink = 0.0;  // keeps results alive (see thesisRun)
+volatile double g_sink = 0.0;  // keeps results alive (see BM_ThesisRun25s)
 
 void BM_PlantRk4Step(benchmark::State& state) {
   const Scenario sc = bench::thesisScenario();
@@ -55,56 +66,66 @@ void BM_PlantRk4Step(benchmark::State& state) {
 }
 BENCHMARK(BM_PlantRk4Step);
 
-void BM_ControlStep(benchmark::State& state) {
-  const Scenario sc = bench::thesisScenario();
-  LineReference ref = bench::thesisLine();
-  bench::ControlLoop loop(sc, ref);
-  for (auto _ : state) {
-    loop.step();
-    benchmark::DoNotOptimize(loop.plant().state().data());
-    benchmark::ClobberMemory();
-  }
-  state.SetItemsProcessed(state.iterations());
-}
-BENCHMARK(BM_ControlStep);
-
-void thesisRun(benchmark::State& state, ReferenceSource& ref) {
-  const Scenario sc = bench::thesisScenario();
+// Runs `run` (one whole run, returning the figure kept as a counter) per iteration; items = control steps.
+template <typename Run>
+void wholeRuns(benchmark::State& state, const Scenario& sc, const char* counter, Run&& run) {
   // A volatile sink, not DoNotOptimize(double&): libbenchmark 1.7's "+m,r" constraint can corrupt a
   // double under GCC -O3 (fixed upstream in 1.8).
-  volatile double itae = 0.0;
-  for (auto _ : state) {
-    const RunResult r = runClosedLoop(sc, ref, false);
-    itae = r.metrics[AXIS_Y].itae;
-  }
+  volatile double figure = 0.0;
+  for (auto _ : state) figure = run();
   // States are evaluated at k = 0..steps(); steps() plant steps per run.
   state.SetItemsProcessed(state.iterations() * sc.steps());
-  state.counters["itae_y"] = benchmark::Counter(itae, benchmark::Counter::kDefaults);
+  state.counters[counter] = benchmark::Counter(figure, benchmark::Counter::kDefaults);
+}
+
+// A benchmark that reads config files: one that does not read skips the benchmark with its message.
+template <typename Body>
+void guarded(benchmark::State& state, Body&& body) {
+  try {
+    body();
+  } catch (const std::exception& e) {
+    state.SkipWithError(e.what());
+  }
 }
 
 void BM_ThesisRun25s(benchmark::State& state) {
+  const Scenario sc = bench::thesisScenario();
   LineReference ref = bench::thesisLine();
-  thesisRun(state, ref);
+  wholeRuns(state, sc, "itae_y", [&] { return runClosedLoop(sc, ref, false).metrics[AXIS_Y].itae; });
 }
 BENCHMARK(BM_ThesisRun25s)->Unit(benchmark::kMillisecond);
+
+void BM_ThesisRun25sTally(benchmark::State& state) {
+  const Scenario sc = bench::thesisScenario();
+  LineReference ref = bench::thesisLine();
+  wholeRuns(state, sc, "worst_cross_track", [&] {
+    RunTally tally;  // as the benchmark command's RowMeter sets it for the thesis line (settle 15 s, no series)
+    tally.dt = secondsFromNanos(sc.control_period_ns);
+    tally.settle_time = 15.0;
+    runClosedLoop(sc, ref, true, tally);
+    return tally.worst_cross_track;
+  });
+}
+BENCHMARK(BM_ThesisRun25sTally)->Unit(benchmark::kMillisecond);
 
 void BM_ThesisRun25sTimeDomain(benchmark::State& state) {
   const Scenario sc = bench::thesisScenario();
   LineReference ref = bench::thesisLine();
-  volatile double settling = 0.0;
-  for (auto _ : state) {
-    const RunResult r = runClosedLoop(sc, ref, true);
-    settling = r.metrics[AXIS_Y].settling_time;
-  }
-  state.SetItemsProcessed(state.iterations() * sc.steps());
-  state.counters["settling_y"] = benchmark::Counter(settling, benchmark::Counter::kDefaults);
+  wholeRuns(state, sc, "settling_y", [&] { return runClosedLoop(sc, ref, true).metrics[AXIS_Y].settling_time; });
 }
 BENCHMARK(BM_ThesisRun25sTimeDomain)->Unit(benchmark::kMillisecond);
 
-// The issue-17 target: 1,000 runs of the 25 s line in under 3 s wall on 2 cores, >= 1.8x from 1 to 2
-// threads. The Monte-Carlo runner's own scenario (Scenario defaults: the thesis line, start (-1, 0, 0))
-// and spec (MonteCarloSpec defaults: mismatch, disturbance, noise and start drawn per run), as
-// `mc_benchmark --controllers kanayama+atsmc --seeds 1000` runs it.
+void BM_ThesisRun25sEstimated(benchmark::State& state) {
+  const Scenario sc = bench::thesisScenario();
+  LineReference ref = bench::thesisLine();
+  const EstimatedRunConfig cfg;  // no-slip plant, truth fed back, every layer off
+  wholeRuns(state, sc, "itae_y", [&] { return runEstimatedLoop(sc, cfg, ref, false).run.metrics[AXIS_Y].itae; });
+}
+BENCHMARK(BM_ThesisRun25sEstimated)->Unit(benchmark::kMillisecond);
+
+// The Monte-Carlo runner's own scenario (Scenario defaults: the thesis line, start (-1, 0, 0)) and spec
+// (MonteCarloSpec defaults: mismatch, disturbance, noise and start drawn per run), as
+// `benchmark --scenarios thesis_line --controllers kanayama+atsmc --seeds 1000` runs it.
 void BM_MonteCarlo1000Runs(benchmark::State& state) {
   const int threads = static_cast<int>(state.range(0));
   const Scenario sc;
@@ -129,68 +150,67 @@ BENCHMARK(BM_MonteCarlo1000Runs)
     ->UseRealTime()
     ->Iterations(1);
 
-// The same run with the traction plant (issue 16: at most 2x BM_ThesisRun25s). Default soil (loose moist
-// soil, mu 0.6, 4 sub-steps, rolling resistance 0.05): the thesis start's 100 N·m spins the wheels.
+// The thesis run on the traction plant (default soil: loose moist soil, mu 0.6, 4 sub-steps, rolling
+// resistance 0.05; the thesis start's 100 N·m spins the wheels), the truth fed back: target at most 2x
+// BM_ThesisRun25s.
 void BM_ThesisRun25sTraction(benchmark::State& state) {
   const Scenario sc = bench::thesisScenario();
   LineReference ref = bench::thesisLine();
-  const TractionParams traction;
-  const std::function<void(const LoopSample&)> no_trace;
-  volatile double itae = 0.0;
-  for (auto _ : state) {
-    // The one loop on the traction plant, fed its own state (no sensors), as runClosedLoop feeds the Plant.
-    SlipPlant plant{TractionPlant(sc.robot, sc.disturbance, traction), sc.robot.R};
-    StateFeed feed;
-    Kanayama outer(sc.kanayama);
-    SlidingModeController inner(sc.sliding, sc.robot);
-    itae = closedLoop(sc, plant, feed, outer, inner, ref, false, no_trace, RunStop{}).run.metrics[AXIS_Y].itae;
-  }
-  state.SetItemsProcessed(state.iterations() * sc.steps());
-  state.counters["itae_y"] = benchmark::Counter(itae, benchmark::Counter::kDefaults);
+  EstimatedRunConfig cfg;
+  cfg.traction = TractionParams();
+  wholeRuns(state, sc, "itae_y", [&] { return runEstimatedLoop(sc, cfg, ref, false).run.metrics[AXIS_Y].itae; });
 }
 BENCHMARK(BM_ThesisRun25sTraction)->Unit(benchmark::kMillisecond);
 
-// The drive train's cost (issue 26: motor model and traction control at most 20 % of a traction-plant run):
+// The drive train's cost (target: motor model and traction control at most 20 % of a traction-plant run):
 // BM_ThesisRun25sTraction with the DC motors (arg 1), and with the traction control too (arg 2: the table's
-// defaults; arg 3: the field profile's with the max_ground_accel option of results/drive_train.md); arg 0 is
+// defaults; arg 3: the field profile's traction_control block, read from the file); arg 0 is
 // BM_ThesisRun25sTraction itself, so the ratios come from one program run.
 void BM_ThesisRun25sDriveTrain(benchmark::State& state) {
   const Scenario sc = bench::thesisScenario();
   LineReference ref = bench::thesisLine();
-  const TractionParams traction;
-  MotorParams motor;
-  motor.enabled = state.range(0) >= 1;
-  TractionControlParams tc_params;
-  tc_params.enabled = state.range(0) >= 2;
-  if (state.range(0) >= 3) {  // config/profiles/field.yaml's traction control, the ground-speed option on
-    tc_params.slip_target = 0.1;
-    tc_params.max_ground_accel = 1.0;
-    tc_params.raise_rate = 10.0;
-    tc_params.speed_floor = 0.3;
-    tc_params.min_torque = 1.4;
-    tc_params.anti_windup = true;
-  }
-  const std::function<void(const LoopSample&)> no_trace;
-  volatile double itae = 0.0;
-  for (auto _ : state) {
-    SlipPlant plant{TractionPlant(sc.robot, sc.disturbance, traction), sc.robot.R};
-    plant.plant.setMotor(motor);
-    StateFeed feed;
-    Kanayama outer(sc.kanayama);
-    SlidingModeController inner(sc.sliding, sc.robot);
-    std::optional<TractionControl> tc;
-    LoopLayers layers;
-    if (tc_params.enabled) layers.traction_control = &tc.emplace(tc_params, sc.robot.L);
-    itae = closedLoop(sc, plant, feed, outer, inner, ref, false, no_trace, RunStop{}, layers).run.metrics[AXIS_Y].itae;
-  }
-  state.SetItemsProcessed(state.iterations() * sc.steps());
-  state.counters["itae_y"] = benchmark::Counter(itae, benchmark::Counter::kDefaults);
+  EstimatedRunConfig cfg;
+  cfg.traction = TractionParams();
+  cfg.motor.enabled = state.range(0) >= 1;
+  cfg.traction_control.enabled = state.range(0) >= 2;
+  guarded(state, [&] {
+    if (state.range(0) >= 3) cfg.traction_control = bench::fieldProfileConfig().traction_control;
+    wholeRuns(state, sc, "itae_y", [&] { return runEstimatedLoop(sc, cfg, ref, false).run.metrics[AXIS_Y].itae; });
+  });
 }
 BENCHMARK(BM_ThesisRun25sDriveTrain)->ArgName("layers")->Arg(0)->Arg(1)->Arg(2)->Arg(3)->Unit(benchmark::kMillisecond);
 
+void BM_FieldProfileRun25s(benchmark::State& state) {
+  guarded(state, [&] {
+    const Scenario sc = bench::fieldProfileScenario();
+    LineReference ref = bench::thesisLine();
+    EstimatedRunConfig cfg = bench::fieldProfileConfig();
+    if (state.range(0) == 1) cfg.feedback = Feedback::ground_truth;
+    double periods = 0.0;  // the periods run (the traction control's no-traction verdict could end a run early)
+    wholeRuns(state, sc, "itae_y", [&] {
+      const EstimatedRunResult r = runEstimatedLoop(sc, cfg, ref, false);
+      periods = static_cast<double>(r.run.periods);
+      return r.run.metrics[AXIS_Y].itae;
+    });
+    state.counters["periods"] = periods;
+  });
+}
+BENCHMARK(BM_FieldProfileRun25s)->ArgName("feedback")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+void BM_WetLineFieldProfileRow(benchmark::State& state) {
+  guarded(state, [&] {
+    BenchScenario wet = bench::loadScenario("wet_line", bench::sourcePath("config/scenarios"),
+                                            bench::sourcePath("config/profiles/field.yaml"));
+    wet = withController(wet, bench::fieldProfileScenario());
+    wholeRuns(state, wet.base, "unsown_distance", [&] { return estimatedBenchRow(wet, 0).unsown_distance; });
+  });
+}
+BENCHMARK(BM_WetLineFieldProfileRow)->Unit(benchmark::kMillisecond);
+
 void BM_ThesisRunPotentialField(benchmark::State& state) {
+  const Scenario sc = bench::thesisScenario();
   PotentialField ref = bench::thesisPotentialField();
-  thesisRun(state, ref);
+  wholeRuns(state, sc, "itae_y", [&] { return runClosedLoop(sc, ref, false).metrics[AXIS_Y].itae; });
 }
 BENCHMARK(BM_ThesisRunPotentialField)->Unit(benchmark::kMillisecond);
 

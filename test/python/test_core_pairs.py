@@ -119,7 +119,10 @@ def test_tuned_file_reproduces_its_cost(path):
     pair = header(text, "controller")
     r = core.run(controller=pair, params=yaml.safe_load(text), keep_samples=False, **LINE)
     itae = sum(r["metrics"][a]["itae"] for a in core.AXES)
-    assert itae == float(header(text, "best_cost"))
+    # The file records the cost the PSO found with the build it ran on; the core's numbers may since have
+    # moved at round-off (std::sin/std::cos in place of a series heading turn: 3e-15 relative), far below
+    # any change of the gains.
+    assert itae == pytest.approx(float(header(text, "best_cost")), rel=1e-12, abs=0)
     assert itae < float(header(text, "untuned_cost"))
 
 

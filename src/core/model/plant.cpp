@@ -7,7 +7,6 @@
 
 #include "sowing_robot/core/common/types.h"
 #include "sowing_robot/core/common/validation.h"
-#include "sowing_robot/core/numerics/rotation.h"
 
 namespace sowing_robot {
 namespace core {
@@ -217,15 +216,18 @@ inline bool Plant::stepWithHeading(double tau_right, double tau_left, double dt,
   applied_[1] = tau_left;
   // The sinusoid is evaluated at each RK4 stage time; command and noise are held over the step.
   // Stages 2 and 3 share t + h/2, and stage 4's t + h is the next step's stage 1 (disturbanceAt).
-  // The heading's cos/sin come from one sincos at the start of the step, turned by each stage's small
-  // heading increment (rotateHeading), instead of a sincos per stage.
-  const double t = time_, h = dt;
+  // Stage 1 is at the step's heading (cos0, sin0); the later stages take the cos/sin of their own heading.
+  const double t = time_, h = dt, theta0 = state_[THETA];
   const double applied_r0 = tau_right + noise_r, applied_l0 = tau_left + noise_l;
   const PlantCoefficients p{mcd_, m0_, i0_, nominal_.R, nominal_.L};
   auto stage = [&](int k, double v, double w, double heading_increment) {
-    double dr, dl, c, sn;
+    double dr, dl, c = cos0, sn = sin0;
     disturbanceAt(stageTime(t, h, k), dr, dl);
-    rotateHeading(cos0, sin0, heading_increment, c, sn);
+    if (k != 0) {
+      const double heading = theta0 + heading_increment;
+      sn = std::sin(heading);
+      c = std::cos(heading);
+    }
     return stageRates(p, v, w, c, sn, applied_r0 + dr, applied_l0 + dl);
   };
   Rates d;

@@ -8,7 +8,6 @@
 
 #include "sowing_robot/core/common/types.h"
 #include "sowing_robot/core/common/validation.h"
-#include "sowing_robot/core/numerics/rotation.h"
 
 namespace sowing_robot {
 namespace core {
@@ -216,9 +215,8 @@ bool TractionPlant::stepWithHeading(double tau_right, double tau_left, double dt
   }
   const int n = traction_.substeps;
   const double h = dt / n;
-  // The sinusoid at each sub-step's midpoint (second order in the impulse), turned from one sincos.
+  // The sinusoid at each sub-step's midpoint (second order in the impulse).
   double dist_s = 0.0, dist_c = 0.0;
-  const double dist_step = disturbance_.frequency * h;
   if (disturbance_.sinusoidal) {
     const double angle = disturbance_.frequency * (time_ + 0.5 * h);
     dist_s = std::sin(angle);
@@ -244,7 +242,11 @@ bool TractionPlant::stepWithHeading(double tau_right, double tau_left, double dt
     }
     substep(applied_[RIGHT] + noise_r + amplitude * dist_s, applied_[LEFT] + noise_l + amplitude * dist_c, rr_force,
             rr_moment, h, cos_th, sin_th);
-    if (disturbance_.sinusoidal) rotateHeading(dist_c, dist_s, dist_step, dist_c, dist_s);
+    if (disturbance_.sinusoidal && j + 1 < n) {  // the next sub-step's midpoint
+      const double angle = disturbance_.frequency * (time_ + (j + 1.5) * h);
+      dist_s = std::sin(angle);
+      dist_c = std::cos(angle);
+    }
   }
   time_ += dt;
   return true;
@@ -300,8 +302,9 @@ void TractionPlant::draft(double dt, double& force, double& moment) const {
   moment = xt * fy - yt * fx;
 }
 
-void TractionPlant::substep(double tau_r, double tau_l, double rr_force, double rr_moment, double h, double& cos_th,
-                            double& sin_th) {
+// cos_th, sin_th: no longer read (the midpoint heading's cos/sin are taken from state_[THETA]).
+void TractionPlant::substep(double tau_r, double tau_l, double rr_force, double rr_moment, double h,
+                            [[maybe_unused]] double& cos_th, [[maybe_unused]] double& sin_th) {
   const double R = nominal_.R, L = nominal_.L, floor = traction_.slip_speed_floor;
   const double v = state_[V], w = state_[OMEGA];
   const double u[2] = {v + L * w, v - L * w};
@@ -356,7 +359,9 @@ void TractionPlant::substep(double tau_r, double tau_l, double rr_force, double 
   // exact rotation (rate frozen at the sub-step's start) conserves the kinetic energy as the ODE does.
   if (mcd_ != 0.0) {
     double c, sn;
-    rotateHeading(1.0, 0.0, mcd_ * w * h * inv_sqrt_mi_, c, sn);
+    const double angle = mcd_ * w * h * inv_sqrt_mi_;
+    sn = std::sin(angle);
+    c = std::cos(angle);
     const double a = sqrt_m_ * v1, b = sqrt_i_ * w1;
     v1 = (a * c + b * sn) * inv_sqrt_m_;
     w1 = (b * c - a * sn) * inv_sqrt_i_;
@@ -365,13 +370,12 @@ void TractionPlant::substep(double tau_r, double tau_l, double rr_force, double 
   for (int i = 0; i < 2; ++i) rate1[i] = wheel_rate_[i] + h * (tau[i] - R * f[i]) * inv_iw;
   // Kinematics (eq 3.13) with the mean velocities, heading at the sub-step's midpoint.
   const double dtheta = 0.5 * h * (w + w1);
-  double cm, sm;
-  rotateHeading(cos_th, sin_th, 0.5 * dtheta, cm, sm);
+  const double mid = state_[THETA] + 0.5 * dtheta;
+  const double sm = std::sin(mid), cm = std::cos(mid);
   const double ds = 0.5 * h * (v + v1);
   state_[X] += ds * cm;
   state_[Y] += ds * sm;
   state_[THETA] += dtheta;
-  rotateHeading(cos_th, sin_th, dtheta, cos_th, sin_th);
   state_[V] = v1;
   state_[OMEGA] = w1;
   state_[PHI_R] += 0.5 * h * (wheel_rate_[RIGHT] + rate1[RIGHT]);
