@@ -1,7 +1,7 @@
 // alloc_check: counts heap allocations (global operator new, every form) per control step of the core
 // ("no allocation per control step in the core"). Prints one line per block; exits 1 if a block that must
 // not allocate per step does (the lines marked (info) are reported, not required). The loop is measured
-// through the product's entry points (runClosedLoop, runEstimatedLoop), per step from two run lengths.
+// through the product's entry points (runClosedLoop, truth-fed and with a LoopConfig), per step from two run lengths.
 //   alloc_check [steps]     (default 10000)
 #include <algorithm>
 #include <atomic>
@@ -177,26 +177,24 @@ int main(int argc, char** argv) {
       PotentialField pf = bench::thesisPotentialField();
       checkRun("runClosedLoop(keep_samples=false), potential field", false,
                [&](const Scenario& s) { g_sink = g_sink + runClosedLoop(s, pf, false).metrics[AXIS_Y].itae; });
-      // runEstimatedLoop is reported, not required: its sensors and EKF allocate per period today (the
+      // runClosedLoop is reported, not required: its sensors and EKF allocate per period today (the
       // encoders' velocity window and the EKF's history are std::deques, the fix queues hand out
       // std::vectors; docs/performance.md lists the sites).
-      const EstimatedRunConfig off;  // no-slip plant, truth fed back, every layer off
-      checkRun("runEstimatedLoop, every layer off", false, [&](const Scenario& s) {
-        g_sink = g_sink + runEstimatedLoop(s, off, line, false).run.metrics[AXIS_Y].itae;
+      const LoopConfig off;  // no-slip plant, truth fed back, every layer off
+      checkRun("runClosedLoop, every layer off", false, [&](const Scenario& s) {
+        g_sink = g_sink + runClosedLoop(s, off, line, false).run.metrics[AXIS_Y].itae;
       });
-      const EstimatedRunConfig field = bench::fieldProfileConfig();
+      const LoopConfig field = bench::fieldProfileConfig();
       checkRun(
-          "runEstimatedLoop, config/profiles/field.yaml", false,
-          [&](const Scenario& s) {
-            g_sink = g_sink + runEstimatedLoop(s, field, line, false).run.metrics[AXIS_Y].itae;
-          },
+          "runClosedLoop, config/profiles/field.yaml", false,
+          [&](const Scenario& s) { g_sink = g_sink + runClosedLoop(s, field, line, false).run.metrics[AXIS_Y].itae; },
           bench::fieldProfileScenario());
-      EstimatedRunConfig field_truth = field;
+      LoopConfig field_truth = field;
       field_truth.feedback = Feedback::ground_truth;
       checkRun(
-          "runEstimatedLoop, field profile's layers, truth fed back", false,
+          "runClosedLoop, field profile's layers, truth fed back", false,
           [&](const Scenario& s) {
-            g_sink = g_sink + runEstimatedLoop(s, field_truth, line, false).run.metrics[AXIS_Y].itae;
+            g_sink = g_sink + runClosedLoop(s, field_truth, line, false).run.metrics[AXIS_Y].itae;
           },
           bench::fieldProfileScenario());
       TuningObjective obj;

@@ -1,5 +1,5 @@
 // core_bench: Google Benchmark figures of the ROS-free core. Figures only, never a pass/fail. Every run goes
-// through the product's entry points (runClosedLoop, runEstimatedLoop: the one loop of closed_loop.h).
+// through the product's entry points (runClosedLoop, truth-fed and with a LoopConfig: the one loop of closed_loop.h).
 //   core_bench [--benchmark_min_time=0.2] [--benchmark_filter=Thesis] ...
 // BM_PlantRk4Step            one Plant::step (RK4, sinusoidal disturbance on)
 // BM_ThesisRun25s            runClosedLoop of the 25 s thesis scenario at 1 kHz, every layer off (the no-slip
@@ -7,11 +7,11 @@
 //                            items/s = control steps/s
 // BM_ThesisRun25sTally       the same as the benchmark command runs it: keep_samples = true and a RunTally
 // BM_ThesisRun25sTimeDomain  keep_samples = true (streaming time-domain figures), no trace
-// BM_ThesisRun25sEstimated   the same run through runEstimatedLoop, every layer off (no-slip plant, truth fed:
+// BM_ThesisRun25sEstimated   the same run through runClosedLoop, every layer off (no-slip plant, truth fed:
 //                            the sensors run unused, the controllers behind their run-time interfaces)
 // BM_MonteCarlo1000Runs/threads:N  runMonteCarlo of 1,000 seeded runs of the thesis line, kanayama+atsmc,
 //                            every metric (the benchmark command's work without the files), N threads; wall time
-// BM_ThesisRun25sTraction    runEstimatedLoop on the traction plant (TractionParams defaults), truth fed back
+// BM_ThesisRun25sTraction    runClosedLoop on the traction plant (TractionParams defaults), truth fed back
 // BM_ThesisRun25sDriveTrain/layers:N  the traction run with the DC motors (1) and traction control too (2, the
 //                            table's; 3, the field profile's values)
 // BM_FieldProfileRun25s/feedback:F  the thesis run with config/profiles/field.yaml's layers read from the file
@@ -33,7 +33,6 @@
 #include "sowing_robot/core/evaluation/pso.h"
 #include "sowing_robot/core/evaluation/tuning.h"
 #include "sowing_robot/core/model/plant.h"
-#include "sowing_robot/core/simulation/estimated_run.h"
 #include "sowing_robot/core/simulation/runner.h"
 
 using namespace sowing_robot;
@@ -118,8 +117,8 @@ BENCHMARK(BM_ThesisRun25sTimeDomain)->Unit(benchmark::kMillisecond);
 void BM_ThesisRun25sEstimated(benchmark::State& state) {
   const Scenario sc = bench::thesisScenario();
   LineReference ref = bench::thesisLine();
-  const EstimatedRunConfig cfg;  // no-slip plant, truth fed back, every layer off
-  wholeRuns(state, sc, "itae_y", [&] { return runEstimatedLoop(sc, cfg, ref, false).run.metrics[AXIS_Y].itae; });
+  const LoopConfig cfg;  // no-slip plant, truth fed back, every layer off
+  wholeRuns(state, sc, "itae_y", [&] { return runClosedLoop(sc, cfg, ref, false).run.metrics[AXIS_Y].itae; });
 }
 BENCHMARK(BM_ThesisRun25sEstimated)->Unit(benchmark::kMillisecond);
 
@@ -156,9 +155,9 @@ BENCHMARK(BM_MonteCarlo1000Runs)
 void BM_ThesisRun25sTraction(benchmark::State& state) {
   const Scenario sc = bench::thesisScenario();
   LineReference ref = bench::thesisLine();
-  EstimatedRunConfig cfg;
+  LoopConfig cfg;
   cfg.traction = TractionParams();
-  wholeRuns(state, sc, "itae_y", [&] { return runEstimatedLoop(sc, cfg, ref, false).run.metrics[AXIS_Y].itae; });
+  wholeRuns(state, sc, "itae_y", [&] { return runClosedLoop(sc, cfg, ref, false).run.metrics[AXIS_Y].itae; });
 }
 BENCHMARK(BM_ThesisRun25sTraction)->Unit(benchmark::kMillisecond);
 
@@ -169,13 +168,13 @@ BENCHMARK(BM_ThesisRun25sTraction)->Unit(benchmark::kMillisecond);
 void BM_ThesisRun25sDriveTrain(benchmark::State& state) {
   const Scenario sc = bench::thesisScenario();
   LineReference ref = bench::thesisLine();
-  EstimatedRunConfig cfg;
+  LoopConfig cfg;
   cfg.traction = TractionParams();
   cfg.motor.enabled = state.range(0) >= 1;
   cfg.traction_control.enabled = state.range(0) >= 2;
   guarded(state, [&] {
     if (state.range(0) >= 3) cfg.traction_control = bench::fieldProfileConfig().traction_control;
-    wholeRuns(state, sc, "itae_y", [&] { return runEstimatedLoop(sc, cfg, ref, false).run.metrics[AXIS_Y].itae; });
+    wholeRuns(state, sc, "itae_y", [&] { return runClosedLoop(sc, cfg, ref, false).run.metrics[AXIS_Y].itae; });
   });
 }
 BENCHMARK(BM_ThesisRun25sDriveTrain)->ArgName("layers")->Arg(0)->Arg(1)->Arg(2)->Arg(3)->Unit(benchmark::kMillisecond);
@@ -184,11 +183,11 @@ void BM_FieldProfileRun25s(benchmark::State& state) {
   guarded(state, [&] {
     const Scenario sc = bench::fieldProfileScenario();
     LineReference ref = bench::thesisLine();
-    EstimatedRunConfig cfg = bench::fieldProfileConfig();
+    LoopConfig cfg = bench::fieldProfileConfig();
     if (state.range(0) == 1) cfg.feedback = Feedback::ground_truth;
     double periods = 0.0;  // the periods run (the traction control's no-traction verdict could end a run early)
     wholeRuns(state, sc, "itae_y", [&] {
-      const EstimatedRunResult r = runEstimatedLoop(sc, cfg, ref, false);
+      const LoopResult r = runClosedLoop(sc, cfg, ref, false);
       periods = static_cast<double>(r.run.periods);
       return r.run.metrics[AXIS_Y].itae;
     });
@@ -199,8 +198,8 @@ BENCHMARK(BM_FieldProfileRun25s)->ArgName("feedback")->Arg(0)->Arg(1)->Unit(benc
 
 void BM_WetLineFieldProfileRow(benchmark::State& state) {
   guarded(state, [&] {
-    BenchScenario wet = bench::loadScenario("wet_line", bench::sourcePath("config/scenarios"),
-                                            bench::sourcePath("config/profiles/field.yaml"));
+    BenchScenario wet = scenario_file::loadScenario("wet_line", bench::sourcePath("config/scenarios"),
+                                                    bench::sourcePath("config/profiles/field.yaml"));
     wet = withController(wet, bench::fieldProfileScenario());
     wholeRuns(state, wet.base, "unsown_distance", [&] { return estimatedBenchRow(wet, 0).unsown_distance; });
   });

@@ -2,7 +2,7 @@
 // loop with the traction plant, the seeded sensors and the controllers fed the truth, the encoder odometry or the EKF's
 // estimate, scored on the truth. Its blocks take the nodes' keys (plant_sim's traction/ and sensors/, state_estimator's
 // estimator/), checked by the same tables, so a key or a range reads as the node's. profile= applies a profile file
-// (config/profiles/NAME.yaml) through the benchmark's own reading of it (bench::applyProfileTo), on top of the
+// (config/profiles/NAME.yaml) through the benchmark's own reading of it (scenario_file::applyProfileTo), on top of the
 // call's blocks.
 #include <stdexcept>
 #include <string>
@@ -148,7 +148,8 @@ py::dict runEstimatedPy(const std::string& controller, const py::object& params,
     if (!py::isinstance<py::str>(profile)) throw py::type_error("profile must be a name (\"field\") or a file path");
     profile_name = profile.cast<std::string>();
     try {  // the benchmark's reading of the file: its keys win over the call's
-      sowing_robot::bench::applyProfileTo(sowing_robot::bench::profilePath(profile_name, SOWING_PROFILE_DIR), cfg);
+      sowing_robot::scenario_file::applyProfileTo(
+          sowing_robot::scenario_file::profilePath(profile_name, SOWING_PROFILE_DIR), cfg);
     } catch (const std::invalid_argument& ex) {
       throw py::value_error(ex.what());
     }

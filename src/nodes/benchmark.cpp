@@ -39,7 +39,7 @@
 #include "sowing_robot/scenario_file/scenario_loader.h"
 
 using namespace sowing_robot::core;
-namespace bench = sowing_robot::bench;
+namespace scenario_file = sowing_robot::scenario_file;
 
 #ifndef SOWING_SOURCE_DIR
 #define SOWING_SOURCE_DIR "."
@@ -227,7 +227,8 @@ int run(sowing_robot::farm::Farm& farm, int argc, char** argv) {
   if (threads < 0) return fail("--threads must be >= 0 (0: all cores)");
   if (base_seed < -1) return fail("--base-seed must be >= 0");
   if (output.empty()) return fail("--output DIR is required");
-  if (scenario_names.size() == 1 && scenario_names[0] == "all") scenario_names = bench::scenarioNames(scenario_dir);
+  if (scenario_names.size() == 1 && scenario_names[0] == "all")
+    scenario_names = scenario_file::scenarioNames(scenario_dir);
 
   // Load and check everything before the first run.
   std::vector<BenchScenario> scenarios;
@@ -235,15 +236,15 @@ int run(sowing_robot::farm::Farm& farm, int argc, char** argv) {
   std::vector<std::string> gains_source;
   try {
     for (const auto& name : scenario_names) {
-      scenarios.push_back(bench::loadScenario(name, scenario_dir, profile));
+      scenarios.push_back(scenario_file::loadScenario(name, scenario_dir, profile));
       if (base_seed >= 0) scenarios.back().spec.base_seed = static_cast<std::uint64_t>(base_seed);
     }
     for (const auto& c : controllers) {
       Scenario sc;
       const std::string e = parseControllerPair(c, sc.outer, sc.inner, sc.sliding.adaptive);
       if (!e.empty()) return fail(e);
-      const std::string tuned = bench::tunedGainsFile(tuned_dir, sc);
-      if (!tuned.empty()) bench::applyTunedGains(tuned, sc);
+      const std::string tuned = scenario_file::tunedGainsFile(tuned_dir, sc);
+      if (!tuned.empty()) scenario_file::applyTunedGains(tuned, sc);
       gains_source.push_back(tuned.empty() ? "the parameter tables' defaults (no " + sc.controllerName() + ".yaml in " +
                                                  tuned_dir + ")"
                                            : tuned);
@@ -287,7 +288,7 @@ int run(sowing_robot::farm::Farm& farm, int argc, char** argv) {
   std::string held_out;  // for gains from a robust tuning: which scenarios and draws it never saw
   for (std::size_t p = 0; p < pairs.size(); ++p) {
     report += "- " + pairs[p].controllerName() + ": " + gains_source[p] + "\n";
-    const auto training = bench::trainingOf(gains_source[p]);
+    const auto training = scenario_file::trainingOf(gains_source[p]);
     if (training.empty()) continue;
     held_out += "- " + pairs[p].controllerName() + ", trained on";
     for (const auto& t : training)
@@ -295,7 +296,7 @@ int run(sowing_robot::farm::Farm& farm, int argc, char** argv) {
                   std::to_string(t.base_seed) + ")";
     held_out += ":";
     for (const auto& b : scenarios)
-      held_out += " " + b.name + " " + bench::heldOutVerdict(training, b.name, b.spec.base_seed, seeds) + ";";
+      held_out += " " + b.name + " " + scenario_file::heldOutVerdict(training, b.name, b.spec.base_seed, seeds) + ";";
     held_out += "\n";
   }
   if (!held_out.empty()) report += "\nTraining and held-out data (robust-tuned gains):\n\n" + held_out;

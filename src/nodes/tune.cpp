@@ -120,7 +120,7 @@ farm::Payload evaluate(const core::GainObjective& problem, const farm::Payload& 
 }
 
 /// The objective the config describes: one run on its base scenario, or its robust training set.
-std::unique_ptr<const core::GainObjective> makeObjective(const bench::TuneConfig& cfg,
+std::unique_ptr<const core::GainObjective> makeObjective(const scenario_file::TuneConfig& cfg,
                                                          const core::ReferenceSource& reference, int threads) {
   if (cfg.isRobust()) return std::make_unique<core::RobustTuningProblem>(cfg.training, cfg.gains, cfg.robust, threads);
   return std::make_unique<core::TuningProblem>(cfg.base, reference, cfg.gains, cfg.objective, threads);
@@ -201,9 +201,9 @@ int run(farm::Farm& farm, int argc, char** argv) {
     if (farm.root()) std::fprintf(stderr, "tune: %s\n", arg_error.c_str());
     return 2;
   }
-  bench::TuneConfig cfg;
+  scenario_file::TuneConfig cfg;
   try {
-    cfg = bench::loadTuneConfig(args.config, args.controller);
+    cfg = scenario_file::loadTuneConfig(args.config, args.controller);
   } catch (const std::exception& e) {
     // Every rank reads the same file: rank 0 says what is wrong, the others leave quietly.
     if (farm.root()) std::fprintf(stderr, "tune: %s\n", e.what());

@@ -18,11 +18,11 @@ KinematicController::KinematicController(ros::NodeHandle nh, ros::NodeHandle pnh
   period_ = core::secondsFromNanos(run.periodNs());                    // the in-process loop's dt, to the bit
   // The factory builds the controller; the live gains (reconfigure_bridge.h; one server on the private
   // namespace) are served for the controllers that have a .cfg.
-  outer_ = core::makeOuterController(settings.controllers());  // validated above: does not throw
+  outer_ = core::makeOuterController(settings);  // validated above: does not throw
   if (auto* kanayama = dynamic_cast<core::OuterAdapter<core::Kanayama>*>(outer_.get())) {
     kanayama_ = &kanayama->controller();
     kanayama_reconfigure_ =
-        startReconfigure<KinematicControllerConfig>(pnh, core::kanayamaTable(), settings.gains, [this](auto& c) {
+        startReconfigure<KinematicControllerConfig>(pnh, core::kanayamaTable(), settings.kanayama, [this](auto& c) {
           applyReconfigure("kinematic_controller", core::kanayamaTable(), kanayama_->gains(), c,
                            [this](const core::KanayamaGains& g) { kanayama_->setGains(g); });
         });

@@ -144,7 +144,7 @@ PsoTuner::PsoTuner(ros::NodeHandle nh, ros::NodeHandle pnh) {
   base_.control_period_ns = static_cast<std::int64_t>(std::llround(1e9 / settings.control_rate));
   base_.start = run.start();
   base_.disturbance = plant_settings.disturbance;
-  base_.kanayama = kin_settings.gains;
+  base_.kanayama = kin_settings.kanayama;
   base_.sliding = torque_settings.sliding;
   base_.sliding.adaptive = settings.adaptive;
   // The baselines' parameters, nested under the same nodes as the gains YAML writes them (core::gainKey).

@@ -29,7 +29,7 @@ TorqueController::TorqueController(ros::NodeHandle nh, ros::NodeHandle pnh) {
   lockstep_ = run.lockstep;  // lockstep: wait for the paired desired velocity, never time out
   dt_ = core::secondsFromNanos(run.periodNs());
   // Validated above, so the factory does not throw.
-  inner_ = core::makeInnerController(settings.controllers(), robot);
+  inner_ = core::makeInnerController(settings, robot);
   if (auto* smc = dynamic_cast<core::InnerAdapter<core::SlidingModeController>*>(inner_.get()))
     smc_ = &smc->controller();
   else if (auto* pid = dynamic_cast<core::InnerAdapter<core::WheelPid>*>(inner_.get()))

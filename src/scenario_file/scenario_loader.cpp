@@ -33,7 +33,7 @@
 #include "sowing_robot/scenario_file/yaml_reading.h"
 
 namespace sowing_robot {
-namespace bench {
+namespace scenario_file {
 
 using core::ParamTable;
 using core::ParamValue;
@@ -528,5 +528,5 @@ std::string heldOutVerdict(const std::vector<TrainingRecord>& training, const st
   return trained_on ? "held-out draws (the scenario was trained on with another base seed)" : "held out";
 }
 
-}  // namespace bench
+}  // namespace scenario_file
 }  // namespace sowing_robot

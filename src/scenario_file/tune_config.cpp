@@ -18,7 +18,7 @@
 #include "sowing_robot/scenario_file/yaml_reading.h"
 
 namespace sowing_robot {
-namespace bench {
+namespace scenario_file {
 
 using namespace yaml_reading;
 
@@ -221,5 +221,5 @@ TuneConfig loadTuneConfig(const std::string& path, const std::string& controller
   return c;
 }
 
-}  // namespace bench
+}  // namespace scenario_file
 }  // namespace sowing_robot

@@ -39,7 +39,7 @@ std::string variant(const TempDir& dir, const std::string& from, const std::stri
 
 std::string loadError(const std::string& path) {
   try {
-    bench::loadScenarioFile(path);
+    scenario_file::loadScenarioFile(path);
   } catch (const std::invalid_argument& e) {
     return e.what();
   }
@@ -48,42 +48,43 @@ std::string loadError(const std::string& path) {
 }  // namespace
 
 TEST(ScenarioLoader, EverySuiteFileLoads) {
-  const auto names = bench::scenarioNames(kSuite);
+  const auto names = scenario_file::scenarioNames(kSuite);
   for (const char* expected : {"thesis_line", "thesis_field", "three_row_field", "sine_rows", "heavy_robot",
                                "disturbance_sweep", "wet_soil", "estimated_pose"})
     EXPECT_NE(std::find(names.begin(), names.end(), expected), names.end()) << expected;
   for (const auto& n : names) {
     SCOPED_TRACE(n);
     BenchScenario b;
-    ASSERT_NO_THROW(b = bench::loadScenario(n, kSuite));
+    ASSERT_NO_THROW(b = scenario_file::loadScenario(n, kSuite));
     EXPECT_EQ(b.name, n);
     EXPECT_EQ(b.validate(), "");
   }
   // What the files say arrives where it belongs.
-  const BenchScenario line = bench::loadScenario("thesis_line", kSuite);
+  const BenchScenario line = scenario_file::loadScenario("thesis_line", kSuite);
   EXPECT_EQ(line.track, TrackKind::line);
   EXPECT_EQ(line.base.duration, 25.0);
   EXPECT_EQ(line.base.control_period_ns, 1000000);
   EXPECT_EQ(line.spec.mass_scale.lo, 0.8);
   EXPECT_EQ(line.spec.mass_scale.hi, 1.5);
   EXPECT_EQ(line.spec.cross_track_threshold, 0.05);
-  const BenchScenario field = bench::loadScenario("thesis_field", kSuite);
+  const BenchScenario field = scenario_file::loadScenario("thesis_field", kSuite);
   EXPECT_EQ(field.track, TrackKind::field);
   ASSERT_EQ(field.obstacles.size(), 3u);
   EXPECT_EQ(field.obstacles[1].x, 50.0);
   EXPECT_EQ(field.field.row_length, 100.0);
   EXPECT_EQ(field.field.potential.beta, 4.0);
-  const BenchScenario rows = bench::loadScenario("three_row_field", kSuite);
+  const BenchScenario rows = scenario_file::loadScenario("three_row_field", kSuite);
   EXPECT_EQ(rows.field.rows, 3);
   EXPECT_EQ(rows.obstacles.size(), 1u);
-  EXPECT_EQ(bench::loadScenario("sine_rows", kSuite).track, TrackKind::sine);
-  EXPECT_GE(bench::loadScenario("heavy_robot", kSuite).spec.mass_scale.lo, 1.3);
-  EXPECT_GE(bench::loadScenario("disturbance_sweep", kSuite).spec.amplitude.hi, 5.0);
+  EXPECT_EQ(scenario_file::loadScenario("sine_rows", kSuite).track, TrackKind::sine);
+  EXPECT_GE(scenario_file::loadScenario("heavy_robot", kSuite).spec.mass_scale.lo, 1.3);
+  EXPECT_GE(scenario_file::loadScenario("disturbance_sweep", kSuite).spec.amplitude.hi, 5.0);
   // The same fields through the path follower (config/scenarios/path_follower/): only the follower differs.
   for (const char* n : {"thesis_field", "three_row_field"}) {
     SCOPED_TRACE(n);
-    const BenchScenario own = bench::loadScenario(n, kSuite);
-    const BenchScenario path = bench::loadScenarioFile(kSuite + "/path_follower/" + std::string(n) + "_path.yaml");
+    const BenchScenario own = scenario_file::loadScenario(n, kSuite);
+    const BenchScenario path =
+        scenario_file::loadScenarioFile(kSuite + "/path_follower/" + std::string(n) + "_path.yaml");
     EXPECT_EQ(own.field.follower, core::FieldFollower::kPotential);
     EXPECT_EQ(path.field.follower, core::FieldFollower::kPath);
     EXPECT_EQ(path.field.rows, own.field.rows);
@@ -126,7 +127,7 @@ TEST(ScenarioLoader, TyposAndMissingKeysAreRefusedNamingThem) {
   EXPECT_EQ(e.rfind(dir.path, 0), 0u) << e;
   // An unknown name lists the known ones.
   try {
-    bench::loadScenario("thesis_lien", kSuite);
+    scenario_file::loadScenario("thesis_lien", kSuite);
     FAIL();
   } catch (const std::invalid_argument& ex) {
     EXPECT_NE(std::string(ex.what()).find("unknown scenario 'thesis_lien'"), std::string::npos) << ex.what();
@@ -136,7 +137,7 @@ TEST(ScenarioLoader, TyposAndMissingKeysAreRefusedNamingThem) {
 
 TEST(ScenarioLoader, RequiredModelsMustBeKnownAndSwitchedOn) {
   // wet_soil and estimated_pose are built (nothing is pending now); a scenario that requires one must switch it on.
-  EXPECT_TRUE(bench::pendingModels().empty());
+  EXPECT_TRUE(scenario_file::pendingModels().empty());
   TempDir dir;
   std::string e = loadError(variant(dir, "requires: []", "requires: [wet_soil]"));
   EXPECT_NE(e.find("requires wet_soil but its traction is not enabled"), std::string::npos) << e;
@@ -149,7 +150,7 @@ TEST(ScenarioLoader, RequiredModelsMustBeKnownAndSwitchedOn) {
 }
 
 TEST(ScenarioLoader, TheNewScenariosCarryTheirPlantSensorsAndFeedback) {
-  const BenchScenario wet = bench::loadScenario("wet_soil", kSuite);
+  const BenchScenario wet = scenario_file::loadScenario("wet_soil", kSuite);
   ASSERT_TRUE(wet.realism.has_value());
   ASSERT_TRUE(wet.realism->traction.has_value());
   EXPECT_EQ(wet.realism->traction->draft_force, 10.0);
@@ -160,15 +161,15 @@ TEST(ScenarioLoader, TheNewScenariosCarryTheirPlantSensorsAndFeedback) {
   EXPECT_EQ(wet.realism->patches[0].rolling_resistance, 0.08);
   EXPECT_EQ(wet.realism->feedback, core::Feedback::ground_truth);
   EXPECT_EQ(wet.obstacles.size(), 3u);
-  const BenchScenario est = bench::loadScenario("estimated_pose", kSuite);
+  const BenchScenario est = scenario_file::loadScenario("estimated_pose", kSuite);
   ASSERT_TRUE(est.realism.has_value());
   EXPECT_FALSE(est.realism->traction.has_value());
   EXPECT_EQ(est.realism->feedback, core::Feedback::fused);
   EXPECT_EQ(est.realism->sensors.fix.sigma, 0.02);
   EXPECT_EQ(est.realism->sensors.encoder.ticks_per_turn, 2048);
   // Today's scenarios stay on today's loop.
-  EXPECT_FALSE(bench::loadScenario("thesis_line", kSuite).realism.has_value());
-  EXPECT_FALSE(bench::loadScenario("thesis_field", kSuite).realism.has_value());
+  EXPECT_FALSE(scenario_file::loadScenario("thesis_line", kSuite).realism.has_value());
+  EXPECT_FALSE(scenario_file::loadScenario("thesis_field", kSuite).realism.has_value());
 }
 
 namespace {
@@ -233,25 +234,25 @@ TEST(ScenarioLoader, TunedGainsGoThroughTheParameterTables) {
   TempDir dir;
   core::Scenario sc;
   ASSERT_EQ(core::parseControllerPair("kanayama+atsmc", sc.outer, sc.inner, sc.sliding.adaptive), "");
-  EXPECT_EQ(bench::tunedGainsFile(dir.path, sc), "");
+  EXPECT_EQ(scenario_file::tunedGainsFile(dir.path, sc), "");
   const std::string path = dir.write("kanayama+atsmc.yaml",
                                      "kinematic_controller:\n  kx: 9.5\n  ky: 7.5\n  ktheta: 7.0\n"
                                      "torque_controller:\n  k1: 400.0\n  rate_m: 0.5\n  mode: atsmc\n");
-  EXPECT_EQ(bench::tunedGainsFile(dir.path, sc), path);
-  bench::applyTunedGains(path, sc);
+  EXPECT_EQ(scenario_file::tunedGainsFile(dir.path, sc), path);
+  scenario_file::applyTunedGains(path, sc);
   EXPECT_EQ(sc.kanayama.kx, 9.5);
   EXPECT_EQ(sc.sliding.k1, 400.0);
   EXPECT_EQ(sc.sliding.rate_m, 0.5);
   // The results/ file of today loads as it is.
   core::Scenario today = core::Scenario();
-  EXPECT_NO_THROW(bench::applyTunedGains(kSource + "/results/tuned_gains.yaml", today));
+  EXPECT_NO_THROW(scenario_file::applyTunedGains(kSource + "/results/tuned_gains.yaml", today));
   EXPECT_NE(today.kanayama.kx, core::Scenario().kanayama.kx);
   // Unknown keys and groups, values out of range, a file of the other mode: refused.
   auto refused = [&](const std::string& text, const std::string& needle) {
     core::Scenario s = core::Scenario();
     const std::string p = dir.write("bad.yaml", text);
     try {
-      bench::applyTunedGains(p, s);
+      scenario_file::applyTunedGains(p, s);
       ADD_FAILURE() << text;
     } catch (const std::invalid_argument& e) {
       EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
@@ -265,7 +266,7 @@ TEST(ScenarioLoader, TunedGainsGoThroughTheParameterTables) {
   refused("pid:\n  kp: 3.0\n", "pid");  // the nodes' groups only: the PID's keys sit under torque_controller
   core::Scenario pid;
   ASSERT_EQ(core::parseControllerPair("rpp+pid", pid.outer, pid.inner, pid.sliding.adaptive), "");
-  bench::applyTunedGains(
+  scenario_file::applyTunedGains(
       dir.write("rpp+pid.yaml", "kinematic_controller:\n  lookahead_dist: 0.8\ntorque_controller:\n  kp: 3.0\n"), pid);
   EXPECT_EQ(pid.pure_pursuit.lookahead_dist, 0.8);
   EXPECT_EQ(pid.pid.kp, 3.0);
@@ -290,7 +291,7 @@ BenchScenario shortField(const TempDir& dir, bool avoid) {
   text = std::regex_replace(text, std::regex("amplitude: \\[0.0, 2.0\\]"), "amplitude: 0.0");
   text = std::regex_replace(text, std::regex("cross_track_threshold: 0.05"), "cross_track_threshold: 10.0");
   text = std::regex_replace(text, std::regex("settle_time: 15.0"), "settle_time: 2.0");
-  return bench::loadScenarioFile(dir.write("short_field.yaml", text));
+  return scenario_file::loadScenarioFile(dir.write("short_field.yaml", text));
 }
 }  // namespace
 
@@ -329,7 +330,7 @@ TEST(ScenarioLoader, AFieldRunCutShortIsNotFinished) {
 // scenario's other keys stay; a scenario without those blocks gets them; a typo in a profile is refused.
 TEST(ScenarioLoader, AProfileGoesOnTopOfTheScenariosBlocks) {
   const std::string field = kSource + "/config/profiles/field.yaml";
-  const BenchScenario wet = bench::loadScenario("wet_soil", kSuite, field);
+  const BenchScenario wet = scenario_file::loadScenario("wet_soil", kSuite, field);
   ASSERT_TRUE(wet.realism);
   ASSERT_TRUE(wet.realism->traction);
   EXPECT_EQ(wet.realism->traction->draft_force, 10.0);  // the scenario's own key stays
@@ -340,9 +341,9 @@ TEST(ScenarioLoader, AProfileGoesOnTopOfTheScenariosBlocks) {
   EXPECT_TRUE(wet.realism->estimator.slip.detect);  // the slip-aware estimator (used with feedback fused)
   EXPECT_TRUE(wet.realism->hitch_control.enabled);
   EXPECT_FALSE(wet.realism->patches.empty());  // the field file's patches, with traction on
-  EXPECT_FALSE(bench::loadScenario("wet_soil", kSuite).realism->motor.enabled);
-  EXPECT_FALSE(bench::loadScenario("wet_soil", kSuite).realism->estimator.slip.detect);
-  const BenchScenario line = bench::loadScenario("thesis_line", kSuite, field);  // no blocks of its own
+  EXPECT_FALSE(scenario_file::loadScenario("wet_soil", kSuite).realism->motor.enabled);
+  EXPECT_FALSE(scenario_file::loadScenario("wet_soil", kSuite).realism->estimator.slip.detect);
+  const BenchScenario line = scenario_file::loadScenario("thesis_line", kSuite, field);  // no blocks of its own
   ASSERT_TRUE(line.realism);
   EXPECT_TRUE(line.realism->traction);
   EXPECT_TRUE(line.realism->motor.enabled);
@@ -350,18 +351,18 @@ TEST(ScenarioLoader, AProfileGoesOnTopOfTheScenariosBlocks) {
   TempDir dir;
   const std::string bad = dir.write("bad.yaml", "profile: {name: bad}\nplant_sim:\n  motor: {enabld: true}\n");
   try {
-    bench::loadScenario("wet_soil", kSuite, bad);
+    scenario_file::loadScenario("wet_soil", kSuite, bad);
     ADD_FAILURE() << "not refused";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("motor/enabld"), std::string::npos) << e.what();
   }
   const std::string stray = dir.write("stray.yaml", "profile: {name: stray}\nduration: 3\n");
-  EXPECT_THROW(bench::loadScenario("wet_soil", kSuite, stray), std::invalid_argument);
+  EXPECT_THROW(scenario_file::loadScenario("wet_soil", kSuite, stray), std::invalid_argument);
   // A block a node does not own (the plant's motor under the torque controller) is refused by name.
   const std::string misplaced =
       dir.write("misplaced.yaml", "profile: {name: misplaced}\ntorque_controller:\n  motor: {enabled: true}\n");
   try {
-    bench::loadScenario("wet_soil", kSuite, misplaced);
+    scenario_file::loadScenario("wet_soil", kSuite, misplaced);
     ADD_FAILURE() << "not refused";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("torque_controller/motor"), std::string::npos) << e.what();
@@ -371,7 +372,7 @@ TEST(ScenarioLoader, AProfileGoesOnTopOfTheScenariosBlocks) {
 // The same profile onto an in-process configuration (Python's run_estimated(profile=)): its blocks over what the
 // configuration holds, through the same reading as the benchmark's.
 TEST(ScenarioLoader, AProfileAppliesToAnInProcessConfiguration) {
-  const std::string field = bench::profilePath("field", kSource + "/config/profiles");
+  const std::string field = scenario_file::profilePath("field", kSource + "/config/profiles");
   EXPECT_EQ(field, kSource + "/config/profiles/field.yaml");
   core::LoopConfig cfg;
   core::TractionParams wet;
@@ -379,7 +380,7 @@ TEST(ScenarioLoader, AProfileAppliesToAnInProcessConfiguration) {
   wet.mu_slide = 0.2;
   cfg.traction = wet;
   cfg.motor.stall_torque = 30.0;
-  bench::applyProfileTo(field, cfg);
+  scenario_file::applyProfileTo(field, cfg);
   ASSERT_TRUE(cfg.traction);
   EXPECT_EQ(cfg.traction->mu_peak, 0.25);  // the caller's own key stays
   EXPECT_TRUE(cfg.motor.enabled);
@@ -389,30 +390,30 @@ TEST(ScenarioLoader, AProfileAppliesToAnInProcessConfiguration) {
   EXPECT_EQ(cfg.feedback, core::Feedback::fused);
   EXPECT_EQ(cfg.validate(), "");
   core::LoopConfig bare;  // no traction of its own: the profile's with the defaults
-  bench::applyProfileTo(field, bare);
+  scenario_file::applyProfileTo(field, bare);
   ASSERT_TRUE(bare.traction);
   EXPECT_EQ(bare.traction->mu_peak, core::TractionParams().mu_peak);
-  EXPECT_THROW(bench::profilePath("feild", kSource + "/config/profiles"), std::invalid_argument);
+  EXPECT_THROW(scenario_file::profilePath("feild", kSource + "/config/profiles"), std::invalid_argument);
 }
 
 // The hitch control's block in a scenario or a profile, through its table; the field profile turns it on.
 TEST(ScenarioLoader, TheHitchControlBlockIsRead) {
-  const BenchScenario wet = bench::loadScenario("wet_soil", kSuite, kSource + "/config/profiles/field.yaml");
+  const BenchScenario wet = scenario_file::loadScenario("wet_soil", kSuite, kSource + "/config/profiles/field.yaml");
   ASSERT_TRUE(wet.realism);
   EXPECT_TRUE(wet.realism->hitch_control.enabled);
-  EXPECT_FALSE(bench::loadScenario("wet_soil", kSuite).realism->hitch_control.enabled);
+  EXPECT_FALSE(scenario_file::loadScenario("wet_soil", kSuite).realism->hitch_control.enabled);
   TempDir dir;
   const std::string prof = dir.write("p.yaml",
                                      "profile: {name: p}\ntorque_controller: {traction_control: {enabled: true}, "
                                      "hitch_control: {enabled: true, lower_after: 7.5}}\n");
-  const BenchScenario b = bench::loadScenario("wet_soil", kSuite, prof);
+  const BenchScenario b = scenario_file::loadScenario("wet_soil", kSuite, prof);
   EXPECT_EQ(b.realism->hitch_control.lower_after, 7.5);
   // A block given twice is refused, not half taken (yaml-cpp's lookup finds the first).
   const std::string twice = dir.write("twice.yaml",
                                       "profile: {name: twice}\ntorque_controller: {traction_control: {enabled: true}}\n"
                                       "torque_controller: {hitch_control: {enabled: true}}\n");
   try {
-    bench::loadScenario("wet_soil", kSuite, twice);
+    scenario_file::loadScenario("wet_soil", kSuite, twice);
     ADD_FAILURE() << "a repeated key taken";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("key 'torque_controller' appears twice (line 3)"), std::string::npos)
@@ -421,7 +422,7 @@ TEST(ScenarioLoader, TheHitchControlBlockIsRead) {
   const std::string bad =
       dir.write("bad.yaml", "profile: {name: bad}\ntorque_controller: {hitch_control: {lower_after: -1}}\n");
   try {
-    bench::loadScenario("wet_soil", kSuite, bad);
+    scenario_file::loadScenario("wet_soil", kSuite, bad);
     ADD_FAILURE() << "not refused";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("hitch_control/lower_after"), std::string::npos) << e.what();
@@ -431,15 +432,15 @@ TEST(ScenarioLoader, TheHitchControlBlockIsRead) {
 // The command limits' block (kinematic_controller's limits/) in a scenario or a profile, through its table; the
 // field profile turns them on with the table's bounds.
 TEST(ScenarioLoader, TheCommandLimitsBlockIsRead) {
-  const BenchScenario wet = bench::loadScenario("wet_line", kSuite, kSource + "/config/profiles/field.yaml");
+  const BenchScenario wet = scenario_file::loadScenario("wet_line", kSuite, kSource + "/config/profiles/field.yaml");
   ASSERT_TRUE(wet.realism);
   EXPECT_TRUE(wet.realism->limits.enabled);
   EXPECT_EQ(wet.realism->limits.max_acceleration, core::CommandLimitsParams().max_acceleration);
-  EXPECT_FALSE(bench::loadScenario("wet_line", kSuite).realism->limits.enabled);
+  EXPECT_FALSE(scenario_file::loadScenario("wet_line", kSuite).realism->limits.enabled);
   TempDir dir;
   const std::string prof =
       dir.write("p.yaml", "profile: {name: p}\nkinematic_controller: {limits: {enabled: true, max_v: 1.2}}\n");
-  const BenchScenario b = bench::loadScenario("thesis_line", kSuite, prof);  // a scenario without blocks
+  const BenchScenario b = scenario_file::loadScenario("thesis_line", kSuite, prof);  // a scenario without blocks
   ASSERT_TRUE(b.realism);
   EXPECT_TRUE(b.realism->limits.enabled);
   EXPECT_EQ(b.realism->limits.max_v, 1.2);
@@ -447,7 +448,7 @@ TEST(ScenarioLoader, TheCommandLimitsBlockIsRead) {
                            "kinematic_controller: {kx: 2.0}"}) {
     const std::string bad = dir.write("bad.yaml", std::string("profile: {name: bad}\n") + body + "\n");
     try {
-      bench::loadScenario("wet_line", kSuite, bad);
+      scenario_file::loadScenario("wet_line", kSuite, bad);
       ADD_FAILURE() << "not refused: " << body;
     } catch (const std::invalid_argument& e) {
       const std::string what = e.what();

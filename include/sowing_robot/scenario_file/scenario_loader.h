@@ -14,7 +14,7 @@
 #include "sowing_robot/core/simulation/runner.h"
 
 namespace sowing_robot {
-namespace bench {
+namespace scenario_file {
 
 /// The scenario file at `path` (its `name` must equal the file's stem). A field scenario's `field/config`
 /// is read relative to the scenario file's directory (with its plant_sim/field/patches, used with traction on).
@@ -75,5 +75,5 @@ std::vector<TrainingRecord> trainingOf(const std::string& gains_path);
 std::string heldOutVerdict(const std::vector<TrainingRecord>& training, const std::string& scenario,
                            unsigned long long base_seed, long long runs);
 
-}  // namespace bench
+}  // namespace scenario_file
 }  // namespace sowing_robot

@@ -35,7 +35,7 @@
 #include "sowing_robot/core/simulation/runner.h"
 
 namespace sowing_robot {
-namespace bench {
+namespace scenario_file {
 
 struct TuneConfig {
   core::Scenario base;
@@ -58,5 +58,5 @@ struct TuneConfig {
 /// `controller` (not ""): replaces pso_tuner/controller (tune --controller), before the gains are chosen.
 TuneConfig loadTuneConfig(const std::string& path, const std::string& controller = "");
 
-}  // namespace bench
+}  // namespace scenario_file
 }  // namespace sowing_robot

@@ -17,7 +17,7 @@
 #include "sowing_robot/core/common/param_table.h"
 
 namespace sowing_robot {
-namespace bench {
+namespace scenario_file {
 namespace yaml_reading {
 
 using core::ParamTable;
@@ -178,5 +178,5 @@ void applyTableBlock(const ParamTable<S>& table, const YAML::Node& group, S& s, 
 }
 
 }  // namespace yaml_reading
-}  // namespace bench
+}  // namespace scenario_file
 }  // namespace sowing_robot

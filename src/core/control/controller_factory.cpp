@@ -30,7 +30,7 @@ struct InnerEntry {
 bool always(const ControllerPair&, const std::string&) { return true; }
 // nav2's RPP regulates the speed on curvature; plain pure pursuit has no minimum radius to act on.
 bool ppActs(const ControllerPair& p, const std::string& key) {
-  return key != "regulated_linear_scaling_min_radius" || p.outer == OuterKind::rpp;
+  return key.rfind("regulated_", 0) != 0 || p.outer == OuterKind::rpp;
 }
 // The adaptation rates act only while the model estimates adapt (ATSMC, not TSMC).
 bool slidingActs(const ControllerPair& p, const std::string& key) {
@@ -191,6 +191,46 @@ std::vector<ControllerParam> slotParams(ControllerParam::Slot slot) {
     for (ControllerParam& p : lists[i]()) out.push_back(std::move(p));
   }
   return out;
+}
+
+std::vector<std::string> controllersActingOn(ControllerParam::Slot slot, const ParamInfo* info) {
+  std::vector<std::string> names;
+  auto check = [&](const char* name, std::vector<ControllerParam> (*params)(), const ControllerPair& pair) {
+    for (const ControllerParam& p : params())
+      if (p.info == info && p.acts(pair, info->key)) names.push_back(name);
+  };
+  ControllerPair pair;
+  if (slot == kOuterSlot) {
+    for (const OuterEntry& e : kOuter) {
+      pair.outer = e.kind;
+      check(e.name, e.params, pair);
+    }
+  } else {
+    for (const InnerEntry& e : kInner) {
+      pair.inner = e.kind;
+      check(e.name, e.params, pair);
+    }
+  }
+  return names;
+}
+
+std::string validateSlot(const ControllerPair& pair, ControllerParam::Slot slot) {
+  std::string e;
+  if (slot == kOuterSlot)
+    for (const OuterEntry& o : kOuter)
+      if (e.empty()) e = o.validate(pair);
+  if (slot == kInnerSlot)
+    for (const InnerEntry& i : kInner)
+      if (e.empty()) e = i.validate(pair);
+  return e;
+}
+
+void copySlot(ControllerPair& to, const ControllerPair& from, ControllerParam::Slot slot) {
+  if (slot == kOuterSlot)
+    to.outer = from.outer;
+  else
+    to.inner = from.inner;
+  for (const ControllerParam& p : slotParams(slot)) p.set(to, p.get(from));
 }
 
 std::unique_ptr<OuterController> makeOuterController(const ControllerPair& pair) {

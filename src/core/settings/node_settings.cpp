@@ -100,19 +100,36 @@ std::string PlantSimSettings::validate() const {
 
 namespace {
 
-/// `table`'s entries under `member`, each meaning prefixed by `mark(key)`: which controller reads it,
-/// "[kanayama]" (an empty mark leaves the entry out).
-template <typename S, typename N>
-void nestMarked(ParamTable<S>& out, N S::*member, const ParamTable<N>& table,
-                const std::function<std::string(const std::string&)>& mark) {
-  ParamTable<S> nested;
-  nested.nest("", member, table);
-  for (ParamEntry<S> e : nested.entries()) {
-    const std::string m = mark(e.info.key);
-    if (m.empty()) continue;
-    e.info.meaning = m + " " + e.info.meaning;
-    out.add(std::move(e));
+/// The slot's controller parameters as entries of a node's table (controller_factory.h: every registered
+/// controller's, a table shared by two controllers once): the thesis controller's (the slot's first)
+/// unmarked, another's meaning marked with the controllers it acts in ("[pid]", "[pure_pursuit, rpp]"); a key
+/// in two tables (max_torque: the motors' one limit) is one entry that sets both.
+template <typename S>
+void addControllerParams(ParamTable<S>& table, ControllerParam::Slot slot) {
+  const std::string thesis =
+      slot == ControllerParam::Slot::outer ? outerChoices().front().first : innerChoices().front().first;
+  std::vector<ParamEntry<S>> entries;
+  for (const ControllerParam& p : slotParams(slot)) {
+    auto same =
+        std::find_if(entries.begin(), entries.end(), [&](const ParamEntry<S>& e) { return e.info.key == p.info->key; });
+    if (same != entries.end()) {
+      same->set = [set = same->set, also = p.set](S& s, const ParamValue& v) {
+        set(s, v);
+        also(s, v);
+      };
+      continue;
+    }
+    ParamEntry<S> e{*p.info, [get = p.get](const S& s) { return get(s); },
+                    [set = p.set](S& s, const ParamValue& v) { set(s, v); }};
+    const std::vector<std::string> acting = controllersActingOn(slot, p.info);
+    if (std::find(acting.begin(), acting.end(), thesis) == acting.end()) {
+      std::string mark;
+      for (const std::string& name : acting) mark += (mark.empty() ? "[" : ", ") + name;
+      e.info.meaning = mark + "] " + e.info.meaning;
+    }
+    entries.push_back(std::move(e));
   }
+  for (ParamEntry<S>& e : entries) table.add(std::move(e));
 }
 
 }  // namespace
@@ -121,17 +138,14 @@ const ParamTable<KinematicControllerSettings>& KinematicControllerSettings::tabl
   using S = KinematicControllerSettings;
   static const ParamTable<S> table = [] {
     ParamTable<S> t({
-        choice("outer", &S::outer, OuterKind::kanayama, outerChoices(),
+        choice("outer", static_cast<OuterKind S::*>(&S::outer), OuterKind::kanayama, outerChoices(),
                "the outer controller: Kanayama (eqs 4.1-4.2), pure pursuit, or nav2's Regulated Pure Pursuit; "
                "the parameters of the others are checked but inert"),
         number("input_timeout", &S::input_timeout, 0.05, Limits::positive(), "s",
                "realtime: a reference older than this commands a stop (simulated time); shorter than "
                "torque_controller's, so a silent reference generator is reported as such"),
     });
-    t.nest("", &S::gains, kanayamaTable());  // unmarked: Kanayama's (the thesis's, as before the baselines)
-    nestMarked(t, &S::pure_pursuit, purePursuitTable(), [](const std::string& key) {
-      return key.rfind("regulated_", 0) == 0 ? "[rpp]" : "[pure_pursuit, rpp]";  // RPP's speed heuristic
-    });
+    addControllerParams(t, ControllerParam::Slot::outer);
     t.nest("", &S::limits, commandLimitsTable());  // whichever controller runs
     return t;
   }();
@@ -140,44 +154,22 @@ const ParamTable<KinematicControllerSettings>& KinematicControllerSettings::tabl
 
 KinematicControllerSettings::KinematicControllerSettings() { table().applyDefaults(*this); }
 
-ControllerPair KinematicControllerSettings::controllers() const {
-  ControllerPair pair;
-  pair.outer = outer;
-  pair.kanayama = gains;
-  pair.pure_pursuit = pure_pursuit;
-  return pair;
-}
-
 std::string KinematicControllerSettings::validate() const {
-  return firstError({table().checkRanges(*this), pure_pursuit.validate(), limits.validate()});
+  return firstError({table().checkRanges(*this), validateSlot(*this, ControllerParam::Slot::outer), limits.validate()});
 }
 
 const ParamTable<TorqueControllerSettings>& TorqueControllerSettings::table() {
   using S = TorqueControllerSettings;
   static const ParamTable<S> table = [] {
     ParamTable<S> t({
-        choice("inner", &S::inner, InnerKind::sliding_mode, innerChoices(),
+        choice("inner", static_cast<InnerKind S::*>(&S::inner), InnerKind::sliding_mode, innerChoices(),
                "the inner controller: the sliding-mode controller (atsmc or tsmc by `mode`) or the wheel-velocity "
                "PID; the parameters of the other are checked but inert"),
         number("input_timeout", &S::input_timeout, 0.1, Limits::positive(), "s",
                "realtime: a desired_velocity older than this gives zero torque; the sliding integrals (PID: "
                "its integrals) restart when it returns (simulated time)"),
     });
-    // Unmarked: the sliding-mode controller's (as before the baselines), but max_torque: one key, the
-    // motor's limit, for whichever controller runs.
-    ParamTable<S> sliding;
-    sliding.nest("", &S::sliding, slidingModeTable());
-    for (ParamEntry<S> e : sliding.entries()) {
-      if (e.info.key == "max_torque") {
-        e.set = [set = e.set](S& s, const ParamValue& v) {
-          set(s, v);
-          s.pid.max_torque = s.sliding.max_torque;
-        };
-      }
-      t.add(std::move(e));
-    }
-    nestMarked(t, &S::pid, wheelPidTable(),
-               [](const std::string& key) { return key == "max_torque" ? std::string() : std::string("[pid]"); });
+    addControllerParams(t, ControllerParam::Slot::inner);
     t.nest("", &S::hold, standstillHoldTable());  // whichever controller runs
     return t;
   }();
@@ -186,16 +178,8 @@ const ParamTable<TorqueControllerSettings>& TorqueControllerSettings::table() {
 
 TorqueControllerSettings::TorqueControllerSettings() { table().applyDefaults(*this); }
 
-ControllerPair TorqueControllerSettings::controllers() const {
-  ControllerPair pair;
-  pair.inner = inner;
-  pair.sliding = sliding;
-  pair.pid = pid;
-  return pair;
-}
-
 std::string TorqueControllerSettings::validate() const {
-  return firstError({table().checkRanges(*this), sliding.validate(), pid.validate(), hold.validate()});
+  return firstError({table().checkRanges(*this), validateSlot(*this, ControllerParam::Slot::inner), hold.validate()});
 }
 
 const ParamTable<ReferenceGeneratorSettings>& ReferenceGeneratorSettings::table() {

@@ -126,12 +126,8 @@ std::string loadPipelineScenario(core::Scenario& sc, double& duration) {
   sc.start = run.start();
   duration = run.duration;
   sc.duration = duration;
-  sc.outer = kin_settings.outer;
-  sc.kanayama = kin_settings.gains;
-  sc.pure_pursuit = kin_settings.pure_pursuit;
-  sc.inner = torque_settings.inner;
-  sc.sliding = torque_settings.sliding;
-  sc.pid = torque_settings.pid;
+  core::copySlot(sc, kin_settings, core::ControllerParam::Slot::outer);  // the pair as the nodes run it
+  core::copySlot(sc, torque_settings, core::ControllerParam::Slot::inner);
   sc.hold = torque_settings.hold;
   return sc.validate();
 }

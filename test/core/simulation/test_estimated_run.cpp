@@ -1,4 +1,4 @@
-// The in-process loop with an estimate in it (core/simulation/estimated_run.h) and the benchmark rows built on it
+// The in-process loop with an estimate in it (core/simulation/runner.h) and the benchmark rows built on it
 // (core/evaluation/estimated_bench.h): fed the truth it is runClosedLoop / the one loop with the plant's own state bit
 // for bit; fed the EKF on the line its error stays bounded; fed the encoders it drifts under slip; the sensors' seed
 // changes the sensor noise and nothing else; a benchmark row through it equals today's row; a robot that

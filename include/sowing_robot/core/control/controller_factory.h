@@ -75,6 +75,12 @@ struct ControllerParam {
 std::vector<ControllerParam> chosenControllerParams(const ControllerPair& pair);
 /// Every registered controller's parameters in one slot (a table shared by two entries listed once).
 std::vector<ControllerParam> slotParams(ControllerParam::Slot slot);
+/// The registered names of the slot whose controller reads `info` and in which it acts ("pure_pursuit", "rpp").
+std::vector<std::string> controllersActingOn(ControllerParam::Slot slot, const ParamInfo* info);
+/// "" or the first bad parameter of any registered controller of the slot (chosen or not).
+std::string validateSlot(const ControllerPair& pair, ControllerParam::Slot slot);
+/// The slot's choice and every registered controller's parameters of that slot, copied from `from`.
+void copySlot(ControllerPair& to, const ControllerPair& from, ControllerParam::Slot slot);
 
 /// The pair's outer / inner controller behind the run-time interfaces. Throws std::invalid_argument when
 /// its parameters do not validate. `nominal`: the robot model the inner controller assumes.

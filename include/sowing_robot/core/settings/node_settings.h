@@ -53,39 +53,30 @@ struct PlantSimSettings {
   static const ParamTable<PlantSimSettings>& table();
 };
 
-/// kinematic_controller: which outer controller (`outer`), the Kanayama gains and the pure pursuit /
-/// RPP parameters (nested, flat keys: nav2's names), and the reference timeout. Every parameter is read
-/// and checked whatever `outer` is; only the selected controller's are used (the others are inert).
-struct KinematicControllerSettings {
+/// kinematic_controller: which outer controller (`outer`) and every registered outer controller's
+/// parameters (ControllerPair, controller_factory.h; flat keys: the Kanayama gains, nav2's names for the
+/// pure pursuit / RPP), the command limits and the reference timeout. Every parameter is read and checked
+/// whatever `outer` is; only the selected controller's are used (the others are inert).
+struct KinematicControllerSettings : ControllerPair {
   KinematicControllerSettings();
   double input_timeout;
-  OuterKind outer;
-  KanayamaGains gains;
-  PurePursuitParams pure_pursuit;
   CommandLimitsParams limits;  ///< limits/: bounds on the command handed on (whichever controller runs)
-  /// Ranges (the table), then the pure pursuit's min <= L <= max (checked even when not selected).
+  /// Ranges (the table), then every outer controller's own checks (even when not selected).
   std::string validate() const;
-  /// The outer slot's choice and parameters, for the controller factory (the inner slot's defaults).
-  ControllerPair controllers() const;
   static const ParamTable<KinematicControllerSettings>& table();
 };
 
 /// torque_controller: which inner controller (`inner`: sliding_mode, whose `mode` picks atsmc or tsmc,
-/// or pid), the sliding-mode and wheel-PID parameters (nested, flat keys), and the desired-velocity
-/// timeout. `max_torque` is the motor's per-wheel limit, one key for both controllers. As for the
-/// kinematic controller, the parameters of the controller not selected are checked but inert.
-struct TorqueControllerSettings {
+/// or pid) and every registered inner controller's parameters (flat keys), the standstill hold and the
+/// desired-velocity timeout. `max_torque` is the motor's per-wheel limit, one key for every controller. As
+/// for the kinematic controller, the parameters of the controllers not selected are checked but inert.
+struct TorqueControllerSettings : ControllerPair {
   TorqueControllerSettings();
   double input_timeout;
-  InnerKind inner;
-  SlidingModeParams sliding;
-  WheelPidParams pid;         ///< pid.max_torque is always sliding.max_torque (the one `max_torque` key)
   StandstillHoldParams hold;  ///< the standstill hold at a stop (either controller)
   std::string validate() const;
   /// "atsmc", "tsmc" or "pid": the pair's inner name.
   std::string innerName() const { return core::innerName(inner, sliding.adaptive); }
-  /// The inner slot's choice and parameters, for the controller factory (the outer slot's defaults).
-  ControllerPair controllers() const;
   static const ParamTable<TorqueControllerSettings>& table();
 };
 
