@@ -199,14 +199,6 @@ double TractionPlant::kineticEnergy() const {
 }
 
 bool TractionPlant::step(double tau_right, double tau_left, double dt) {
-  double c, s;
-  s = std::sin(state_[THETA]);
-  c = std::cos(state_[THETA]);
-  return stepWithHeading(tau_right, tau_left, dt, c, s);
-}
-
-// cos_th, sin_th: cos and sin of state_[THETA].
-bool TractionPlant::stepWithHeading(double tau_right, double tau_left, double dt, double cos_th, double sin_th) {
   if (!allFinite(tau_right, tau_left, dt) || !(dt > 0.0)) return false;
   double noise_r = 0.0, noise_l = 0.0;
   if (disturbance_.noise_std > 0.0) {
@@ -241,7 +233,7 @@ bool TractionPlant::stepWithHeading(double tau_right, double tau_left, double dt
       applied_[LEFT] = motor_[LEFT].apply(tau_left, wheel_rate_[LEFT], h);
     }
     substep(applied_[RIGHT] + noise_r + amplitude * dist_s, applied_[LEFT] + noise_l + amplitude * dist_c, rr_force,
-            rr_moment, h, cos_th, sin_th);
+            rr_moment, h);
     if (disturbance_.sinusoidal && j + 1 < n) {  // the next sub-step's midpoint
       const double angle = disturbance_.frequency * (time_ + (j + 1.5) * h);
       dist_s = std::sin(angle);
@@ -302,9 +294,7 @@ void TractionPlant::draft(double dt, double& force, double& moment) const {
   moment = xt * fy - yt * fx;
 }
 
-// cos_th, sin_th: no longer read (the midpoint heading's cos/sin are taken from state_[THETA]).
-void TractionPlant::substep(double tau_r, double tau_l, double rr_force, double rr_moment, double h,
-                            [[maybe_unused]] double& cos_th, [[maybe_unused]] double& sin_th) {
+void TractionPlant::substep(double tau_r, double tau_l, double rr_force, double rr_moment, double h) {
   const double R = nominal_.R, L = nominal_.L, floor = traction_.slip_speed_floor;
   const double v = state_[V], w = state_[OMEGA];
   const double u[2] = {v + L * w, v - L * w};

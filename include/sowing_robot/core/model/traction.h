@@ -217,8 +217,7 @@ class TractionPlant {
   void draft(double dt, double& force, double& moment) const;
   /// ground_ of the wheels' and the caster's contact points (soil patches).
   void locateContacts();
-  bool stepWithHeading(double tau_right, double tau_left, double dt, double cos_th, double sin_th);
-  void substep(double tau_r, double tau_l, double rr_force, double rr_moment, double h, double& cos_th, double& sin_th);
+  void substep(double tau_r, double tau_l, double rr_force, double rr_moment, double h);
 
   RobotParams nominal_;
   PlantDisturbance disturbance_;
