@@ -1,5 +1,5 @@
-// benchmark: Monte-Carlo statistics of controller pairs over the scenario suite, in-process (no ROS master),
-// issue 17 items 2 and 3. Usage and options: kUsage below (benchmark --help).
+// benchmark: Monte-Carlo statistics of controller pairs over the scenario suite, in-process (no ROS master).
+// Usage and options: kUsage below (benchmark --help).
 // Scenarios are names in the scenario directory (default: the package's config/scenarios; `all` for every
 // file there) or paths to scenario files; controllers are outer+inner pairs (kanayama|pure_pursuit|rpp +
 // atsmc|tsmc|pid). A pair's gains come from TUNED_DIR/OUTER+INNER.yaml when that file exists (default the
@@ -13,7 +13,7 @@
 // name, a seed count of 0, a scenario file with a typo or an unwritable DIR gives one error line, exit 2,
 // and no report. A progress line goes to stderr.
 //
-// Under mpirun (or srun) the runs go to an MPI evaluation farm (farm/farm.h, issue 28): every rank reads the
+// Under mpirun (or srun) the runs go to an MPI evaluation farm (farm/farm.h): every rank reads the
 // same arguments and files, rank 0 hands out one run at a time to whichever rank is free (its own evaluation
 // thread included) and writes the files; each rank runs core::benchmarkWorker, as the threads do, so the
 // files are the same byte for byte for any number of ranks or threads. --threads is then ignored.

@@ -5,7 +5,7 @@
 // 20 % mismatch, 110 s) measured on the body (the URDF's footprint) and prints clearance, contacts, peak
 // yaw rate and v omega (from t = 12 s, after the approach from the start; and over the whole run), and
 // the seeds on the rows and on the detours; --potential-only is the thesis potential field without the
-// planned detours (the figures before issue 15). The robot starts at --start (default the thesis's
+// planned detours (the thesis's figures). The robot starts at --start (default the thesis's
 // (-1, 0, 0)) and the target starts there too, on an approach to the row (field/approach);
 // --no-approach starts the target at the row start instead (the figures before the approach).
 // --traction runs the line with the traction plant (traction.h: peak friction MU, sliding 0.75 MU, the

@@ -1,4 +1,4 @@
-// tune: the PSO gain tuner on the command line, no ROS master (issue 28). Same search and objective as the
+// tune: the PSO gain tuner on the command line, no ROS master. Same search and objective as the
 // pso_tuner node (core::TuningSession = core::tuneGains in steps); threads without an MPI launcher, an MPI
 // evaluation farm under mpirun / srun (rank 0 owns the search, checkpoint and output; every rank evaluates
 // one particle at a time; results go back by particle index, so the gains do not depend on the number of
