@@ -158,6 +158,111 @@ Options readOptions(const ros::NodeHandle& pnh) {
   return o;
 }
 
+using MessageEvent = ros::MessageEvent<topic_tools::ShapeShifter const>;
+
+/// What every topic's callback writes to and counts: the bag directly, or (~deterministic) the stamp-order
+/// writer, which holds each message ~reorder_window behind ~recorded_until.
+struct Recording {
+  Recording(rosbag::Bag& bag, const Options& o, RecordedUntil& recorded)
+      : bag(bag), o(o), recorded(recorded), ordered(bag, o.topics), window(o.reorder_window) {}
+  rosbag::Bag& bag;
+  const Options& o;
+  RecordedUntil& recorded;
+  std::size_t received = 0;
+  sowing_robot::StampOrderWriter ordered;  // ~deterministic only
+  const ros::Duration window;
+  std::unordered_set<std::string> warned;  // topics already warned of (deterministic mode)
+};
+
+/// A message of `topic` received (period topic number `index` if `is_period`): written or held.
+void recordMessage(Recording& rec, const std::string& topic, std::size_t index, bool is_period,
+                   const MessageEvent& event) {
+  const topic_tools::ShapeShifter& msg = *event.getMessage();
+  ros::Time stamp;
+  bool stamped = false;
+  ++rec.received;
+  if (!rec.o.deterministic) {
+    stamped = is_period && sowing_robot::messageStamp(msg, stamp);
+    ros::Time t = ros::Time::now();
+    if (t < ros::TIME_MIN) t = ros::TIME_MIN;  // before the first /clock
+    rec.bag.write(topic, t, event.getMessage(), event.getConnectionHeaderPtr());
+  } else {
+    std::vector<std::uint8_t> bytes(msg.size());  // held by the writer; the stamp is read from them
+    ros::serialization::OStream to(bytes.data(), static_cast<std::uint32_t>(bytes.size()));
+    msg.write(to);
+    stamped = sowing_robot::messageStamp(msg, bytes, stamp);
+    ros::Time t = stamped ? stamp : ros::Time::now();
+    if (t < ros::TIME_MIN) t = ros::TIME_MIN;  // a stamp of 0
+    if (!stamped && rec.warned.insert(topic).second)
+      ROS_WARN(
+          "bag_recorder: %s (%s) carries no stamp: recorded at its receive time, so the bag will not "
+          "repeat bit for bit",
+          topic.c_str(), msg.getDataType().c_str());
+    const ros::Time written_up_to = rec.ordered.writtenUpTo();
+    if (!rec.ordered.add(topic, t, std::move(bytes), event.getConnectionHeaderPtr()) &&
+        rec.warned.insert(topic + " late").second)
+      ROS_WARN(
+          "bag_recorder: %s stamped %.3f s came after the bag was written to %.3f s (~reorder_window "
+          "%.1f s): written out of order, so the bag will not repeat bit for bit",
+          topic.c_str(), t.toSec(), written_up_to.toSec(), rec.window.toSec());
+  }
+  if (is_period) rec.recorded.received(index, topic, msg, stamped, stamp);
+  if (rec.o.deterministic && rec.recorded.until() > ros::TIME_MIN + rec.window)
+    rec.ordered.writeBefore(rec.recorded.until() - rec.window);
+}
+
+/// One subscriber per topic into `rec`, on `delaying` when ~receive_delay is set; the period topics' own
+/// subscribers are also put in `period_subs`.
+std::vector<ros::Subscriber> subscribeAll(ros::NodeHandle& nh, Recording& rec, DelayingQueue& delaying,
+                                          std::vector<ros::Subscriber>& period_subs) {
+  const Options& o = rec.o;
+  std::vector<ros::Subscriber> subs;
+  for (const std::string& topic : o.topics) {
+    const auto period = std::find(o.period_topics.begin(), o.period_topics.end(), topic);
+    const std::size_t index = static_cast<std::size_t>(period - o.period_topics.begin());
+    const bool is_period = period != o.period_topics.end();
+    boost::function<void(const MessageEvent&)> cb = [&rec, topic, index, is_period](const MessageEvent& event) {
+      recordMessage(rec, topic, index, is_period, event);
+    };
+    ros::SubscribeOptions so;
+    so.initByFullCallbackType<const MessageEvent&>(topic, static_cast<std::uint32_t>(o.queue), cb);
+    so.transport_hints = ros::TransportHints().tcpNoDelay();
+    if (o.receive_delay > 0.0) so.callback_queue = &delaying;
+    subs.push_back(nh.subscribe(so));
+    if (is_period) period_subs.push_back(subs.back());
+  }
+  return subs;
+}
+
+/// Keeps writing what arrives until nothing has for a second.
+void drain(ros::CallbackQueue& q, const Recording& rec) {
+  for (ros::WallTime quiet = ros::WallTime::now(); (ros::WallTime::now() - quiet).toSec() < 1.0;) {
+    const std::size_t before = rec.received;
+    q.callAvailable(ros::WallDuration(0.05));
+    if (rec.received != before) quiet = ros::WallTime::now();
+  }
+}
+
+/// Writes what is held, closes the bag and gives it its name; the exit code.
+int closeBag(Recording& rec, const std::string& active) {
+  const Options& o = rec.o;
+  std::string order;
+  if (o.deterministic) {
+    rec.ordered.writeAll();
+    const sowing_robot::StampOrderWriter::Counts& c = rec.ordered.counts();
+    order = " in stamp order (" + std::to_string(c.repeats) + " resent kept once, " + std::to_string(c.late) + " late)";
+  }
+  rec.bag.close();
+  if (std::rename(active.c_str(), o.output.c_str()) != 0) {
+    ROS_ERROR("bag_recorder: could not rename %s to %s", active.c_str(), o.output.c_str());
+    return 1;
+  }
+  std::printf("bag_recorder: %zu messages written to %s%s\n",
+              o.deterministic ? rec.ordered.counts().written : rec.received, o.output.c_str(), order.c_str());
+  std::fflush(stdout);
+  return 0;
+}
+
 int record(ros::NodeHandle& nh, ros::NodeHandle& pnh, const Options& o) {
   rosbag::Bag bag;
   const std::string active = o.output + ".active";
@@ -169,59 +274,9 @@ int record(ros::NodeHandle& nh, ros::NodeHandle& pnh, const Options& o) {
   RecordedUntil recorded(pnh, o.period_topics.size());
   ros::CallbackQueue* q = ros::getGlobalCallbackQueue();
   DelayingQueue delaying(q, o.receive_delay);
-  std::size_t received = 0;
-  sowing_robot::StampOrderWriter ordered(bag, o.topics);  // ~deterministic only
-  const ros::Duration window(o.reorder_window);
-  std::unordered_set<std::string> warned;  // topics already warned of (deterministic mode)
-  std::vector<ros::Subscriber> subs, period_subs;
-  for (const std::string& topic : o.topics) {
-    const auto period = std::find(o.period_topics.begin(), o.period_topics.end(), topic);
-    const std::size_t index = static_cast<std::size_t>(period - o.period_topics.begin());
-    const bool is_period = period != o.period_topics.end();
-    boost::function<void(const ros::MessageEvent<topic_tools::ShapeShifter const>&)> cb =
-        [&bag, &received, &recorded, &ordered, &window, &warned, &o, topic, index,
-         is_period](const ros::MessageEvent<topic_tools::ShapeShifter const>& event) {
-          const topic_tools::ShapeShifter& msg = *event.getMessage();
-          ros::Time stamp;
-          bool stamped = false;
-          ++received;
-          if (!o.deterministic) {
-            stamped = is_period && sowing_robot::messageStamp(msg, stamp);
-            ros::Time t = ros::Time::now();
-            if (t < ros::TIME_MIN) t = ros::TIME_MIN;  // before the first /clock
-            bag.write(topic, t, event.getMessage(), event.getConnectionHeaderPtr());
-          } else {
-            std::vector<std::uint8_t> bytes(msg.size());  // held by the writer; the stamp is read from them
-            ros::serialization::OStream to(bytes.data(), static_cast<std::uint32_t>(bytes.size()));
-            msg.write(to);
-            stamped = sowing_robot::messageStamp(msg, bytes, stamp);
-            ros::Time t = stamped ? stamp : ros::Time::now();
-            if (t < ros::TIME_MIN) t = ros::TIME_MIN;  // a stamp of 0
-            if (!stamped && warned.insert(topic).second)
-              ROS_WARN(
-                  "bag_recorder: %s (%s) carries no stamp: recorded at its receive time, so the bag will not "
-                  "repeat bit for bit",
-                  topic.c_str(), msg.getDataType().c_str());
-            const ros::Time written_up_to = ordered.writtenUpTo();
-            if (!ordered.add(topic, t, std::move(bytes), event.getConnectionHeaderPtr()) &&
-                warned.insert(topic + " late").second)
-              ROS_WARN(
-                  "bag_recorder: %s stamped %.3f s came after the bag was written to %.3f s (~reorder_window "
-                  "%.1f s): written out of order, so the bag will not repeat bit for bit",
-                  topic.c_str(), t.toSec(), written_up_to.toSec(), window.toSec());
-          }
-          if (is_period) recorded.received(index, topic, msg, stamped, stamp);
-          if (o.deterministic && recorded.until() > ros::TIME_MIN + window)
-            ordered.writeBefore(recorded.until() - window);
-        };
-    ros::SubscribeOptions so;
-    so.initByFullCallbackType<const ros::MessageEvent<topic_tools::ShapeShifter const>&>(
-        topic, static_cast<std::uint32_t>(o.queue), cb);
-    so.transport_hints = ros::TransportHints().tcpNoDelay();
-    if (o.receive_delay > 0.0) so.callback_queue = &delaying;
-    subs.push_back(nh.subscribe(so));
-    if (is_period) period_subs.push_back(subs.back());
-  }
+  Recording rec(bag, o, recorded);
+  std::vector<ros::Subscriber> period_subs;
+  std::vector<ros::Subscriber> subs = subscribeAll(nh, rec, delaying, period_subs);
   // plant_sim's wait_for may name the recorder: announced once the per-period topics are linked, so none of
   // their first messages is lost
   const sowing_robot::ReadyAnnouncer ready(nh, pnh, true, period_subs);
@@ -231,26 +286,8 @@ int record(ros::NodeHandle& nh, ros::NodeHandle& pnh, const Options& o) {
   while (!g_stop && ros::ok()) q->callAvailable(ros::WallDuration(0.1));
   // Drain: keep writing until nothing has arrived for a second, then close.
   subs.clear();
-  for (ros::WallTime quiet = ros::WallTime::now(); (ros::WallTime::now() - quiet).toSec() < 1.0;) {
-    const std::size_t before = received;
-    q->callAvailable(ros::WallDuration(0.05));
-    if (received != before) quiet = ros::WallTime::now();
-  }
-  std::string order;
-  if (o.deterministic) {
-    ordered.writeAll();
-    const sowing_robot::StampOrderWriter::Counts& c = ordered.counts();
-    order = " in stamp order (" + std::to_string(c.repeats) + " resent kept once, " + std::to_string(c.late) + " late)";
-  }
-  bag.close();
-  if (std::rename(active.c_str(), o.output.c_str()) != 0) {
-    ROS_ERROR("bag_recorder: could not rename %s to %s", active.c_str(), o.output.c_str());
-    return 1;
-  }
-  std::printf("bag_recorder: %zu messages written to %s%s\n", o.deterministic ? ordered.counts().written : received,
-              o.output.c_str(), order.c_str());
-  std::fflush(stdout);
-  return 0;
+  drain(*q, rec);
+  return closeBag(rec, active);
 }
 
 }  // namespace

@@ -1,5 +1,5 @@
-// benchmark: Monte-Carlo statistics of controller pairs over the scenario suite, in-process (no ROS master),
-// issue 17 items 2 and 3. Usage and options: kUsage below (benchmark --help).
+// benchmark: Monte-Carlo statistics of controller pairs over the scenario suite, in-process (no ROS master).
+// Usage and options: kUsage below (benchmark --help).
 // Scenarios are names in the scenario directory (default: the package's config/scenarios; `all` for every
 // file there) or paths to scenario files; controllers are outer+inner pairs (kanayama|pure_pursuit|rpp +
 // atsmc|tsmc|pid). A pair's gains come from TUNED_DIR/OUTER+INNER.yaml when that file exists (default the
@@ -13,7 +13,7 @@
 // name, a seed count of 0, a scenario file with a typo or an unwritable DIR gives one error line, exit 2,
 // and no report. A progress line goes to stderr.
 //
-// Under mpirun (or srun) the runs go to an MPI evaluation farm (farm/farm.h, issue 28): every rank reads the
+// Under mpirun (or srun) the runs go to an MPI evaluation farm (farm/farm.h): every rank reads the
 // same arguments and files, rank 0 hands out one run at a time to whichever rank is free (its own evaluation
 // thread included) and writes the files; each rank runs core::benchmarkWorker, as the threads do, so the
 // files are the same byte for byte for any number of ranks or threads. --threads is then ignored.
@@ -27,16 +27,17 @@
 #include <fstream>
 #include <functional>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "sowing_robot/scenario_file/scenario_loader.h"
 #include "sowing_robot/cli/usage.h"
 #include "sowing_robot/core/evaluation/benchmark.h"
 #include "sowing_robot/core/evaluation/estimated_bench.h"
 #include "sowing_robot/core/evaluation/run_metrics.h"
 #include "sowing_robot/core/simulation/runner.h"
 #include "sowing_robot/farm/farm.h"
-#include "sowing_robot/scenario_file/scenario_loader.h"
 
 using namespace sowing_robot::core;
 namespace scenario_file = sowing_robot::scenario_file;
@@ -175,6 +176,259 @@ std::string loadLine(const std::vector<WorkerLoad>& loads, double wall) {
   return line + tail;
 }
 
+/// The command line, as given (defaults where an option is absent).
+struct Options {
+  std::vector<std::string> scenario_names{"thesis_line"}, controllers{"kanayama+atsmc"};
+  long long seeds = -1, threads = 0, base_seed = -1;
+  std::string output, scenario_dir = SOWING_SOURCE_DIR "/config/scenarios",
+                      tuned_dir = SOWING_SOURCE_DIR "/config/tuned", profile;
+};
+
+/// Reads and checks the options; false (with `exit_code` and the error line printed) on a bad request.
+bool parseOptions(int argc, char** argv, Options& o, int& exit_code) {
+  static const std::vector<std::string> kOptions{"--controllers",  "--scenarios", "--output",
+                                                 "--scenario-dir", "--tuned-dir", "--seeds",
+                                                 "--threads",      "--base-seed", "--profile"};
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (std::find(kOptions.begin(), kOptions.end(), a) == kOptions.end()) {
+      exit_code = sowing_robot::cli::unknownOption("benchmark", a);
+      return false;
+    }
+    if (i + 1 >= argc) {
+      exit_code = fail("missing value after " + a);
+      return false;
+    }
+    const char* v = argv[++i];
+    if (a == "--controllers") {
+      o.controllers = splitComma(v);
+    } else if (a == "--scenarios") {
+      o.scenario_names = splitComma(v);
+    } else if (a == "--output") {
+      o.output = v;
+    } else if (a == "--scenario-dir") {
+      o.scenario_dir = v;
+    } else if (a == "--tuned-dir") {
+      o.tuned_dir = v;
+    } else if (a == "--profile") {
+      o.profile = v;
+    } else {  // --seeds, --threads or --base-seed: kOptions has no other
+      long long n;
+      if (!parseInteger(v, n)) {
+        exit_code = fail(a + " needs an integer, not '" + v + "'");
+        return false;
+      }
+      (a == "--seeds" ? o.seeds : a == "--threads" ? o.threads : o.base_seed) = n;
+    }
+  }
+  std::string error;
+  if (o.seeds < 1)
+    error = o.seeds == -1 ? "--seeds N is required" : "--seeds must be >= 1";
+  else if (o.threads < 0)
+    error = "--threads must be >= 0 (0: all cores)";
+  else if (o.base_seed < -1)
+    error = "--base-seed must be >= 0";
+  else if (o.output.empty())
+    error = "--output DIR is required";
+  if (!error.empty()) {
+    exit_code = fail(error);
+    return false;
+  }
+  if (o.scenario_names.size() == 1 && o.scenario_names[0] == "all")
+    o.scenario_names = scenario_file::scenarioNames(o.scenario_dir);
+  return true;
+}
+
+/// The scenarios and controller pairs the options name, loaded and checked before the first run.
+struct Suite {
+  std::vector<BenchScenario> scenarios;
+  std::vector<Scenario> pairs;
+  std::vector<std::string> gains_source;  // per pair: the tuned file its gains come from, or why the defaults
+};
+
+/// Throws on the first unknown name or bad file (scenarios first, then controllers, in the given order).
+Suite loadSuite(const Options& o) {
+  Suite suite;
+  for (const auto& name : o.scenario_names) {
+    suite.scenarios.push_back(scenario_file::loadScenario(name, o.scenario_dir, o.profile));
+    if (o.base_seed >= 0) suite.scenarios.back().spec.base_seed = static_cast<std::uint64_t>(o.base_seed);
+  }
+  for (const auto& c : o.controllers) {
+    Scenario sc;
+    const std::string e = parseControllerPair(c, sc.outer, sc.inner, sc.sliding.adaptive);
+    if (!e.empty()) throw std::invalid_argument(e);
+    const std::string tuned = scenario_file::tunedGainsFile(o.tuned_dir, sc);
+    if (!tuned.empty()) scenario_file::applyTunedGains(tuned, sc);
+    suite.gains_source.push_back(tuned.empty() ? "the parameter tables' defaults (no " + sc.controllerName() +
+                                                     ".yaml in " + o.tuned_dir + ")"
+                                               : tuned);
+    suite.pairs.push_back(sc);
+  }
+  return suite;
+}
+
+/// Every scenario x controller batch, in the files' order: the runs' (batch, seed) is what the farm sends.
+std::vector<BenchScenario> batchesOf(const Suite& suite) {
+  std::vector<BenchScenario> batches;
+  for (const BenchScenario& scenario : suite.scenarios) {
+    for (const Scenario& pair : suite.pairs) {
+      batches.push_back(withController(scenario, pair));
+    }
+  }
+  return batches;
+}
+
+/// Makes DIR if missing and checks that a file can be written into it (before any run).
+bool canWriteInto(const std::string& dir) {
+  ::mkdir(dir.c_str(), 0777);  // may exist; the writes below report a real failure
+  {
+    std::ofstream probe(dir + "/.benchmark_probe");
+    if (!probe.good()) return false;
+  }
+  std::remove((dir + "/.benchmark_probe").c_str());
+  return true;
+}
+
+/// report.md up to its overview: how many runs, where each pair's gains come from (with what a robust
+/// tuning never saw), and what each scenario draws.
+std::string reportHead(const Suite& suite, long long seeds) {
+  std::string report =
+      "# Controller benchmark\n\n" + std::to_string(seeds) +
+      " seeded runs per scenario and controller, in-process (`benchmark`, core/evaluation/benchmark.h); every "
+      "run can be repeated alone from its row of runs.csv.\n\nGains:\n\n";
+  std::string held_out;  // for gains from a robust tuning: which scenarios and draws it never saw
+  for (std::size_t p = 0; p < suite.pairs.size(); ++p) {
+    report += "- " + suite.pairs[p].controllerName() + ": " + suite.gains_source[p] + "\n";
+    const auto training = scenario_file::trainingOf(suite.gains_source[p]);
+    if (training.empty()) continue;
+    held_out += "- " + suite.pairs[p].controllerName() + ", trained on";
+    for (const auto& t : training)
+      held_out += " " + t.scenario + " (runs 0-" + std::to_string(t.runs - 1) + ", base seed " +
+                  std::to_string(t.base_seed) + ")";
+    held_out += ":";
+    for (const auto& b : suite.scenarios)
+      held_out += " " + b.name + " " + scenario_file::heldOutVerdict(training, b.name, b.spec.base_seed, seeds) + ";";
+    held_out += "\n";
+  }
+  if (!held_out.empty()) report += "\nTraining and held-out data (robust-tuned gains):\n\n" + held_out;
+  report += "\nScenarios:\n\n";
+  for (const auto& b : suite.scenarios) report += describe(b) + describeRealism(b);
+  return report;
+}
+
+/// The progress line on stderr: every 10 runs on a terminal (rewritten in place), else once per batch.
+class Progress {
+ public:
+  Progress(long long seeds, long long total)
+      : tty_(::isatty(STDERR_FILENO) != 0), t0_(std::chrono::steady_clock::now()), seeds_(seeds), total_(total) {}
+
+  /// The callback for one batch's runs (`done` of its seeds finished).
+  std::function<void(std::int64_t)> forBatch(const std::string& scenario, const std::string& controller) const {
+    return [this, scenario, controller](std::int64_t done) {
+      if (!tty_ && done != seeds_) return;
+      if (tty_ && done % 10 != 0 && done != seeds_) return;
+      const double wall = seconds();
+      const double frac = static_cast<double>(finished_ + done) / static_cast<double>(total_);
+      std::fprintf(stderr, "%s%s / %s: %lld/%lld runs; all %lld/%lld, %.0f s, about %.0f s left%s", tty_ ? "\r" : "",
+                   scenario.c_str(), controller.c_str(), static_cast<long long>(done), seeds_, finished_ + done, total_,
+                   wall, frac > 0 ? wall * (1.0 - frac) / frac : 0.0, tty_ ? "   " : "\n");
+    };
+  }
+  void batchDone() { finished_ += seeds_; }
+  /// Ends the line a terminal rewrites in place.
+  void endLine() const {
+    if (tty_) std::fprintf(stderr, "\n");
+  }
+  /// Wall time since the runs began.
+  double seconds() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count(); }
+
+ private:
+  bool tty_;
+  std::chrono::steady_clock::time_point t0_;
+  long long seeds_, total_, finished_ = 0;
+};
+
+/// The rows of one batch's seeds: from the farm under MPI, else from runBenchmark's threads (their loads in
+/// `loads`). Throws what a run throws.
+std::vector<RunRow> runBatch(sowing_robot::farm::Farm& farm, const sowing_robot::farm::Compute& compute, std::size_t k,
+                             const BenchScenario& b, const Options& o,
+                             const std::function<void(std::int64_t)>& progress, std::vector<WorkerLoad>& loads) {
+  if (!farm.active()) return runBenchmark(b, o.seeds, static_cast<int>(o.threads), progress, &loads);
+  checkBenchmark(b, o.seeds);  // before any run, as runBenchmark does
+  std::vector<RunRow> rows(static_cast<std::size_t>(o.seeds));
+  std::int64_t done = 0;
+  farm.run(
+      static_cast<int>(o.seeds),
+      [k](int i) {
+        return sowing_robot::farm::Payload{static_cast<double>(k), static_cast<double>(i)};
+      },
+      compute,
+      [&](int i, const sowing_robot::farm::Payload& packed) {
+        rows[static_cast<std::size_t>(i)] = unpackRow(packed);
+        progress(++done);
+      });
+  return rows;
+}
+
+/// The four files' texts, filled batch by batch in the files' order.
+struct Outputs {
+  std::string csv, envelopes, summary, sections;
+  std::vector<WorkerLoad> loads;  // per worker thread, over all batches
+};
+
+/// Runs every batch into `out`; on a failed run, the error line and exit 2 (every rank of a farm ends).
+bool runAll(sowing_robot::farm::Farm& farm, const sowing_robot::farm::Compute& compute,
+            const std::vector<BenchScenario>& batches, const Options& o, bool realism, Progress& progress, Outputs& out,
+            int& exit_code) {
+  for (std::size_t k = 0; k < batches.size(); ++k) {
+    const BenchScenario& b = batches[k];
+    const std::string name = b.base.controllerName();
+    std::vector<RunRow> rows;
+    std::vector<WorkerLoad> batch_loads;
+    try {
+      rows = runBatch(farm, compute, k, b, o, progress.forBatch(b.name, name), batch_loads);
+    } catch (const std::exception& e) {
+      progress.endLine();
+      if (farm.active()) {
+        fail(b.name + " / " + name + ": " + e.what());
+        farm.abort(2);
+      }
+      exit_code = fail(b.name + " / " + name + ": " + e.what());
+      return false;
+    }
+    progress.batchDone();
+    addLoads(batch_loads, out.loads);
+    out.csv += runsCsvLines(b.name, name, rows, realism);
+    out.envelopes += envelopeCsvLines(b.name, name, crossTrackEnvelope(rows, b.envelope_period));
+    out.summary += summaryLine(b.name, name, rows);
+    out.sections += reportSection(b.name, name, rows);
+  }
+  return true;
+}
+
+/// The closing lines on stdout: runs and wall time, then how the farm's ranks or the threads were loaded.
+void printTotals(const sowing_robot::farm::Farm& farm, const Options& o, long long total, double wall,
+                 const std::vector<WorkerLoad>& loads) {
+  if (farm.active()) {
+    const double eval = farm.evaluationSeconds();
+    std::printf("benchmark: %lld runs in %.2f s wall (%.2f ms per run, %s); %s/runs.csv, envelopes.csv, report.md\n",
+                total, wall, 1e3 * wall / static_cast<double>(total), farm.describe().c_str(), o.output.c_str());
+    std::printf(
+        "benchmark: farm: evaluation %.2f s summed over %d evaluators, rank 0 farm work %.4f s (%.3f %% of "
+        "evaluation), evaluators busy %.1f %% of %d x wall\n",
+        eval, farm.size(), farm.overheadSeconds(), eval > 0 ? 100.0 * farm.overheadSeconds() / eval : 0.0,
+        wall > 0 ? 100.0 * eval / (wall * farm.size()) : 0.0, farm.size());
+    return;
+  }
+  // The worker threads that ran (--threads 0 is all cores; never more workers than batches of runs).
+  const std::size_t nworkers = loads.size();
+  std::printf(
+      "benchmark: %lld runs in %.2f s wall (%.2f ms per run, %zu thread%s%s); %s/runs.csv, envelopes.csv, report.md\n",
+      total, wall, 1e3 * wall / static_cast<double>(total), nworkers, nworkers == 1 ? "" : "s",
+      o.threads == 0 ? ", all cores" : "", o.output.c_str());
+  std::printf("%s\n", loadLine(loads, wall).c_str());
+}
+
 }  // namespace
 
 int run(sowing_robot::farm::Farm& farm, int argc, char** argv);
@@ -192,74 +446,16 @@ int main(int argc, char** argv) {
 }
 
 int run(sowing_robot::farm::Farm& farm, int argc, char** argv) {
-  std::vector<std::string> scenario_names{"thesis_line"}, controllers{"kanayama+atsmc"};
-  long long seeds = -1, threads = 0, base_seed = -1;
-  std::string output, scenario_dir = SOWING_SOURCE_DIR "/config/scenarios",
-                      tuned_dir = SOWING_SOURCE_DIR "/config/tuned", profile;
-  static const std::vector<std::string> kOptions{"--controllers",  "--scenarios", "--output",
-                                                 "--scenario-dir", "--tuned-dir", "--seeds",
-                                                 "--threads",      "--base-seed", "--profile"};
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (std::find(kOptions.begin(), kOptions.end(), a) == kOptions.end())
-      return sowing_robot::cli::unknownOption("benchmark", a);
-    if (i + 1 >= argc) return fail("missing value after " + a);
-    const char* v = argv[++i];
-    if (a == "--controllers") {
-      controllers = splitComma(v);
-    } else if (a == "--scenarios") {
-      scenario_names = splitComma(v);
-    } else if (a == "--output") {
-      output = v;
-    } else if (a == "--scenario-dir") {
-      scenario_dir = v;
-    } else if (a == "--tuned-dir") {
-      tuned_dir = v;
-    } else if (a == "--profile") {
-      profile = v;
-    } else {  // --seeds, --threads or --base-seed: kOptions has no other
-      long long n;
-      if (!parseInteger(v, n)) return fail(a + " needs an integer, not '" + v + "'");
-      (a == "--seeds" ? seeds : a == "--threads" ? threads : base_seed) = n;
-    }
-  }
-  if (seeds < 1) return fail(seeds == -1 ? "--seeds N is required" : "--seeds must be >= 1");
-  if (threads < 0) return fail("--threads must be >= 0 (0: all cores)");
-  if (base_seed < -1) return fail("--base-seed must be >= 0");
-  if (output.empty()) return fail("--output DIR is required");
-  if (scenario_names.size() == 1 && scenario_names[0] == "all")
-    scenario_names = scenario_file::scenarioNames(scenario_dir);
-
-  // Load and check everything before the first run.
-  std::vector<BenchScenario> scenarios;
-  std::vector<Scenario> pairs;
-  std::vector<std::string> gains_source;
+  Options o;
+  int exit_code = 0;
+  if (!parseOptions(argc, argv, o, exit_code)) return exit_code;
+  Suite suite;
   try {
-    for (const auto& name : scenario_names) {
-      scenarios.push_back(scenario_file::loadScenario(name, scenario_dir, profile));
-      if (base_seed >= 0) scenarios.back().spec.base_seed = static_cast<std::uint64_t>(base_seed);
-    }
-    for (const auto& c : controllers) {
-      Scenario sc;
-      const std::string e = parseControllerPair(c, sc.outer, sc.inner, sc.sliding.adaptive);
-      if (!e.empty()) return fail(e);
-      const std::string tuned = scenario_file::tunedGainsFile(tuned_dir, sc);
-      if (!tuned.empty()) scenario_file::applyTunedGains(tuned, sc);
-      gains_source.push_back(tuned.empty() ? "the parameter tables' defaults (no " + sc.controllerName() + ".yaml in " +
-                                                 tuned_dir + ")"
-                                           : tuned);
-      pairs.push_back(sc);
-    }
+    suite = loadSuite(o);
   } catch (const std::exception& e) {
     return fail(e.what());
   }
-  // Every scenario x controller batch, in the files' order: the runs' (batch, seed) is what the farm sends.
-  std::vector<BenchScenario> batches;
-  for (const BenchScenario& scenario : scenarios) {
-    for (const Scenario& pair : pairs) {
-      batches.push_back(withController(scenario, pair));
-    }
-  }
+  const std::vector<BenchScenario> batches = batchesOf(suite);
   // One run on any rank: {batch, seed} -> the packed row, by each batch's benchmarkWorker (made on first use).
   std::vector<std::function<RunRow(std::int64_t)>> workers(batches.size());
   const sowing_robot::farm::Compute compute = [&](const sowing_robot::farm::Payload& request) {
@@ -268,123 +464,34 @@ int run(sowing_robot::farm::Farm& farm, int argc, char** argv) {
     return packRow(workers[k](static_cast<std::int64_t>(request.at(1))));
   };
   if (!farm.root()) return farm.serve(compute) ? 0 : 1;
-
-  ::mkdir(output.c_str(), 0777);  // may exist; the writes below report a real failure
-  {
-    std::ofstream probe(output + "/.benchmark_probe");
-    if (!probe.good()) return fail("cannot write into " + output);
-  }
-  std::remove((output + "/.benchmark_probe").c_str());
+  if (!canWriteInto(o.output)) return fail("cannot write into " + o.output);
 
   // Scenarios with sensors, traction or an estimate in the loop add their columns (estimated_bench.h); without
   // one, runs.csv is today's, byte for byte.
   bool realism = false;
-  for (const auto& b : scenarios) realism = realism || b.realism.has_value();
-  std::string csv = runsCsvHeader(realism), envelopes = envelopeCsvHeader();
-  std::string report =
-      "# Controller benchmark\n\n" + std::to_string(seeds) +
-      " seeded runs per scenario and controller, in-process (`benchmark`, core/evaluation/benchmark.h); every "
-      "run can be repeated alone from its row of runs.csv.\n\nGains:\n\n";
-  std::string held_out;  // for gains from a robust tuning: which scenarios and draws it never saw
-  for (std::size_t p = 0; p < pairs.size(); ++p) {
-    report += "- " + pairs[p].controllerName() + ": " + gains_source[p] + "\n";
-    const auto training = scenario_file::trainingOf(gains_source[p]);
-    if (training.empty()) continue;
-    held_out += "- " + pairs[p].controllerName() + ", trained on";
-    for (const auto& t : training)
-      held_out += " " + t.scenario + " (runs 0-" + std::to_string(t.runs - 1) + ", base seed " +
-                  std::to_string(t.base_seed) + ")";
-    held_out += ":";
-    for (const auto& b : scenarios)
-      held_out += " " + b.name + " " + scenario_file::heldOutVerdict(training, b.name, b.spec.base_seed, seeds) + ";";
-    held_out += "\n";
-  }
-  if (!held_out.empty()) report += "\nTraining and held-out data (robust-tuned gains):\n\n" + held_out;
-  report += "\nScenarios:\n\n";
-  for (const auto& b : scenarios) report += describe(b) + describeRealism(b);
-  std::string summary = summaryHeader(), sections;
+  for (const auto& b : suite.scenarios) realism = realism || b.realism.has_value();
+  Outputs out;
+  out.csv = runsCsvHeader(realism);
+  out.envelopes = envelopeCsvHeader();
+  out.summary = summaryHeader();
+  std::string report = reportHead(suite, o.seeds);
 
-  const bool tty = ::isatty(STDERR_FILENO) != 0;
-  const auto t0 = std::chrono::steady_clock::now();
-  const long long total = seeds * static_cast<long long>(scenarios.size() * pairs.size());
-  long long finished = 0;
-  std::vector<WorkerLoad> loads;  // per worker thread, over all batches
-  for (std::size_t k = 0; k < batches.size(); ++k) {
-    {
-      const BenchScenario& b = batches[k];
-      const std::string name = b.base.controllerName();
-      std::vector<RunRow> rows;
-      std::vector<WorkerLoad> batch_loads;
-      const auto progress = [&](std::int64_t done) {
-        if (!tty && done != seeds) return;
-        if (tty && done % 10 != 0 && done != seeds) return;
-        const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        const double frac = static_cast<double>(finished + done) / static_cast<double>(total);
-        std::fprintf(stderr, "%s%s / %s: %lld/%lld runs; all %lld/%lld, %.0f s, about %.0f s left%s", tty ? "\r" : "",
-                     b.name.c_str(), name.c_str(), static_cast<long long>(done), seeds, finished + done, total, wall,
-                     frac > 0 ? wall * (1.0 - frac) / frac : 0.0, tty ? "   " : "\n");
-      };
-      try {
-        if (farm.active()) {
-          checkBenchmark(b, seeds);  // before any run, as runBenchmark does
-          rows.resize(static_cast<std::size_t>(seeds));
-          std::int64_t done = 0;
-          farm.run(
-              static_cast<int>(seeds),
-              [k](int i) {
-                return sowing_robot::farm::Payload{static_cast<double>(k), static_cast<double>(i)};
-              },
-              compute,
-              [&](int i, const sowing_robot::farm::Payload& packed) {
-                rows[static_cast<std::size_t>(i)] = unpackRow(packed);
-                progress(++done);
-              });
-        } else {
-          rows = runBenchmark(b, seeds, static_cast<int>(threads), progress, &batch_loads);
-        }
-      } catch (const std::exception& e) {
-        if (tty) std::fprintf(stderr, "\n");
-        if (farm.active()) {
-          fail(b.name + " / " + name + ": " + e.what());
-          farm.abort(2);
-        }
-        return fail(b.name + " / " + name + ": " + e.what());
-      }
-      finished += seeds;
-      addLoads(batch_loads, loads);
-      csv += runsCsvLines(b.name, name, rows, realism);
-      envelopes += envelopeCsvLines(b.name, name, crossTrackEnvelope(rows, b.envelope_period));
-      summary += summaryLine(b.name, name, rows);
-      sections += reportSection(b.name, name, rows);
-    }
-  }
-  if (tty) std::fprintf(stderr, "\n");
-  report += "\n## Overview\n\n" + summary + "\n" + sections;
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const long long total = o.seeds * static_cast<long long>(suite.scenarios.size() * suite.pairs.size());
+  Progress progress(o.seeds, total);
+  if (!runAll(farm, compute, batches, o, realism, progress, out, exit_code)) return exit_code;
+  progress.endLine();
+  report += "\n## Overview\n\n" + out.summary + "\n" + out.sections;
+  const double wall = progress.seconds();
   std::string error;
   const std::string metrics = runMetricsJson();
-  if (!writeAll(output,
-                {{"runs.csv", &csv}, {"metrics.json", &metrics}, {"envelopes.csv", &envelopes}, {"report.md", &report}},
+  if (!writeAll(o.output,
+                {{"runs.csv", &out.csv},
+                 {"metrics.json", &metrics},
+                 {"envelopes.csv", &out.envelopes},
+                 {"report.md", &report}},
                 error))
     return fail(error);
   farm.stop();
-  if (farm.active()) {
-    const double eval = farm.evaluationSeconds();
-    std::printf("benchmark: %lld runs in %.2f s wall (%.2f ms per run, %s); %s/runs.csv, envelopes.csv, report.md\n",
-                total, wall, 1e3 * wall / static_cast<double>(total), farm.describe().c_str(), output.c_str());
-    std::printf(
-        "benchmark: farm: evaluation %.2f s summed over %d evaluators, rank 0 farm work %.4f s (%.3f %% of "
-        "evaluation), evaluators busy %.1f %% of %d x wall\n",
-        eval, farm.size(), farm.overheadSeconds(), eval > 0 ? 100.0 * farm.overheadSeconds() / eval : 0.0,
-        wall > 0 ? 100.0 * eval / (wall * farm.size()) : 0.0, farm.size());
-    return 0;
-  }
-  // The worker threads that ran (--threads 0 is all cores; never more workers than batches of runs).
-  const std::size_t nworkers = loads.size();
-  std::printf(
-      "benchmark: %lld runs in %.2f s wall (%.2f ms per run, %zu thread%s%s); %s/runs.csv, envelopes.csv, report.md\n",
-      total, wall, 1e3 * wall / static_cast<double>(total), nworkers, nworkers == 1 ? "" : "s",
-      threads == 0 ? ", all cores" : "", output.c_str());
-  std::printf("%s\n", loadLine(loads, wall).c_str());
+  printTotals(farm, o, total, wall, out.loads);
   return 0;
 }

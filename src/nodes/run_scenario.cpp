@@ -5,7 +5,7 @@
 // 20 % mismatch, 110 s) measured on the body (the URDF's footprint) and prints clearance, contacts, peak
 // yaw rate and v omega (from t = 12 s, after the approach from the start; and over the whole run), and
 // the seeds on the rows and on the detours; --potential-only is the thesis potential field without the
-// planned detours (the figures before issue 15). The robot starts at --start (default the thesis's
+// planned detours (the thesis's figures). The robot starts at --start (default the thesis's
 // (-1, 0, 0)) and the target starts there too, on an approach to the row (field/approach);
 // --no-approach starts the target at the row start instead (the figures before the approach).
 // --traction runs the line with the traction plant (traction.h: peak friction MU, sliding 0.75 MU, the
@@ -55,14 +55,113 @@ const char* const kUsage =
     "  --traction MU            with --wet (the wet patch of config/field_thesis_wet.yaml), --draft N (tool draft)\n"
     "  -h, --help               this text\n";
 
-/// The thesis field on the body; returns the exit code.
-int runThesisField(bool potential_only, bool approach, bool path_follower, const Pose2D& start, std::int64_t period_ns,
-                   const TractionParams& traction, bool wet, bool adaptive) {
+/// The command line, as given (defaults where an option is absent).
+struct Options {
+  std::vector<bool> modes;  // the sliding modes run, in order: true ATSMC, false TSMC
+  bool field = false, potential_only = false, approach = true, wet = false, path_follower = false;
+  Pose2D start = Scenario().start;
+  Scenario sc;
+  int repeat = 1;
+  std::string yaml;
+  TractionParams traction;  // enabled by --traction
+};
+
+/// An option's value is missing: what was expected ("--start Y").
+struct MissingValue {
+  std::string what;
+};
+
+/// Reads the options into `o`; false, with the error line printed and `exit_code` set, on a bad one.
+bool parseOptions(int argc, char** argv, Options& o, int& exit_code) {
+  try {
+    for (int i = 1; i < argc; ++i) {
+      const std::string a = argv[i];
+      auto value = [&](const char* what) {
+        if (i + 1 >= argc) throw MissingValue{what};
+        return std::strtod(argv[++i], nullptr);
+      };
+      if (a == "--field")
+        o.field = true;
+      else if (a == "--potential-only")
+        o.potential_only = true;
+      else if (a == "--no-approach")
+        o.approach = false;
+      else if (a == "--path-follower")
+        o.path_follower = true;
+      else if (a == "--start") {
+        o.start.x = value("--start X");
+        o.start.y = value("--start Y");
+        o.start.theta = value("--start THETA");
+      } else if (a == "--tsmc")
+        o.modes.push_back(false);
+      else if (a == "--atsmc")
+        o.modes.push_back(true);
+      else if (a == "--disturbance")
+        o.sc.disturbance.sinusoidal = true;
+      else if (a == "--mismatch")
+        o.sc.disturbance.mass_scale = o.sc.disturbance.inertia_scale = value("--mismatch");
+      else if (a == "--noise")
+        o.sc.disturbance.noise_std = value("--noise");
+      else if (a == "--duration")
+        o.sc.duration = value("--duration");
+      else if (a == "--rate")
+        o.sc.control_period_ns = static_cast<std::int64_t>(1e9 / value("--rate") + 0.5);
+      else if (a == "--width")
+        o.sc.sliding.switching.width = value("--width");
+      else if (a == "--repeat")
+        o.repeat = static_cast<int>(value("--repeat"));
+      else if (a == "--traction") {
+        o.traction.enabled = true;
+        o.traction.mu_peak = value("--traction");
+        o.traction.mu_slide = 0.75 * o.traction.mu_peak;
+      } else if (a == "--wet")
+        o.wet = true;
+      else if (a == "--draft")
+        o.traction.draft_force = value("--draft");
+      else if (a == "--slip-stiffness")
+        o.traction.slip_stiffness = value("--slip-stiffness");
+      else if (a == "--rolling-resistance")
+        o.traction.rolling_resistance = value("--rolling-resistance");
+      else if (a == "--yaml" && i + 1 < argc)
+        o.yaml = argv[++i];
+      else if (a == "--switching" && i + 1 < argc) {
+        if (!SwitchFunction::parse(argv[++i], o.sc.sliding.switching.type)) {
+          std::fprintf(stderr, "run_scenario: unknown switching '%s'\n", argv[i]);
+          exit_code = 2;
+          return false;
+        }
+      } else {
+        exit_code = sowing_robot::cli::unknownOption("run_scenario", a);
+        return false;
+      }
+    }
+  } catch (const MissingValue& missing) {
+    std::fprintf(stderr, "run_scenario: %s needs a value\n", missing.what.c_str());
+    exit_code = 2;
+    return false;
+  }
+  return true;
+}
+
+/// Why --field's options do not go together ("" when they do).
+std::string fieldOptionsError(const Options& o) {
+  if (o.potential_only && o.path_follower)
+    return "--potential-only and --path-follower exclude each other (the path follower has no repulsion: it needs "
+           "the planned detours)";
+  const std::string err = o.traction.enabled ? o.traction.validate() : "";
+  if (!err.empty() || ((o.wet || o.traction.draft_force > 0.0) && !o.traction.enabled))
+    return err.empty() ? "--wet and --draft need --traction MU" : err;
+  return "";
+}
+
+/// The thesis field (config/field_thesis.yaml) as the options set it up, before its check and the
+/// approach's extra time.
+FieldRunSetup thesisFieldSetup(const Options& o) {
   FieldRunSetup s;
-  s.scenario.sliding.adaptive = adaptive;
-  if (traction.enabled) {
-    s.traction = traction;
-    if (wet) {
+  s.scenario.sliding.adaptive = o.modes.empty() || o.modes.back();
+  if (o.traction.enabled) {
+    s.traction = o.traction;
+    if (o.wet) {
       SoilPatch patch;  // config/field_thesis_wet.yaml
       patch.polygon = {{43.0, 1.0}, {58.0, 1.0}, {58.0, 5.0}, {43.0, 5.0}};
       patch.mu_peak = 0.2;
@@ -72,39 +171,31 @@ int runThesisField(bool potential_only, bool approach, bool path_follower, const
     }
   }
   s.scenario.duration = 110.0;
-  if (period_ns > 0) s.scenario.control_period_ns = period_ns;
-  s.scenario.start = start;
-  s.field.approach = approach;
-  s.field.start_pose = start;  // what the node takes from plant_sim's start/{x, y, theta}
+  if (o.sc.control_period_ns > 0) s.scenario.control_period_ns = o.sc.control_period_ns;
+  s.scenario.start = o.start;
+  s.field.approach = o.approach;
+  s.field.start_pose = o.start;  // what the node takes from plant_sim's start/{x, y, theta}
   s.field.rows = 1;
   s.field.row_length = 100.0;
   s.field.start_x = 0.0;
   s.field.start_y = 3.0;
   s.field.potential.beta = 4.0;  // config/field_thesis.yaml (alpha 4, influence 0.5, gain 5, ratio 1 are the defaults)
-  s.field.avoidance.plan_detours = !potential_only;
-  if (path_follower) s.field.follower = FieldFollower::kPath;
+  s.field.avoidance.plan_detours = !o.potential_only;
+  if (o.path_follower) s.field.follower = FieldFollower::kPath;
   s.obstacles = {{20.0, 3.0, 0.3}, {50.0, 3.0, 0.3}, {80.0, 3.0, 0.3}};
-  const std::string err = s.field.validate();
-  if (!err.empty()) {
-    std::fprintf(stderr, "run_scenario: %s\n", err.c_str());
-    return 2;
-  }
-  // The approach makes the path longer than the straight row (thesis: by 2.46 s): the run is longer by as
-  // much, so it ends at the same point of the row as without it.
-  s.scenario.duration += approachExtraTime(s);
-  FieldRunSetup whole = s;
-  s.peaks_from = 12.0;
-  const auto t0 = std::chrono::steady_clock::now();
-  const FieldRunReport r = runField(s);
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  const FieldRunReport w = runField(whole);
+  return s;
+}
+
+/// The field run's table and lines: `r` measured from t = 12 s, `w` over the whole run.
+void printFieldReport(const Options& o, const FieldRunSetup& s, const FieldRunReport& r, const FieldRunReport& w,
+                      double wall) {
   std::printf("thesis field, %s%s%s (%.0f ms wall), start (%.2f, %.2f, %.3f), footprint circumscribed radius %.3f m:\n",
-              adaptive ? "" : "TSMC, ",
-              potential_only  ? "potential field only (thesis)"
-              : path_follower ? "planned detours through the path follower"
-                              : "planned detours (issue 15)",
-              potential_only ? "" : (approach ? ", approach from the start" : ", no approach"), 1e3 * wall, start.x,
-              start.y, start.theta, s.footprint.circumscribedRadius());
+              s.scenario.sliding.adaptive ? "" : "TSMC, ",
+              o.potential_only  ? "potential field only (thesis)"
+              : o.path_follower ? "planned detours through the path follower"
+                                : "planned detours (issue 15)",
+              o.potential_only ? "" : (o.approach ? ", approach from the start" : ", no approach"), 1e3 * wall,
+              o.start.x, o.start.y, o.start.theta, s.footprint.circumscribedRadius());
   std::printf(
       "| body clearance | contacts | peak yaw rate | peak v*omega | peak yaw rate / v*omega, whole run | "
       "seeds on rows: count, max, RMS | detour seeds: count, max | end |\n|---|---|---|---|---|---|---|---|\n");
@@ -122,141 +213,107 @@ int runThesisField(bool potential_only, bool approach, bool path_follower, const
       r.peak_ref_yaw_rate, r.peak_ref_lateral, r.peak_ref_curvature, w.peak_ref_yaw_rate, w.peak_ref_lateral,
       w.peak_ref_curvature, AvoidanceStatus::name(r.status.code), r.status.reason.empty() ? "" : ": ",
       r.status.reason.c_str(), r.status.within_bounds ? "" : "; bounds not held: ", r.status.bounds_note.c_str());
-  if (traction.enabled)
+  if (o.traction.enabled)
     std::printf(
         "traction: mu_peak %g, %zu soil patch(es), draft %g N (tool down %.1f s); max |slip ratio| %.3f; "
         "seeds on rows: cross-track RMS %.2f mm, max %.2f mm; %ld saturated periods%s\n",
-        traction.mu_peak, s.patches.size(), traction.draft_force, r.tool_down_time, r.max_slip, 1e3 * r.rows.rms,
+        o.traction.mu_peak, s.patches.size(), o.traction.draft_force, r.tool_down_time, r.max_slip, 1e3 * r.rows.rms,
         1e3 * r.rows.max, r.saturated, r.diverged ? ", DIVERGED" : "");
+}
+
+/// The thesis field on the body; returns the exit code.
+int runThesisField(const Options& o) {
+  FieldRunSetup s = thesisFieldSetup(o);
+  const std::string err = s.field.validate();
+  if (!err.empty()) {
+    std::fprintf(stderr, "run_scenario: %s\n", err.c_str());
+    return 2;
+  }
+  // The approach makes the path longer than the straight row (thesis: by 2.46 s): the run is longer by as
+  // much, so it ends at the same point of the row as without it.
+  s.scenario.duration += approachExtraTime(s);
+  FieldRunSetup whole = s;
+  s.peaks_from = 12.0;
+  const auto t0 = std::chrono::steady_clock::now();
+  const FieldRunReport r = runField(s);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const FieldRunReport w = runField(whole);
+  printFieldReport(o, s, r, w, wall);
   return r.diverged ? 1 : 0;
 }
-}  // namespace
 
-int main(int argc, char** argv) {
-  std::vector<bool> modes;
-  bool field = false, potential_only = false, approach = true, wet = false, path_follower = false;
-  Pose2D start = Scenario().start;
-  Scenario sc;
-  int repeat = 1;
-  std::string yaml;
-  TractionParams traction;  // enabled by --traction
-  sowing_robot::cli::exitOnHelp(argc, argv, kUsage);
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto value = [&](const char* what) {
-      if (i + 1 >= argc) {
-        std::fprintf(stderr, "run_scenario: %s needs a value\n", what);
-        std::exit(2);
-      }
-      return std::strtod(argv[++i], nullptr);
-    };
-    if (a == "--field")
-      field = true;
-    else if (a == "--potential-only")
-      potential_only = true;
-    else if (a == "--no-approach")
-      approach = false;
-    else if (a == "--path-follower")
-      path_follower = true;
-    else if (a == "--start") {
-      start.x = value("--start X");
-      start.y = value("--start Y");
-      start.theta = value("--start THETA");
-    } else if (a == "--tsmc")
-      modes.push_back(false);
-    else if (a == "--atsmc")
-      modes.push_back(true);
-    else if (a == "--disturbance")
-      sc.disturbance.sinusoidal = true;
-    else if (a == "--mismatch")
-      sc.disturbance.mass_scale = sc.disturbance.inertia_scale = value("--mismatch");
-    else if (a == "--noise")
-      sc.disturbance.noise_std = value("--noise");
-    else if (a == "--duration")
-      sc.duration = value("--duration");
-    else if (a == "--rate")
-      sc.control_period_ns = static_cast<std::int64_t>(1e9 / value("--rate") + 0.5);
-    else if (a == "--width")
-      sc.sliding.switching.width = value("--width");
-    else if (a == "--repeat")
-      repeat = static_cast<int>(value("--repeat"));
-    else if (a == "--traction") {
-      traction.enabled = true;
-      traction.mu_peak = value("--traction");
-      traction.mu_slide = 0.75 * traction.mu_peak;
-    } else if (a == "--wet")
-      wet = true;
-    else if (a == "--draft")
-      traction.draft_force = value("--draft");
-    else if (a == "--slip-stiffness")
-      traction.slip_stiffness = value("--slip-stiffness");
-    else if (a == "--rolling-resistance")
-      traction.rolling_resistance = value("--rolling-resistance");
-    else if (a == "--yaml" && i + 1 < argc)
-      yaml = argv[++i];
-    else if (a == "--switching" && i + 1 < argc) {
-      if (!SwitchFunction::parse(argv[++i], sc.sliding.switching.type)) {
-        std::fprintf(stderr, "run_scenario: unknown switching '%s'\n", argv[i]);
-        return 2;
-      }
+/// One mode's line runs: the last run, its largest slip (traction plant) and the wall time per run.
+struct LineRuns {
+  RunResult run;
+  double max_slip = 0.0;
+  double seconds_per_run = 0.0;
+};
+
+LineRuns runLine(const Scenario& sc, const TractionParams& traction, int repeat) {
+  LineReference ref;
+  LineRuns out;
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int k = 0; k < repeat; ++k) {
+    if (traction.enabled) {
+      LoopConfig plant;  // the traction plant, fed the truth
+      plant.traction = traction;
+      const LoopResult er = runClosedLoop(sc, plant, ref);
+      out.run = er.run;
+      out.max_slip = er.max_abs_slip;
     } else {
-      return sowing_robot::cli::unknownOption("run_scenario", a);
+      out.run = runClosedLoop(sc, ref);
     }
   }
-  if (field) {
-    if (potential_only && path_follower) {
-      std::fprintf(stderr,
-                   "run_scenario: --potential-only and --path-follower exclude each other (the path follower "
-                   "has no repulsion: it needs the planned detours)\n");
-      return 2;
-    }
-    const std::string err = traction.enabled ? traction.validate() : "";
-    if (!err.empty() || ((wet || traction.draft_force > 0.0) && !traction.enabled)) {
-      std::fprintf(stderr, "run_scenario: %s\n", err.empty() ? "--wet and --draft need --traction MU" : err.c_str());
-      return 2;
-    }
-    return runThesisField(potential_only, approach, path_follower, start, sc.control_period_ns, traction, wet,
-                          modes.empty() || modes.back());
-  }
-  if (modes.empty()) modes = {true, false};
+  out.seconds_per_run = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() / repeat;
+  return out;
+}
+
+/// The line in each mode asked for (default ATSMC, then TSMC): a line per mode, then the metrics table;
+/// returns the exit code.
+int runLineModes(const Options& o) {
+  const std::vector<bool> modes = o.modes.empty() ? std::vector<bool>{true, false} : o.modes;
+  Scenario sc = o.sc;
   std::vector<std::string> names;
   std::vector<std::array<AxisMetrics, AXIS_COUNT>> results;
   for (bool adaptive : modes) {
     sc.sliding.adaptive = adaptive;
-    const std::string err = firstError({sc.validate(), traction.enabled ? traction.validate() : ""});
+    const std::string err = firstError({sc.validate(), o.traction.enabled ? o.traction.validate() : ""});
     if (!err.empty()) {
       std::fprintf(stderr, "run_scenario: %s\n", err.c_str());
       return 2;
     }
-    LineReference ref;
-    RunResult r;
-    double max_slip = 0.0;
-    const auto t0 = std::chrono::steady_clock::now();
-    for (int k = 0; k < repeat; ++k) {
-      if (traction.enabled) {
-        LoopConfig plant;  // the traction plant, fed the truth
-        plant.traction = traction;
-        const LoopResult er = runClosedLoop(sc, plant, ref);
-        r = er.run;
-        max_slip = er.max_abs_slip;
-      } else {
-        r = runClosedLoop(sc, ref);
-      }
-    }
-    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() / repeat;
+    const LineRuns runs = runLine(sc, o.traction, o.repeat);
+    const RunResult& r = runs.run;
+    const double s = runs.seconds_per_run;
     std::printf(
         "%s: %.3f ms wall per %.1f s run (%.2f M steps/s), final (x %.4f, y %.4f, theta %.5f), "
         "%ld saturated periods%s\n",
         adaptive ? "ATSMC" : "TSMC", 1e3 * s, sc.duration, (sc.steps() + 1) / s / 1e6, r.final_state[X],
         r.final_state[Y], r.final_state[THETA], static_cast<long>(r.saturated_steps), r.diverged ? ", DIVERGED" : "");
-    if (traction.enabled) std::printf("  traction: mu_peak %g, max |slip ratio| %.3f\n", traction.mu_peak, max_slip);
+    if (o.traction.enabled)
+      std::printf("  traction: mu_peak %g, max |slip ratio| %.3f\n", o.traction.mu_peak, runs.max_slip);
     names.push_back(adaptive ? "atsmc" : "tsmc");
     results.push_back(r.metrics);
-    if (!yaml.empty() && !writeMetricsYaml(yaml, names.back(), r.metrics)) {
-      std::fprintf(stderr, "run_scenario: cannot write %s\n", yaml.c_str());
+    if (!o.yaml.empty() && !writeMetricsYaml(o.yaml, names.back(), r.metrics)) {
+      std::fprintf(stderr, "run_scenario: cannot write %s\n", o.yaml.c_str());
       return 2;
     }
   }
   std::printf("\n%s", metricsTable(names, results).c_str());
   return 0;
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  sowing_robot::cli::exitOnHelp(argc, argv, kUsage);
+  int exit_code = 0;
+  if (!parseOptions(argc, argv, o, exit_code)) return exit_code;
+  if (!o.field) return runLineModes(o);
+  const std::string err = fieldOptionsError(o);
+  if (!err.empty()) {
+    std::fprintf(stderr, "run_scenario: %s\n", err.c_str());
+    return 2;
+  }
+  return runThesisField(o);
 }

@@ -1,4 +1,4 @@
-// tune: the PSO gain tuner on the command line, no ROS master (issue 28). Same search and objective as the
+// tune: the PSO gain tuner on the command line, no ROS master. Same search and objective as the
 // pso_tuner node (core::TuningSession = core::tuneGains in steps); threads without an MPI launcher, an MPI
 // evaluation farm under mpirun / srun (rank 0 owns the search, checkpoint and output; every rank evaluates
 // one particle at a time; results go back by particle index, so the gains do not depend on the number of
@@ -33,11 +33,11 @@
 #include <string>
 #include <vector>
 
+#include "sowing_robot/scenario_file/tune_config.h"
 #include "sowing_robot/cli/usage.h"
 #include "sowing_robot/core/evaluation/checkpoint.h"
 #include "sowing_robot/core/evaluation/tuning.h"
 #include "sowing_robot/farm/farm.h"
-#include "sowing_robot/scenario_file/tune_config.h"
 
 using namespace sowing_robot;
 using core::TuningCost;
@@ -194,119 +194,106 @@ std::string csvUpTo(const std::string& path, int from) {
   return out;
 }
 
-int run(farm::Farm& farm, int argc, char** argv) {
-  Args args;
-  const std::string arg_error = parseArgs(argc, argv, args);
-  if (!arg_error.empty()) {
-    if (farm.root()) std::fprintf(stderr, "tune: %s\n", arg_error.c_str());
-    return 2;
+/// A worker rank: evaluates what rank 0 sends until rank 0 is done; the exit code.
+int serveRank(farm::Farm& farm, const scenario_file::TuneConfig& cfg, const core::LineReference& reference) {
+  const std::unique_ptr<const core::GainObjective> problem = makeObjective(cfg, reference, 1);
+  long evaluations = 0;
+  const char* die = std::getenv("SOWING_FARM_TEST_DIE_AFTER");  // test hook: this rank dies mid-run
+  const long die_after = die ? std::atol(die) : -1;
+  return farm.serve([&](const farm::Payload& request) {
+    if (die_after >= 0 && evaluations++ >= die_after) std::raise(SIGKILL);
+    return evaluate(*problem, request);
+  })
+             ? 0
+             : 1;
+}
+
+/// --resume: the session continues from the checkpoint (a missing file: from the beginning). false, with
+/// the error line printed, when the checkpoint is damaged or of another setup.
+bool resumeSession(const Args& args, std::uint64_t fingerprint, const scenario_file::TuneConfig& cfg,
+                   core::TuningSession& session) {
+  if (::access(args.checkpoint.c_str(), F_OK) != 0) {
+    std::fprintf(stderr, "tune: no checkpoint at %s yet: starting from the beginning\n", args.checkpoint.c_str());
+    return true;
   }
-  scenario_file::TuneConfig cfg;
+  std::string body;
+  const std::string e = core::readCheckpoint(args.checkpoint, "tune", fingerprint, body);
+  if (!e.empty()) {
+    std::fprintf(stderr, "tune: %s\n", e.c_str());
+    return false;
+  }
   try {
-    cfg = scenario_file::loadTuneConfig(args.config, args.controller);
-  } catch (const std::exception& e) {
-    // Every rank reads the same file: rank 0 says what is wrong, the others leave quietly.
-    if (farm.root()) std::fprintf(stderr, "tune: %s\n", e.what());
-    return 2;
+    session.restore(body);
+  } catch (const std::exception& ex) {
+    std::fprintf(stderr, "tune: checkpoint %s: %s\n", args.checkpoint.c_str(), ex.what());
+    return false;
   }
-  if (args.threads >= 0) cfg.pso.threads = static_cast<int>(args.threads);
-  const core::LineReference reference = cfg.reference();
+  std::fprintf(stderr, "tune: resuming from %s at iteration %d/%d (best cost %s)\n", args.checkpoint.c_str(),
+               session.search().iteration(), cfg.pso.iterations, g(session.search().bestCost(), "%.9g").c_str());
+  return true;
+}
 
-  if (!farm.root()) {  // a worker rank: evaluate until rank 0 is done
-    const std::unique_ptr<const core::GainObjective> problem = makeObjective(cfg, reference, 1);
-    long evaluations = 0;
-    const char* die = std::getenv("SOWING_FARM_TEST_DIE_AFTER");  // test hook: this rank dies mid-run
-    const long die_after = die ? std::atol(die) : -1;
-    return farm.serve([&](const farm::Payload& request) {
-      if (die_after >= 0 && evaluations++ >= die_after) std::raise(SIGKILL);
-      return evaluate(*problem, request);
-    })
-               ? 0
-               : 1;
-  }
+/// The progress CSV's header and, when resumed, the file's rows before the session's iteration.
+std::string progressCsvStart(const Args& args, const scenario_file::TuneConfig& cfg, const core::TuningSession& session) {
+  std::string csv = "iteration,best_cost,evaluations,evaluations_cut,simulated_s,elapsed_s";
+  for (const auto& b : cfg.gains) csv += "," + b.name;
+  csv += "\n";
+  if (session.search().iteration() > 0) csv += csvUpTo(args.progress, session.search().iteration());
+  return csv;
+}
 
-  const std::string output = !args.output.empty() ? args.output : !cfg.output.empty() ? cfg.output : "tuned_gains.yaml";
-  const int threads = farm.active() ? 1 : core::psoThreads(cfg.pso);
-  std::unique_ptr<core::TuningSession> session;
-  try {
-    session = std::make_unique<core::TuningSession>(makeObjective(cfg, reference, threads), cfg.pso);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "tune: %s: %s\n", args.config.c_str(), e.what());
-    return 2;
-  }
-  // What the run was started with: the config's bytes, the scenario as read, and the initial swarm (PSO
-  // parameters, bounds, seed). A checkpoint of anything else is refused.
-  const std::uint64_t fingerprint =
-      core::fnv1a64("tune 1\n" + cfg.text + "\n" + cfg.scenarioText() + "\n" + session->toText());
+/// The progress CSV's row of iteration `it`.
+std::string progressCsvRow(int it, const scenario_file::TuneConfig& cfg, const core::TuningSession& session, double elapsed) {
+  std::string row = std::to_string(it) + "," + g(session.search().bestCost(), "%.17g") + "," +
+                    std::to_string(static_cast<long>(it + 1) * cfg.pso.particles) + "," +
+                    std::to_string(session.evaluationsCut()) + "," + g(session.simulatedSeconds(), "%.9g") + "," +
+                    g(elapsed, "%.3f");
+  for (double v : session.search().bestPosition()) row += "," + g(v, "%.17g");
+  return row + "\n";
+}
 
-  if (args.resume) {
-    std::string body;
-    if (::access(args.checkpoint.c_str(), F_OK) != 0) {
-      std::fprintf(stderr, "tune: no checkpoint at %s yet: starting from the beginning\n", args.checkpoint.c_str());
-    } else {
-      const std::string e = core::readCheckpoint(args.checkpoint, "tune", fingerprint, body);
-      if (!e.empty()) {
-        std::fprintf(stderr, "tune: %s\n", e.c_str());
-        return 2;
-      }
-      try {
-        session->restore(body);
-      } catch (const std::exception& ex) {
-        std::fprintf(stderr, "tune: checkpoint %s: %s\n", args.checkpoint.c_str(), ex.what());
-        return 2;
-      }
-      std::fprintf(stderr, "tune: resuming from %s at iteration %d/%d (best cost %s)\n", args.checkpoint.c_str(),
-                   session->search().iteration(), cfg.pso.iterations, g(session->search().bestCost(), "%.9g").c_str());
-    }
-  }
-
-  std::string csv;
-  if (!args.progress.empty()) {
-    csv = "iteration,best_cost,evaluations,evaluations_cut,simulated_s,elapsed_s";
-    for (const auto& b : cfg.gains) csv += "," + b.name;
-    csv += "\n";
-    if (session->search().iteration() > 0) csv += csvUpTo(args.progress, session->search().iteration());
-  }
-
+/// The gains searched with their bounds: "kx [0.1, 10], ky [0.1, 10], ...".
+std::string searchedDims(const scenario_file::TuneConfig& cfg) {
   std::string dims;
   for (const auto& b : cfg.gains)
     dims += (dims.empty() ? "" : ", ") + b.name + " [" + g(b.lower) + ", " + g(b.upper) + "]";
-  std::fprintf(stderr, "tune: %s; %s\ntune: scenario %s\ntune: searching %s\n",
-               farm.active() ? farm.describe().c_str() : (std::to_string(threads) + " thread(s)").c_str(),
-               ("particles " + std::to_string(cfg.pso.particles) + ", iterations " +
-                std::to_string(cfg.pso.iterations) + ", seed " + std::to_string(cfg.pso.seed))
-                   .c_str(),
-               cfg.scenarioText().c_str(), dims.c_str());
+  return dims;
+}
 
-  const core::TuningBatch batch = farm.active() ? farmBatch(farm, session->problem())
-                                                : core::threadedTuningBatch(session->problem(), session->params());
+/// How the search is run, the PSO and what is searched: rank 0 says what it starts.
+struct SearchSetup {
+  const Args& args;
+  const scenario_file::TuneConfig& cfg;
+  std::uint64_t fingerprint;  // of what the run was started with: checkpoints of anything else are refused
+  std::string evaluators;     // the farm's ranks or "N thread(s)"
+  std::string dims;           // searchedDims
+};
 
-  const auto t0 = std::chrono::steady_clock::now();
-  const int first = session->search().iteration();
+/// Iterates the session to its end; after each iteration the checkpoint, the progress CSV and a log line.
+/// false when --stop-after stopped it (exit 3); a failure ends the run on every rank (exit 1).
+bool runSearch(farm::Farm& farm, const SearchSetup& setup, core::TuningSession& session, const core::TuningBatch& batch,
+               std::chrono::steady_clock::time_point t0, int first) {
+  const Args& args = setup.args;
+  std::string csv = args.progress.empty() ? "" : progressCsvStart(args, setup.cfg, session);
   try {
-    while (!session->finished()) {
-      const int it = session->step(batch);
+    while (!session.finished()) {
+      const int it = session.step(batch);
       const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       std::string error;
       if (!args.checkpoint.empty()) {
-        error = core::writeCheckpoint(args.checkpoint, "tune", fingerprint, session->toText());
+        error = core::writeCheckpoint(args.checkpoint, "tune", setup.fingerprint, session.toText());
         if (!error.empty()) throw std::runtime_error(error);
       }
       if (!args.progress.empty()) {
-        csv += std::to_string(it) + "," + g(session->search().bestCost(), "%.17g") + "," +
-               std::to_string(static_cast<long>(it + 1) * cfg.pso.particles) + "," +
-               std::to_string(session->evaluationsCut()) + "," + g(session->simulatedSeconds(), "%.9g") + "," +
-               g(elapsed, "%.3f");
-        for (double v : session->search().bestPosition()) csv += "," + g(v, "%.17g");
-        csv += "\n";
+        csv += progressCsvRow(it, setup.cfg, session, elapsed);
         if (!writeAtomically(args.progress, csv, error)) throw std::runtime_error(error);
       }
-      const double eta = elapsed / (it + 1 - first) * (cfg.pso.iterations - it);
+      const double eta = elapsed / (it + 1 - first) * (setup.cfg.pso.iterations - it);
       std::fprintf(stderr, "tune: iteration %d/%d  best cost %.9g  elapsed %.2f s  ETA %.2f s\n", it,
-                   cfg.pso.iterations, session->search().bestCost(), elapsed, eta);
-      if (args.stop_after >= 0 && it >= args.stop_after && !session->finished()) {
+                   setup.cfg.pso.iterations, session.search().bestCost(), elapsed, eta);
+      if (args.stop_after >= 0 && it >= args.stop_after && !session.finished()) {
         std::fprintf(stderr, "tune: stopped after iteration %d (--stop-after); resume with --resume\n", it);
-        return 3;
+        return false;
       }
     }
   } catch (const std::exception& e) {
@@ -315,20 +302,12 @@ int run(farm::Farm& farm, int argc, char** argv) {
                                          : ("the last checkpoint is " + args.checkpoint + " (--resume)").c_str());
     farm.abort(1);
   }
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  farm.stop();
+  return true;
+}
 
-  const core::TuningResult r = session->result();
-  if (!std::isfinite(r.pso.best_cost)) {
-    std::fprintf(stderr, "tune: every run diverged (no finite cost); nothing written. Narrow the gain bounds.\n");
-    return 1;
-  }
-  const core::Scenario tuned = session->problem().scenarioFor(r.best_gains);
-  char date[64];
-  const std::time_t now = std::time(nullptr);
-  std::strftime(date, sizeof date, "%Y-%m-%d %H:%M:%S %z", std::localtime(&now));
-  std::string h = "# Controller gains tuned offline by tune (PSO, thesis eqs 4.26-4.31, Table 5.4).\n";
-  h += "# config: " + args.config + "\n# scenario: " + cfg.scenarioText() + "\n";
+/// The gains file's "# cost:" line (robust: then its "# training:" lines), without the last line's newline.
+std::string costComment(const scenario_file::TuneConfig& cfg) {
+  std::string h;
   if (cfg.isRobust()) {
     h += "# cost: per training run min(2 ITAE(x+y+theta)/T^2, penalty) + penalty if not a success" +
          std::string(cfg.robust.max_slip_share < 1.0
@@ -348,20 +327,32 @@ int run(farm::Farm& farm, int argc, char** argv) {
     if (cfg.objective.torque_weight > 0) h += " + " + g(cfg.objective.torque_weight) + " * effort";
     if (cfg.objective.chattering_weight > 0) h += " + " + g(cfg.objective.chattering_weight) + " * chattering";
   }
+  return h;
+}
+
+/// The gains file's comment lines: what was tuned, how, the costs, and (lines "# run:") when and on what.
+std::string gainsHeader(const SearchSetup& setup, const core::TuningResult& r, double wall, int first) {
+  const scenario_file::TuneConfig& cfg = setup.cfg;
+  char date[64];
+  const std::time_t now = std::time(nullptr);
+  std::strftime(date, sizeof date, "%Y-%m-%d %H:%M:%S %z", std::localtime(&now));
+  std::string h = "# Controller gains tuned offline by tune (PSO, thesis eqs 4.26-4.31, Table 5.4).\n";
+  h += "# config: " + setup.args.config + "\n# scenario: " + cfg.scenarioText() + "\n";
+  h += costComment(cfg);
   h += "\n# best_cost: " + core::yamlFloat(r.pso.best_cost) + "\n";
   h += "# initial_best_cost: " + core::yamlFloat(r.initial_best_cost) + "\n";
   h += "# pso: particles " + std::to_string(cfg.pso.particles) + ", iterations " + std::to_string(cfg.pso.iterations) +
        ", seed " + std::to_string(cfg.pso.seed) + ", evaluations " + std::to_string(r.pso.evaluations) + " (" +
        std::to_string(r.evaluations_cut) + " stopped early at their particle's best)\n";
-  h += "# searched: " + dims + "\n";
-  h += "# run: " + std::string(date) + ", " +
-       (farm.active() ? farm.describe() : std::to_string(threads) + " thread(s)") + ", " + g(wall, "%.2f") + " s wall" +
+  h += "# searched: " + setup.dims + "\n";
+  h += "# run: " + std::string(date) + ", " + setup.evaluators + ", " + g(wall, "%.2f") + " s wall" +
        (first > 0 ? ", resumed at iteration " + std::to_string(first) : "") + "\n";
-  std::string error;
-  if (!writeAtomically(output, h + core::gainsYaml(tuned, cfg.gains), error)) {
-    std::fprintf(stderr, "tune: %s\n", error.c_str());
-    return 1;
-  }
+  return h;
+}
+
+/// The result on stdout: the costs, the gains, the file, and under MPI how the ranks were loaded.
+void printResult(const farm::Farm& farm, const scenario_file::TuneConfig& cfg, const core::TuningResult& r, double wall,
+                 const std::string& output) {
   std::string best;
   for (std::size_t d = 0; d < cfg.gains.size(); ++d)
     best += (d ? ", " : "") + cfg.gains[d].name + " " + g(r.best_gains[d], "%.5g");
@@ -375,6 +366,69 @@ int run(farm::Farm& farm, int argc, char** argv) {
         farm.size(), eval, farm.overheadSeconds(), eval > 0 ? 100.0 * farm.overheadSeconds() / eval : 0.0,
         wall > 0 ? 100.0 * eval / (wall * farm.size()) : 0.0, farm.size());
   }
+}
+
+int run(farm::Farm& farm, int argc, char** argv) {
+  Args args;
+  const std::string arg_error = parseArgs(argc, argv, args);
+  if (!arg_error.empty()) {
+    if (farm.root()) std::fprintf(stderr, "tune: %s\n", arg_error.c_str());
+    return 2;
+  }
+  scenario_file::TuneConfig cfg;
+  try {
+    cfg = scenario_file::loadTuneConfig(args.config, args.controller);
+  } catch (const std::exception& e) {
+    // Every rank reads the same file: rank 0 says what is wrong, the others leave quietly.
+    if (farm.root()) std::fprintf(stderr, "tune: %s\n", e.what());
+    return 2;
+  }
+  if (args.threads >= 0) cfg.pso.threads = static_cast<int>(args.threads);
+  const core::LineReference reference = cfg.reference();
+  if (!farm.root()) return serveRank(farm, cfg, reference);
+
+  const std::string output = !args.output.empty() ? args.output : !cfg.output.empty() ? cfg.output : "tuned_gains.yaml";
+  const int threads = farm.active() ? 1 : core::psoThreads(cfg.pso);
+  std::unique_ptr<core::TuningSession> session;
+  try {
+    session = std::make_unique<core::TuningSession>(makeObjective(cfg, reference, threads), cfg.pso);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "tune: %s: %s\n", args.config.c_str(), e.what());
+    return 2;
+  }
+  // What the run was started with: the config's bytes, the scenario as read, and the initial swarm (PSO
+  // parameters, bounds, seed). A checkpoint of anything else is refused.
+  const SearchSetup setup{args, cfg,
+                          core::fnv1a64("tune 1\n" + cfg.text + "\n" + cfg.scenarioText() + "\n" + session->toText()),
+                          farm.active() ? farm.describe() : std::to_string(threads) + " thread(s)", searchedDims(cfg)};
+  if (args.resume && !resumeSession(args, setup.fingerprint, cfg, *session)) return 2;
+
+  std::fprintf(stderr, "tune: %s; %s\ntune: scenario %s\ntune: searching %s\n", setup.evaluators.c_str(),
+               ("particles " + std::to_string(cfg.pso.particles) + ", iterations " +
+                std::to_string(cfg.pso.iterations) + ", seed " + std::to_string(cfg.pso.seed))
+                   .c_str(),
+               cfg.scenarioText().c_str(), setup.dims.c_str());
+
+  const core::TuningBatch batch = farm.active() ? farmBatch(farm, session->problem())
+                                                : core::threadedTuningBatch(session->problem(), session->params());
+  const auto t0 = std::chrono::steady_clock::now();
+  const int first = session->search().iteration();
+  if (!runSearch(farm, setup, *session, batch, t0, first)) return 3;
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  farm.stop();
+
+  const core::TuningResult r = session->result();
+  if (!std::isfinite(r.pso.best_cost)) {
+    std::fprintf(stderr, "tune: every run diverged (no finite cost); nothing written. Narrow the gain bounds.\n");
+    return 1;
+  }
+  const core::Scenario tuned = session->problem().scenarioFor(r.best_gains);
+  std::string error;
+  if (!writeAtomically(output, gainsHeader(setup, r, wall, first) + core::gainsYaml(tuned, cfg.gains), error)) {
+    std::fprintf(stderr, "tune: %s\n", error.c_str());
+    return 1;
+  }
+  printResult(farm, cfg, r, wall, output);
   return 0;
 }
 

@@ -357,9 +357,9 @@ core::BenchScenario loadScenarioFileImpl(const std::string& path, const std::str
       toDouble(required(success, "cross_track_threshold", path, "success/"), path, "success/cross_track_threshold");
   if (root["envelope_period"]) b.envelope_period = toDouble(root["envelope_period"], path, "envelope_period");
 
-  // Issue 16 in the benchmark: the plant (traction:), the sensors (sensors:), the estimator (estimator:) and
-  // what the controllers are fed (feedback:), each block through the nodes' parameter table with the nodes'
-  // keys (traction/..., sensors/..., estimator/...), so a key, a range and an error read as plant_sim's and
+  // The loop's realism (BenchScenario::realism): the plant (traction:), the sensors (sensors:), the estimator
+  // (estimator:) and what the controllers are fed (feedback:), each block through the nodes' parameter table with the
+  // nodes' keys (traction/..., sensors/..., estimator/...), so a key, a range and an error read as plant_sim's and
   // state_estimator's. Any of them puts the scenario on the estimated loop (core/evaluation/estimated_bench.h).
   // The drive train's layers (motor:, limits:, traction_control:, speed_governor:, hitch_control:) likewise,
   // through their tables: any block of kLoopBlocks.

@@ -1,4 +1,4 @@
-// --help and unknown options for the package's commands (issue 27 item 5), one way for all of them:
+// --help and unknown options for the package's commands, one way for all of them:
 // `--help` / `-h` prints the command's usage text (one string per command, used for --help only) to stdout
 // and exits 0 before any work; an unknown option is one line on stderr,
 //   <cmd>: unknown option '--x' (see <cmd> --help)

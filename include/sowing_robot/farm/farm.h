@@ -1,4 +1,4 @@
-// MPI evaluation farm (issue 28): rank 0 owns the work list and the results; every rank, rank 0's own
+// MPI evaluation farm: rank 0 owns the work list and the results; every rank, rank 0's own
 // evaluation thread included, evaluates. Tasks are handed out one at a time to whichever evaluator is free
 // (runs differ in length), each result comes back with its task index and lands at that index, so what
 // the caller assembles depends neither on the number of ranks nor on timing.

@@ -1,4 +1,4 @@
-// The benchmark's YAML side (issue 17): config/scenarios/NAME.yaml -> core::BenchScenario, and the tuned
+// The benchmark's YAML side: config/scenarios/NAME.yaml -> core::BenchScenario, and the tuned
 // gains of a controller pair (config/tuned/OUTER+INNER.yaml) onto a core::Scenario. Kept out of the
 // ROS-free core because it needs yaml-cpp; every value goes through the core's parameter tables (type and
 // range checks, unknown keys refused), and all physics stays in the core (benchmark.h runs the scenario).

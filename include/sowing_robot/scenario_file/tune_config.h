@@ -1,4 +1,4 @@
-// The command-line tuner's configuration (issue 28: `tune --config FILE`, no ROS master): one YAML file with
+// The command-line tuner's configuration (`tune --config FILE`, no ROS master): one YAML file with
 // the pso_tuner block of config/pso.yaml (same keys, same table, same checks; its gains list too) and an
 // optional scenario block for the base scenario that tune.launch reads from the nodes' config files.
 //

@@ -245,7 +245,7 @@ BenchScenario withController(BenchScenario bench, const Scenario& pair) {
 
 std::function<RunRow(std::int64_t)> benchmarkWorker(const BenchScenario& scenario) {
   auto bench = std::make_shared<const BenchScenario>(scenario);
-  if (bench->realism)  // sensors, traction or an estimate in the loop (issue 16): estimated_bench.h
+  if (bench->realism)  // sensors, traction or an estimate in the loop: estimated_bench.h
     return [bench](std::int64_t i) { return estimatedBenchRow(*bench, i); };
   RunExtras extras;
   extras.series_every = seriesEvery(*bench);

@@ -113,7 +113,7 @@ std::string estimatedReportLine(const std::vector<RunRow>& rows) {
   }
   const Statistic s = statistic(slip), e = statistic(rms), m = statistic(mx), o = statistic(odo);
   const Statistic h = statistic(high);
-  // Issue 26's slip target: within twice the peak's slip for 95 % of the run.
+  // The slip target (docs/robust_tuning.md): within twice the peak's slip for 95 % of the run.
   const auto within = std::count_if(high.begin(), high.end(), [](double share) { return share <= 0.05; });
   std::string out =
       "max |slip ratio| mean " + shortNumber(s.mean) + ", worst " + shortNumber(s.worst) +

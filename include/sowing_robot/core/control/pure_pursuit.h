@@ -1,6 +1,6 @@
 // Pure pursuit and nav2's Regulated Pure Pursuit (RPP) for a DDMR, as the outer (kinematic) controller
 // in Kanayama's place: reference + measured pose and velocities in, VelocityCommand (v, omega and their
-// desired time derivatives) out. Baselines of issue 17: what users run today.
+// desired time derivatives) out. Baselines for the benchmark: what users run today.
 //
 // The lookahead point ("carrot"). nav2 takes it on a path at distance L from the robot; here the
 // reference is a trajectory given one time at a time by a stateful source (the potential field cannot

@@ -1,4 +1,4 @@
-// No traction: the progress check of the traction control layer (issue 26). A robot on a patch where no
+// No traction: the progress check of the traction control layer. A robot on a patch where no
 // grip is to be had (the drive wheels' peak traction below rolling resistance + draft) spins its wheels
 // and gets nowhere; driving on, it would spin, orbit or wander. As nav2's progress checker and the
 // immobilisation detectors of planetary rovers (FIELD.md), the verdict comes from what the robot measures:

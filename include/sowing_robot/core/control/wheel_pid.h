@@ -1,6 +1,6 @@
 // Wheel-velocity PID with feedforward and anti-windup, the inner (torque) controller in the
 // sliding-mode controller's place: what a ros_control user runs (diff_drive_controller turns (v, omega)
-// into wheel speeds, a motor driver closes a PID on each wheel's speed). Baseline of issue 17.
+// into wheel speeds, a motor driver closes a PID on each wheel's speed). A baseline for the benchmark.
 //
 // Wheel speed targets w_d = (v_d +- L omega_d) / R (right +, left -), measured w the same from the
 // measured v, omega. Per wheel: tau = ff + kp e + ki int(e) + kd d/dt(-w) (derivative on the

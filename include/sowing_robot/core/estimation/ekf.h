@@ -1,4 +1,4 @@
-// State estimator for the DDMR (issue 16, item 4): an extended Kalman filter over the pose of the axle
+// State estimator for the DDMR: an extended Kalman filter over the pose of the axle
 // midpoint and the gyro's bias, s = (x, y, theta, b), fed by the wheel encoders and the yaw rate, and
 // corrected by a position fix that arrives late.
 //

@@ -1,4 +1,4 @@
-// Wheel-slip detection for the slip-aware EKF (issue 26, item 3; ekf.h with estimator/slip/detect). The
+// Wheel-slip detection for the slip-aware EKF (ekf.h with estimator/slip/detect). The
 // filter itself estimates each wheel's slip speed (slip_aware_step.h: the wheel's encoder measures the
 // ground speed of its contact point plus its slip), so a slip that builds up as fast as the slip's random
 // walk allows needs no detector: against the gyro, the difference of the two wheels' travels less 2L times

@@ -1,4 +1,4 @@
-// Monte-Carlo runner (issue 17 item 3, first part): one scenario and controller pair over N seeded runs,
+// Monte-Carlo runner: one scenario and controller pair over N seeded runs,
 // each run drawing its plant mismatch, disturbance amplitude and phase, noise seed and start pose from
 // stated distributions, run in parallel, with per-run rows and summary statistics.
 //
@@ -137,7 +137,7 @@ struct BenchScenario {
   /// (AvoidanceStatus kOk) and the axle ends within this distance of the reference's last pose [m].
   double finish_tolerance = 0.5;
   double envelope_period = 0.1;  ///< period of RunRow::cross_track_series [s] (> 0)
-  /// Issue 16 in the benchmark (scenario keys traction:, sensors:, estimator:, feedback:): set, every run goes
+  /// What else is in the loop (scenario keys traction:, sensors:, estimator:, feedback:): set, every run goes
   /// through runClosedLoop with this plant, these sensors (their seed replaced by the run's draw 8) and
   /// this feedback, scored on the truth (estimated_bench.h); unset, today's runClosedLoop.
   std::optional<LoopConfig> realism;

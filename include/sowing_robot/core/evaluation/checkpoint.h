@@ -1,4 +1,4 @@
-// Checkpoint files (issue 28 item 3): a text body behind a header that says what it is and lets a reader
+// Checkpoint files: a text body behind a header that says what it is and lets a reader
 // refuse a damaged, truncated or foreign file with one line instead of resuming from it.
 //
 //   sowing_robot_checkpoint 1 KIND

@@ -1,5 +1,5 @@
-// The benchmark's runs of scenarios with sensors, traction or an estimate in the loop (issue 17 item 2,
-// wet_soil and estimated_pose; BenchScenario::realism): one run of runBenchmark through runClosedLoop,
+// The benchmark's runs of scenarios with sensors, traction or an estimate in the loop (the
+// wet_soil and estimated_pose scenarios; BenchScenario::realism): one run of runBenchmark through runClosedLoop,
 // measured and judged as today's runs are (benchmark.cpp's measure(): effort, chattering, time at the
 // limit, cross-track after settle_time, body contacts and the finish check of a field), on the TRUTH,
 // plus the figures of the estimated loop (slip, the fed pose's error, the fixes). Kept beside

@@ -1,4 +1,4 @@
-// Robust gain tuning (issue 26 item 4): the PSO of tuning.h scoring each gain vector over a training set
+// Robust gain tuning: the PSO of tuning.h scoring each gain vector over a training set
 // of benchmark runs (scenarios x seeded draws: soils, patches, drafts, mismatch, start poses, feedback)
 // instead of one run on the thesis line. Every run is the benchmark's own (benchmarkWorker), so a training
 // run and a benchmark row of the same scenario and draw are the same bits.
@@ -11,7 +11,7 @@
 // (diverged, body contact, not finished, cross-track above the threshold after the settle time: the
 // benchmark's success rule) costs the penalty on top, so the search first buys successes, then accuracy.
 // With max_slip_share < 1 a run whose wheels spent more than that share of it beyond twice the friction
-// peak's slip (RunRow::high_slip_share: issue 26's "slip within 2x the peak for 95 % of the run" at 0.05) is
+// peak's slip (RunRow::high_slip_share: the slip target "within 2x the peak for 95 % of the run" at 0.05) is
 // a failure too: the search then buys runs that meet the slip target, not only the benchmark's success.
 // The set's cost is the mean of the run costs, or a chosen quantile (nearest rank) of them.
 #pragma once

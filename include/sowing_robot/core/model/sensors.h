@@ -1,4 +1,4 @@
-// What the robot can measure of itself (issue 16, item 3), ROS-free and seeded: wheel encoders turned
+// What the robot can measure of itself, ROS-free and seeded: wheel encoders turned
 // into dead-reckoning odometry, a yaw-rate gyro, and a position fix with latency and dropouts. The plant
 // wrapper (ros/plant_sim/sensors.h) feeds them the true state; the estimator (core/estimation/ekf.h) reads their
 // output.

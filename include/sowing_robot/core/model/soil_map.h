@@ -1,4 +1,4 @@
-// Soil patches of a field (issue 16, item 2): polygons with their own grip and rolling resistance. The
+// Soil patches of a field: polygons with their own grip and rolling resistance. The
 // traction plant (traction.h) looks up each wheel's and the caster's contact point here every step; a
 // point in no patch is on the field's default soil (the traction/ parameters).
 #pragma once

@@ -1,4 +1,4 @@
-// Wheel–soil traction for the DDMR (issue 16, item 1): an opt-in plant in which each drive wheel has
+// Wheel–soil traction for the DDMR: an opt-in plant in which each drive wheel has
 // its own spin state and pushes the body through the longitudinal slip of its contact patch. The
 // no-slip Plant (plant.h) is untouched; with grip and slip stiffness large this model tends to it.
 //

@@ -1,4 +1,4 @@
-// The approach from the robot's start pose to the first row (issue 15): without it the field's target
+// The approach from the robot's start pose to the first row: without it the field's target
 // starts on the row while the robot stands elsewhere (thesis: 3 m off it), and the controllers close
 // that error at once (4.35 rad/s, 3.61 m/s^2). The approach is a lateral offset of the row line,
 // y(x) a septic in the along-row position x from the start (offset l0, slope tan(psi0), y'' = y''' = 0)

@@ -1,4 +1,4 @@
-// Planned detours around obstacles on straight rows (issue 15): the obstacles are inflated by the
+// Planned detours around obstacles on straight rows: the obstacles are inflated by the
 // robot's footprint plus a safety margin, obstacles whose inflated discs overlap (or whose detours
 // would) are passed as one group on one side, and the detour is a lateral offset of the row with
 // bounded curvature, driven at a speed that keeps the yaw rate and the lateral acceleration within

@@ -1,4 +1,4 @@
-// When the seed drill's tool is down, decided by the plant itself (issue 16, item 3: the draft), from
+// When the seed drill's tool is down, decided by the plant itself (the tool's draft loads it), from
 // the plan's rows and the true tool point only, so a lockstep run stays deterministic (no asynchronous
 // topic enters a step).
 //

@@ -1,6 +1,6 @@
 // plant_sim's sensors: the core's sensor suite (core/simulation/sensor_feeds.h: the seeded sensors of
 // core/model/sensors.h, read on the plant's true state exactly as the in-process loop reads them), and their
-// messages. Topics (relative, contract16.md):
+// messages. Topics (relative, docs/sensors.md):
 //   odom  nav_msgs/Odometry                    encoder dead reckoning (nominal R, L), every step; its
 //                                              pose covariance grows; odom -> base_link tf from it
 //   imu   sensor_msgs/Imu                      yaw rate (omega + bias + noise), every step
