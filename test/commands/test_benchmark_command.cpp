@@ -1,4 +1,4 @@
-// The `benchmark` command (src/nodes/benchmark.cpp) through its executable: bad requests give one error line,
+// The `benchmark` command (src/tools/benchmark.cpp) through its executable: bad requests give one error line,
 // exit != 0 and no report; the files it writes are the same byte for byte whatever --threads.
 #include <gtest/gtest.h>
 

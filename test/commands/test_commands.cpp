@@ -2,7 +2,7 @@
 // built executables (the ROS nodes with no master), the scripts through their paths in the source tree.
 //   cmd --help, cmd -h        exit 0, the usage on stdout, before any work
 //   cmd --no-such-option      exit 2, one line on stderr that names the option and points to --help
-// The lists below are checked against src/nodes/ and scripts/: a new command must join them.
+// The lists below are checked against src/nodes/, src/tools/ and scripts/: a new command must join them.
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
@@ -126,12 +126,15 @@ TEST(NodeArguments, RosArgumentsPassWithHelp) {
 
 TEST(CommandLists, CoverEveryProgramAndScript) {
   std::set<std::string> programs, scripts;
-  for (const auto& e : fs::directory_iterator(kSource + "/src/nodes")) {
-    std::string stem = e.path().stem().string();
-    const std::string suffix = "_node";
-    if (stem.size() > suffix.size() && stem.compare(stem.size() - suffix.size(), suffix.size(), suffix) == 0)
-      stem.resize(stem.size() - suffix.size());
-    programs.insert(stem);
+  // The ROS mains (src/nodes/<name>_node.cpp) and the command-line tools (src/tools/<name>.cpp).
+  for (const std::string dir : {"/src/nodes", "/src/tools"}) {
+    for (const auto& e : fs::directory_iterator(kSource + dir)) {
+      std::string stem = e.path().stem().string();
+      const std::string suffix = "_node";
+      if (stem.size() > suffix.size() && stem.compare(stem.size() - suffix.size(), suffix.size(), suffix) == 0)
+        stem.resize(stem.size() - suffix.size());
+      programs.insert(stem);
+    }
   }
   for (const std::string dir : {std::string(), std::string("dev/")})
     for (const auto& e : fs::directory_iterator(kSource + "/scripts/" + dir))

@@ -102,6 +102,8 @@ decltype(auto) withControllers(const ControllerPair& pair, const RobotParams& no
         SlidingModeController smc(pair.sliding, nominal);
         return f(outer, smc);
       }
+      default:  // registered without a case here
+        break;
     }
     const std::unique_ptr<InnerController> inner = makeInnerController(pair, nominal);
     return f(outer, *inner);
@@ -116,6 +118,8 @@ decltype(auto) withControllers(const ControllerPair& pair, const RobotParams& no
       PurePursuit pursuit(pair.pure_pursuit, pair.outer == OuterKind::rpp);
       return with_inner(pursuit);
     }
+    default:  // registered without a case here
+      break;
   }
   const std::unique_ptr<OuterController> outer = makeOuterController(pair);
   return with_inner(*outer);

@@ -193,7 +193,7 @@ void printFieldReport(const Options& o, const FieldRunSetup& s, const FieldRunRe
               s.scenario.sliding.adaptive ? "" : "TSMC, ",
               o.potential_only  ? "potential field only (thesis)"
               : o.path_follower ? "planned detours through the path follower"
-                                : "planned detours (issue 15)",
+                                : "planned detours",
               o.potential_only ? "" : (o.approach ? ", approach from the start" : ", no approach"), 1e3 * wall,
               o.start.x, o.start.y, o.start.theta, s.footprint.circumscribedRadius());
   std::printf(

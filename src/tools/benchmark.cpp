@@ -31,13 +31,13 @@
 #include <string>
 #include <vector>
 
-#include "sowing_robot/scenario_file/scenario_loader.h"
 #include "sowing_robot/cli/usage.h"
 #include "sowing_robot/core/evaluation/benchmark.h"
 #include "sowing_robot/core/evaluation/estimated_bench.h"
 #include "sowing_robot/core/evaluation/run_metrics.h"
 #include "sowing_robot/core/simulation/runner.h"
 #include "sowing_robot/farm/farm.h"
+#include "sowing_robot/scenario_file/scenario_loader.h"
 
 using namespace sowing_robot::core;
 namespace scenario_file = sowing_robot::scenario_file;

@@ -33,11 +33,11 @@
 #include <string>
 #include <vector>
 
-#include "sowing_robot/scenario_file/tune_config.h"
 #include "sowing_robot/cli/usage.h"
 #include "sowing_robot/core/evaluation/checkpoint.h"
 #include "sowing_robot/core/evaluation/tuning.h"
 #include "sowing_robot/farm/farm.h"
+#include "sowing_robot/scenario_file/tune_config.h"
 
 using namespace sowing_robot;
 using core::TuningCost;
@@ -234,7 +234,8 @@ bool resumeSession(const Args& args, std::uint64_t fingerprint, const scenario_f
 }
 
 /// The progress CSV's header and, when resumed, the file's rows before the session's iteration.
-std::string progressCsvStart(const Args& args, const scenario_file::TuneConfig& cfg, const core::TuningSession& session) {
+std::string progressCsvStart(const Args& args, const scenario_file::TuneConfig& cfg,
+                             const core::TuningSession& session) {
   std::string csv = "iteration,best_cost,evaluations,evaluations_cut,simulated_s,elapsed_s";
   for (const auto& b : cfg.gains) csv += "," + b.name;
   csv += "\n";
@@ -243,7 +244,8 @@ std::string progressCsvStart(const Args& args, const scenario_file::TuneConfig& 
 }
 
 /// The progress CSV's row of iteration `it`.
-std::string progressCsvRow(int it, const scenario_file::TuneConfig& cfg, const core::TuningSession& session, double elapsed) {
+std::string progressCsvRow(int it, const scenario_file::TuneConfig& cfg, const core::TuningSession& session,
+                           double elapsed) {
   std::string row = std::to_string(it) + "," + g(session.search().bestCost(), "%.17g") + "," +
                     std::to_string(static_cast<long>(it + 1) * cfg.pso.particles) + "," +
                     std::to_string(session.evaluationsCut()) + "," + g(session.simulatedSeconds(), "%.9g") + "," +
