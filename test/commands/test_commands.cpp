@@ -1,4 +1,4 @@
-// Every command answers --help and names an unknown option (issue 27 item 5): the C++ programs through their
+// Every command answers --help and names an unknown option: the C++ programs through their
 // built executables (the ROS nodes with no master), the scripts through their paths in the source tree.
 //   cmd --help, cmd -h        exit 0, the usage on stdout, before any work
 //   cmd --no-such-option      exit 2, one line on stderr that names the option and points to --help

@@ -1,4 +1,4 @@
-// The `tune` command through its executable (issue 28): threads and MPI ranks (mpirun -np 1, 2, 4,
+// The `tune` command through its executable: threads and MPI ranks (mpirun -np 1, 2, 4,
 // oversubscribed) give the same gains bit for bit; a run stopped after iteration K, or killed with SIGKILL
 // at any moment, and resumed gives the gains of an uninterrupted one; a rank that dies ends the job with
 // a message within seconds and the checkpoint resumes; bad input gives one line.
@@ -214,7 +214,7 @@ TEST(TuneCommand, BadInputGivesOneLine) {
   EXPECT_NE(o.err.find("checksum"), std::string::npos) << o.err;
 }
 
-// Robust tuning (issue 26 item 4) through the command: --controller picks the pair, the gains file records
+// Robust tuning through the command: --controller picks the pair, the gains file records
 // its training set, and MPI ranks (each training run its own task) give the threaded gains bit for bit.
 TEST(TuneCommand, RobustTuningOnRanksGivesTheThreadedGainsAndRecordsItsTrainingSet) {
   TempDir dir;

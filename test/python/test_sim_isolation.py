@@ -1,4 +1,4 @@
-"""Runs that keep to themselves (issue 27 item 4): two headless scripts/sim runs started at the same moment
+"""Runs that keep to themselves: two headless scripts/sim runs started at the same moment
 each get a ROS master of their own and finish with their own results; --local-only refuses in one line
 (exit 4) where no network namespace can be made. Needs the built workspace (the nodes), no master."""
 import os

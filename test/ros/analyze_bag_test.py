@@ -231,7 +231,7 @@ class AnalyzeBag(unittest.TestCase):
                 odom.pose.pose.orientation.z = math.sin(0.05 * math.exp(-t))
                 odom.pose.pose.orientation.w = math.cos(0.05 * math.exp(-t))
                 odom.twist.twist.linear.x = 1.0 + math.exp(-t)
-                bag.write("/ground_truth", odom, bt)  # the true state (issue 16)
+                bag.write("/ground_truth", odom, bt)  # the true state
                 encoders = copy.deepcopy(odom)
                 encoders.pose.pose.position.x += 0.5  # the encoders' dead reckoning, off by 0.5 m
                 bag.write("/odom", encoders, bt)
@@ -296,7 +296,7 @@ class AnalyzeBag(unittest.TestCase):
         return lines[0]
 
     def test_old_bag_falls_back_to_odom_and_says_so(self):
-        # Bags recorded before issue 16 have no /ground_truth: their /odom was the true state.
+        # Bags recorded before plant_sim had sensors have no /ground_truth: their /odom was the true state.
         path = self.path("old.bag")
         with rosbag.Bag(path, "w") as bag:
             for k in range(0, 200):

@@ -22,7 +22,7 @@ CASES = [
     ("plant_sim", {"control_rate": "fast"}, "control_rate"),  # wrong type
     ("plant_sim", {"min_subscribers": 2.5}, "min_subscribers"),  # not an integer (roscpp would truncate)
     ("plant_sim", {"robot_description": "ZERO_RADIUS"}, "radius"),
-    # the sensors (issue 16): negative, NaN, out of range, an unknown sensor key, the feedback topic
+    # the sensors: negative, NaN, out of range, an unknown sensor key, the feedback topic
     ("plant_sim", {"sensors/encoder/ticks_per_turn": 0}, "/bad_%d/sensors/encoder/ticks_per_turn = 0"),
     ("plant_sim", {"sensors/encoder/noise": -0.5}, "/bad_%d/sensors/encoder/noise = -0.5"),
     ("plant_sim", {"sensors/imu/noise": float("nan")}, "/bad_%d/sensors/imu/noise = "),
@@ -40,7 +40,7 @@ CASES = [
     ("torque_controller", {"switching": "magic"}, "switching"),
     ("torque_controller", {"mode": "pid"}, "mode"),
     ("kinematic_controller", {"kx": -1.0}, "kx"),
-    # the controller pair (issue 17): an unknown name, a typo of a baseline's key, and a bad value of a
+    # the controller pair: an unknown name, a typo of a baseline's key, and a bad value of a
     # parameter of a controller not selected (checked although inert)
     ("kinematic_controller", {"outer": "stanley"}, "outer"),
     ("torque_controller", {"inner": "lqr"}, "inner"),
@@ -54,7 +54,7 @@ CASES = [
     ("reference_generator", {"line/v_r": -1.0}, "v_r"),
     # a key the configuration does not read is refused like an unknown one: field keys with type line
     ("reference_generator", {"field/rows": 0}, "is set but type is not 'field'"),
-    # the path follower (issue 27): path keys with another type, a bad value, a malformed point, a typo
+    # the path follower: path keys with another type, a bad value, a malformed point, a typo
     ("reference_generator", {"path/v_max": 0.5}, "is set but type is not 'path'"),
     ("reference_generator", {"type": "path", "path/v_max": -1.0}, "/bad_%d/path/v_max = -1"),
     ("reference_generator", {"type": "path", "path/points": [[0, 0], [1]]}, "/bad_%d/path/points[1] must be a pair"),
@@ -63,7 +63,7 @@ CASES = [
     # a run-wide setting is set once (run/): a node's own copy that disagrees names both values
     ("torque_controller", {"control_rate": 500.0}, "disagrees with /run/control_rate = 1000.0"),
     ("plant_sim", {"duration": 60.0}, "disagrees with /run/duration = 25.0"),
-    # the drive train (issue 26): a bad value or a typo of each layer, motors that cannot move the robot, and
+    # the drive train: a bad value or a typo of each layer, motors that cannot move the robot, and
     # the speed governor without the traction control whose verdicts it needs
     ("plant_sim", {"motor/stall_torque": -1.0}, "/bad_%d/motor/stall_torque = -1"),
     ("plant_sim", {"motor/enabld": True}, "motor/enabld"),

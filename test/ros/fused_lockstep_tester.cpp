@@ -6,7 +6,7 @@
 // bit for bit. Fails without what it protects: an in-process loop that fed the controllers at another step,
 // formed the EKF's inputs otherwise (e.g. without the quaternion round trip or the increment covariance) or
 // applied the fixes at another time gives other numbers (the printed differences say how far).
-// The drive train (issue 26) comes from the nodes' namespaces too: plant_sim's traction/ (+ field/patches) and
+// The drive train comes from the nodes' namespaces too: plant_sim's traction/ (+ field/patches) and
 // motor/, kinematic_controller's limits/, torque_controller's traction_control/, reference_generator's speed_governor/
 // (fused_field_lockstep.test: sim.launch profile:=field on a wet stretch of the line). ~expect_drive_train: the
 // in-process run must show the traction control cutting and the governor slowing the target, so the comparison

@@ -3,7 +3,7 @@
 the verdict with a report "no traction at (x y): ..." while the robot is on the no-grip patch (x in [10, 20] m);
 from then on the robot is held: from 3 s after the verdict to the plant's duration (the run ended on the verdict, the
 plant goes on: exit_at_end false, the hold with it) |v| and |omega| stay within 0.01 (m/s, rad/s) and it moves less
-than 2 cm (issue 26: "a stop is a stop"); the plant never diverges (it did 5.2 s after the verdict, the draft's
+than 2 cm ("a stop is a stop"); the plant never diverges (it did 5.2 s after the verdict, the draft's
 damper at speeds near 1e-164 m/s: test_traction); run_monitor's ~status says the run ended on no traction, no_traction_hold (3 s) after
 the verdict, to the period; plant_sim says why on no_traction_diagnosis: the patch's grip budget at the verdict's place, its
 peak traction below what driving there needs."""

@@ -1,4 +1,4 @@
-// Baselines of issue 17 (pure pursuit, Regulated Pure Pursuit, wheel-velocity PID) and the outer/inner
+// The baselines (pure pursuit, Regulated Pure Pursuit, wheel-velocity PID) and the outer/inner
 // controller slots of runClosedLoop.
 #include <gtest/gtest.h>
 

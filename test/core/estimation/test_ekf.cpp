@@ -546,7 +546,7 @@ SensorRun runWithSensors(std::uint64_t seed, double seconds, double dropout_star
 
 }  // namespace
 
-// Consistency fed by core/model/sensors.h (issue 16: NEES within its bounds over a long run): 40 runs of 60 s
+// Consistency fed by core/model/sensors.h (NEES within its bounds over a long run): 40 runs of 60 s
 // (as NeesWithinChiSquareBoundsOverLongRuns), each starting from a draw of the initial covariance (started
 // at the truth, the first checkpoint's NEES is ~2.4: the covariance then says more than the error), and
 // per state (squared error over the marginal variance, 1 for a consistent filter; its mean over 2,400

@@ -1,4 +1,4 @@
-// The PSO as ask/tell and its checkpoints (issue 28 item 3): PsoSearch driven by hand is psoMinimize; its
+// The PSO as ask/tell and its checkpoints: PsoSearch driven by hand is psoMinimize; its
 // text state round-trips exactly; stopping after any iteration K, writing the state and resuming from it
 // gives the uninterrupted result bit for bit (the PSO alone and the tuner); damaged, truncated or foreign
 // checkpoint files are refused with one line.

@@ -1,4 +1,4 @@
-// Robust tuning (issue 26 item 4): the cost of one training run (tracking term capped, a failure's penalty
+// Robust tuning: the cost of one training run (tracking term capped, a failure's penalty
 // on top), the set's mean and quantile, that evaluating the whole set equals combining its runs one by one
 // (what the MPI farm does), that a bounded evaluation never hides a better cost, and that the search over a
 // training set gives the same gains for any thread count and improves on its initial swarm.

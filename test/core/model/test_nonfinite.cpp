@@ -1,4 +1,4 @@
-// NaN and infinity at every core entry point that takes run-time input (issue 6): a bad value is refused
+// NaN and infinity at every core entry point that takes run-time input: a bad value is refused
 // where it enters, leaves the component's state exactly as it was, and the next good input gives the
 // same result as in a twin that never saw the bad one. Each test fails if its guard is removed: the
 // state or output would turn NaN (or, for the potential field given t = inf, the integration would

@@ -1,4 +1,4 @@
-// Soil patches (issue 16, item 2): the patch lookup, the patches' validation naming the key, and the
+// Soil patches: the patch lookup, the patches' validation naming the key, and the
 // traction plant taking each wheel's grip from the patch under it; the tool's rule (tool_engagement.h).
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-// Traction plant (issue 16, item 1): the friction curve, the normal loads, parameter refusal, the
+// Traction plant: the friction curve, the normal loads, parameter refusal, the
 // limit of high grip (today's no-slip Plant, open and closed loop), the integrator against a fine-step
 // reference, ice, a wheel in the air, energy, and a cost print beside Plant.
 #include <gtest/gtest.h>
@@ -465,7 +465,7 @@ TEST(Traction, CostBesidePlant) {
   SUCCEED();
 }
 
-// --- The tool's draft (issue 16, item 3) and its edges -------------------------------------------------
+// --- The tool's draft and its edges ----------------------------------------------------------------------
 
 namespace {
 // Equal torques from rest for `seconds` with the tool at `tool`, down with `draft` N.

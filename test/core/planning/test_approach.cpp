@@ -1,4 +1,4 @@
-// Issue 15, the first seconds: the field's target starts at the robot's start pose and joins the first
+// The approach, the first seconds: the field's target starts at the robot's start pose and joins the first
 // row on an approach within the detours' bounds (approach.h), so the whole run, not only the rows,
 // keeps the yaw rate and the lateral acceleration within them.
 #include <gtest/gtest.h>
@@ -68,7 +68,7 @@ TEST(Approach, ThesisFieldWholeRunWithinTheBoundsWithoutContactAndKeepsTheRowSee
   EXPECT_EQ(r.status.code, AvoidanceStatus::Code::kOk);
   EXPECT_NEAR(r.end.x(), 100.0, 0.15);
   EXPECT_NEAR(r.end.y(), 3.0, 0.05);
-  // The approach sows nothing; the rows' seeds no worse than issue 15's figures (max 7.8 mm, RMS 1.6 mm).
+  // The approach sows nothing; the rows' seeds no worse than with the thesis potential field (max 7.8 mm, RMS 1.6 mm).
   EXPECT_GT(r.rows.count, 600u);
   EXPECT_LE(r.rows.max, 7.8e-3);
   EXPECT_LE(r.rows.rms, 1.6e-3);

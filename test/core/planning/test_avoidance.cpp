@@ -1,4 +1,4 @@
-// Issue 15: obstacle avoidance a real robot can drive. The closed loop (ATSMC, disturbance 2.75 N m at
+// Obstacle avoidance a real robot can drive. The closed loop (ATSMC, disturbance 2.75 N m at
 // 3 rad/s, 20 % mismatch, start (-1, 0, 0), 1 kHz) on planned field references, measured on the
 // body (the URDF's footprint) with the contact monitor and the seed drill.
 #include <gtest/gtest.h>
@@ -26,7 +26,7 @@ FieldRunSetup thesisField() {
   return s;
 }
 
-/// One row of 60 m at y = 3 (issue 15's layouts).
+/// One row of 60 m at y = 3 (the layouts of docs/detours.md).
 FieldRunSetup row60(std::vector<Obstacle> obstacles) {
   FieldRunSetup s = thesisField();
   s.scenario.duration = 75.0;
@@ -58,7 +58,7 @@ TEST(Avoidance, ThesisFieldClearsEveryObstacleWithinTheBoundsAndKeepsTheRowSeeds
   EXPECT_EQ(r.status.detours, 3u);
   EXPECT_NEAR(r.end.x(), 100.0, 0.15);
   EXPECT_NEAR(r.end.y(), 3.0, 0.05);
-  // On-row seeds no worse than with the thesis potential field (issue 15: max 7.8 mm, RMS 1.6 mm).
+  // On-row seeds no worse than with the thesis potential field (max 7.8 mm, RMS 1.6 mm).
   FieldRunSetup before = s;
   before.field.avoidance.plan_detours = false;
   const FieldRunReport b = runField(before);

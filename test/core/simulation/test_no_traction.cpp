@@ -1,4 +1,4 @@
-// Issue 26, "no traction": on a patch where no grip is to be had the robot stops, the run ends with the
+// "No traction": on a patch where no grip is to be had the robot stops, the run ends with the
 // status "no traction" saying where and why, and the robot does not spin, orbit or wander. The verdict is
 // the traction control's progress check (traction_monitor.h) on what the robot measures.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Issue 26, "a stop is a stop": wherever the plan stops the robot it stands still within 3 s (|v|, |omega|
+// "A stop is a stop": wherever the plan stops the robot it stands still within 3 s (|v|, |omega|
 // <= 0.01) and holds there against the thesis disturbance (2.75 N·m at 3 rad/s, 20 % mismatch), whatever
 // the pair. Before the standstill hold, at a row end inside an obstacle ATSMC rocked about the stop point,
 // +-0.11 m at up to 0.33 m/s, for as long as the run lasted.
