@@ -23,7 +23,7 @@ import cmd_vel_drive as drive
 
 TOL = 1e-9  # [unit] rounding allowance on the limiter's exact bounds
 # [% of the step] how far the robot may pass its target beyond its own steady offset (reverse scenario). The
-# limiter's profile never passes the target (docs/interfaces.md), so what the robot shows beyond it is its
+# limiter's profile never passes the target (docs/cmd_vel.md), so what the robot shows beyond it is its
 # steady offset (the ATSMC's: ~0.3 % on v, ~2.1 % on omega, the steady error's max) plus its transient.
 # Lockstep repeats the run bit for bit: measured 0.32 % / 2.14 % with offsets 0.32 % / 2.14 %, a transient
 # of < 0.01 %. 1 % leaves room for another controller tuning while a robot that swings past the command (a
