@@ -2,6 +2,7 @@
 // through the product's entry points (runClosedLoop, truth-fed and with a LoopConfig: the one loop of closed_loop.h).
 //   core_bench [--benchmark_min_time=0.2] [--benchmark_filter=Thesis] ...
 // BM_PlantRk4Step            one Plant::step (RK4, sinusoidal disturbance on)
+// BM_TractionStep            one TractionPlant::step with the same torques (TractionParams defaults: 4 sub-steps)
 // BM_ThesisRun25s            runClosedLoop of the 25 s thesis scenario at 1 kHz, every layer off (the no-slip
 //                            plant fed its own state, no trace, keep_samples = false: the tuner's run);
 //                            items/s = control steps/s
@@ -33,6 +34,7 @@
 #include "sowing_robot/core/evaluation/pso.h"
 #include "sowing_robot/core/evaluation/tuning.h"
 #include "sowing_robot/core/model/plant.h"
+#include "sowing_robot/core/model/traction.h"
 #include "sowing_robot/core/simulation/runner.h"
 
 using namespace sowing_robot;
@@ -64,6 +66,30 @@ void BM_PlantRk4Step(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations());
 }
 BENCHMARK(BM_PlantRk4Step);
+
+// The traction plant's step beside BM_PlantRk4Step (the figure test_traction's CostBesidePlant printed):
+// the same torques and resets, the thesis scenario's disturbance, TractionParams defaults.
+void BM_TractionStep(benchmark::State& state) {
+  const Scenario sc = bench::thesisScenario();
+  TractionPlant plant(sc.robot, sc.disturbance, TractionParams{});
+  State x0 = State::Zero();
+  x0[X] = -1.0;
+  x0[V] = 1.0;
+  plant.reset(x0, 0.0);
+  const double dt = 1e-3;
+  std::int64_t k = 0;
+  for (auto _ : state) {
+    plant.step(0.5 * ((k & 1) ? 1.0 : -1.0), 0.3, dt);
+    if (++k == 25000) {
+      plant.reset(x0, 0.0);
+      k = 0;
+    }
+    benchmark::DoNotOptimize(plant.state().data());
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_TractionStep);
 
 // Runs `run` (one whole run, returning the figure kept as a counter) per iteration; items = control steps.
 template <typename Run>

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "sowing_robot/core/simulation/lockstep.h"
 #include "sowing_robot/ros/common/component_params.h"
 #include "sowing_robot/ros/common/msg_checks.h"
 #include "sowing_robot/ros/common/urdf_params.h"
@@ -31,6 +32,7 @@ SeedDrillNode::SeedDrillNode(ros::NodeHandle nh, ros::NodeHandle pnh) {
       error = linkPositionFromUrdf(xml, settings_.tool_link, tool_x_, tool_y_);
   }
   requireValid(p, error);
+  if (run.duration > 0.0) end_ns_ = core::lockstepLastStep(run.duration, run.periodNs()) * run.periodNs();
   logSettings("seed_drill", core::SeedDrillSettings::table(), settings_);
   ROS_INFO("seed_drill: tool point (%.3f, %.3f) m in base_link; waiting for the plan", tool_x_, tool_y_);
 
@@ -120,7 +122,14 @@ void SeedDrillNode::update(const nav_msgs::Odometry& odom, bool tool_down) {
   c = std::cos(pose.theta);
   const Eigen::Vector2d tool(pose.x + c * tool_x_ - s * tool_y_, pose.y + s * tool_x_ + c * tool_y_);
   Eigen::Vector2d seed;
-  if (!drill_->update(tool, tool_down, seed)) return;
+  if (drill_->update(tool, tool_down, seed)) addSeed(seed, odom.header.stamp);
+  if (!final_sent_ && end_ns_ >= 0 && static_cast<std::int64_t>(odom.header.stamp.toNSec()) >= end_ns_) {
+    final_sent_ = true;
+    publishReport(odom.header.stamp);
+  }
+}
+
+void SeedDrillNode::addSeed(const Eigen::Vector2d& seed, const ros::Time& stamp) {
   if (chunk_.points.size() >= kChunk) {
     chunk_.points.clear();
     ++chunk_id_;
@@ -130,11 +139,11 @@ void SeedDrillNode::update(const nav_msgs::Odometry& odom, bool tool_down) {
   pt.y = seed.y();
   chunk_.points.push_back(pt);
   chunk_.id = chunk_id_;
-  chunk_.header.stamp = odom.header.stamp;
+  chunk_.header.stamp = stamp;
   visualization_msgs::MarkerArray out;
   out.markers.push_back(chunk_);
   seeds_pub_.publish(out);
-  if (++seeds_ % 50 == 0) publishReport(odom.header.stamp);
+  if (++seeds_ % 50 == 0) publishReport(stamp);
 }
 
 void SeedDrillNode::publishReport(const ros::Time& stamp) {

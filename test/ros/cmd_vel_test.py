@@ -7,7 +7,7 @@
   it by then plus ~robot_slack; the command goes stale 0.5 s after the last twist (cmd_vel_timeout), and the
   output ramps to zero in the limiter's time, the robot after it.
 ~scenario reverse: astern (-0.3, -0.2), then straight to ahead (+0.3, +0.2) through zero: the same checks
-  both ways.
+  both ways, and the robot passes -0.3 / -0.2 by at most its steady offset + OVERSHOOT_ALLOWANCE.
 Both: every bound (value, acceleration, jerk) holds throughout, in both directions, and the accelerations
 handed to the inner loop are the derivatives of the velocities.
 
@@ -22,6 +22,13 @@ import rostest
 import cmd_vel_drive as drive
 
 TOL = 1e-9  # [unit] rounding allowance on the limiter's exact bounds
+# [% of the step] how far the robot may pass its target beyond its own steady offset (reverse scenario). The
+# limiter's profile never passes the target (docs/cmd_vel.md), so what the robot shows beyond it is its
+# steady offset (the ATSMC's: ~0.3 % on v, ~2.1 % on omega, the steady error's max) plus its transient.
+# Lockstep repeats the run bit for bit: measured 0.32 % / 2.14 % with offsets 0.32 % / 2.14 %, a transient
+# of < 0.01 %. 1 % leaves room for another controller tuning while a robot that swings past the command (a
+# limiter that overshoots, a jerk or acceleration bound lost, a loop gone oscillatory) exceeds it.
+OVERSHOOT_ALLOWANCE = 1.0
 
 
 class CmdVelStep(unittest.TestCase):
@@ -128,6 +135,12 @@ class CmdVelStep(unittest.TestCase):
             print("cmd_vel reverse %s %g: limiter reach %.3f s, robot settled %.3f s, overshoot %.2f %%, steady "
                   "error mean %.2e max %.2e" % (axis, -target, back[0], back[1], f["overshoot_pct"], f["steady_mean"],
                                                 f["steady_max"]))
+            offset_pct = f["steady_max"] / abs(target) * 100.0
+            self.assertLessEqual(f["overshoot_pct"], offset_pct + OVERSHOOT_ALLOWANCE,
+                                 "%s: the robot passed %g by %.2f %% of the step, %.2f %% beyond its steady offset" %
+                                 (axis, -target, f["overshoot_pct"], f["overshoot_pct"] - offset_pct))
+            # and never out of the settling band, whatever its offset
+            self.assertLess(f["overshoot_pct"], self.band * 100.0, "%s: overshoot beyond the settling band" % axis)
             flip = self.expect_change(axis, drive.FLIP_AT, -target, target)
             print("cmd_vel flip %s %g -> %g: limiter reach %.3f s, robot settled %.3f s" %
                   (axis, -target, target, flip[0], flip[1]))

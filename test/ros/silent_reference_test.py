@@ -9,7 +9,11 @@ of the two input_timeouts (kinematic 0.1 s < torque 0.2 s in fault_overlay.yaml,
 Verified to fail without it: with stopIfStale reduced to `return;` kinematic_controller publishes
 nothing while the reference is missing, and the wait for the stop command fails. With its age check
 removed (a stop on every odom that has no reference yet) it fails on the stop coming before
-input_timeout."""
+input_timeout.
+
+Every verdict is on the messages' stamps (simulated time) or on an event waited for; the wall clock only
+bounds a hang (WALL_LIMIT). fault_overlay.yaml runs the plant at a quarter of the wall clock, so that the
+controllers keep up with it on a loaded machine (a controller behind the plant sees stale inputs)."""
 import time
 import unittest
 
@@ -21,9 +25,12 @@ from sowing_robot.msg import DesiredVelocity, ReferenceState, TrackingError
 
 import node_process
 
-WALL_LIMIT = 60.0  # [s wall] for anything that takes about a second on an idle machine
+WALL_LIMIT = 120.0  # [s wall] bounds a hang only: anything waited for takes a few seconds on an idle machine
 STOP_SLACK = 0.1   # [s sim] the last references seen here may have missed their odom in the controller
-LATE_SLACK = 0.5   # [s sim] odom the controller dropped under load (queue of 50) can delay the stop
+# [s sim] the stop comes at the first state past input_timeout the controller takes (all of them, in order:
+# its queue holds 20,000), one period after it; this allows for references of the killed generator that
+# reached the controller but not this test
+LATE_SLACK = 0.5
 
 
 def is_stop(d):
@@ -38,7 +45,6 @@ class SilentReference(unittest.TestCase):
     def setUp(self):
         self.timeout = rospy.get_param("/kinematic_controller/input_timeout")
         self.desired, self.refs, self.errors, self.logs = [], [], [], []
-        self.ref_received = time.time()
         self.subs = [
             rospy.Subscriber("desired_velocity", DesiredVelocity, self.desired.append, queue_size=20000),
             rospy.Subscriber("reference", ReferenceState, self.on_reference, queue_size=20000),
@@ -62,12 +68,11 @@ class SilentReference(unittest.TestCase):
 
     def on_reference(self, m):
         self.refs.append(m.header.stamp.to_sec())
-        self.ref_received = time.time()
 
-    def generator_gone(self):
-        """The killed generator has left the graph and its last references have been delivered."""
-        return (time.time() - self.ref_received > 0.3 and
-                "/reference_generator" not in rosnode.get_node_names())
+    @staticmethod
+    def generator_gone():
+        """The killed generator has left the graph."""
+        return "/reference_generator" not in rosnode.get_node_names()
 
     @staticmethod
     def latest(stamps):
@@ -82,18 +87,23 @@ class SilentReference(unittest.TestCase):
     def test_stop_while_the_reference_is_missing(self):
         self.wait_for(lambda: self.latest(self.refs) >= 1.0, "reference up to t = 1 s")
         rosnode.kill_nodes(["/reference_generator"])
-        self.wait_for(self.generator_gone, "end of the references")
-        last_ref = self.refs[-1]
-        self.wait_for(lambda: self.first_stop_after(last_ref) is not None, "stop command")
-        stop_at = self.first_stop_after(last_ref).header.stamp.to_sec()
-        self.assertGreaterEqual(stop_at - last_ref, self.timeout - STOP_SLACK, "stop before input_timeout")
-        self.assertLessEqual(stop_at - last_ref, self.timeout + LATE_SLACK, "stop late")
+        self.wait_for(self.generator_gone, "end of the reference generator")
+        self.wait_for(lambda: self.first_stop_after(self.latest(self.refs)) is not None, "stop command")
         self.wait_for(lambda: any(m.name == "/kinematic_controller" and m.level == Log.WARN and
                                   "no reference for" in m.msg and "commanding stop" in m.msg for m in list(self.logs)),
                       "warning from kinematic_controller")
 
-        # Hold the outage for 1 s of simulated time, then bring the generator back.
-        self.wait_for(lambda: self.latest_desired() >= stop_at + 1.0, "1 s of outage")
+        # Hold the outage for 1 s of simulated time (4 s wall or more), then bring the generator back. The
+        # stop is judged once the outage is over, against the killed generator's last reference: by then
+        # everything it sent has arrived.
+        first_stop = self.first_stop_after(self.latest(self.refs)).header.stamp.to_sec()
+        self.wait_for(lambda: self.latest_desired() >= first_stop + 1.0, "1 s of outage")
+        last_ref = self.latest(self.refs)
+        stop_at = self.first_stop_after(last_ref).header.stamp.to_sec()
+        print("silent_reference: last reference t = %.3f s, stop from t = %.3f s (input_timeout %.3f s)" %
+              (last_ref, stop_at, self.timeout))
+        self.assertGreaterEqual(stop_at - last_ref, self.timeout - STOP_SLACK, "stop before input_timeout")
+        self.assertLessEqual(stop_at - last_ref, self.timeout + LATE_SLACK, "stop late")
         self.restarted = node_process.start("reference_generator", "reference_generator")
         self.wait_for(lambda: self.latest(self.refs) > stop_at + 1.0, "reference after the restart")
         back_at = next(t for t in self.refs if t > stop_at + 1.0)

@@ -4,9 +4,12 @@
 // the seeds in rviz and reports the cross-track error of the sown line against the intended rows (away
 // from obstacles and in detours apart).
 // Outputs: `seeds` (visualization_msgs/MarkerArray, a chunk of points per message, stamped with the state's
-// stamp) and `seed_report` (std_msgs/Float64MultiArray, latched, at the plan and every 50 seeds; its label
-// names the entries: rows_count, rows_max, rows_rms, rows_fraction_over, detour_count, detour_max,
-// detour_rms [m], stamp [s, of the state that sowed the last seed]).
+// stamp) and `seed_report` (std_msgs/Float64MultiArray, latched, at the plan, every 50 seeds and once
+// more for the run's final state (run/duration > 0: the last state of the run on the control period's grid),
+// so that the last report holds every seed of the run; its label names the entries: rows_count, rows_max,
+// rows_rms, rows_fraction_over, detour_count, detour_max, detour_rms [m], stamp [s, of the state that sowed
+// the last seed; of the final state in the final report]). A tester waits for the report stamped at the
+// run's end instead of guessing when the drill has caught up (the plant does not wait for this node).
 #pragma once
 
 #include <nav_msgs/Odometry.h>
@@ -42,8 +45,11 @@ class SeedDrillNode {
   /// The reference generator's plan: the first one starts the drill, later ones replace its rows and
   /// obstacles (run-time obstacle changes).
   void planCallback(const FieldPlan::ConstPtr& msg);
-  /// The state and the reference for the same time: move the tool, maybe drop a seed.
+  /// The state and the reference for the same time: move the tool, maybe drop a seed; the final report
+  /// after the run's final state.
   void update(const nav_msgs::Odometry& odom, bool tool_down);
+  /// A seed dropped by the state stamped `stamp`: shown, and every 50th reported.
+  void addSeed(const Eigen::Vector2d& seed, const ros::Time& stamp);
   void publishReport(const ros::Time& stamp);
 
   core::SeedDrillSettings settings_;
@@ -63,7 +69,9 @@ class SeedDrillNode {
   visualization_msgs::Marker chunk_;  // the current SPHERE_LIST of up to kChunk seeds
   int chunk_id_ = 0;
   std::size_t seeds_ = 0;
-  ReadyAnnouncer ready_;  // plant_sim waits for it before step 0
+  std::int64_t end_ns_ = -1;  ///< stamp of the run's final state [ns]; -1: the run has no end (duration 0)
+  bool final_sent_ = false;   ///< the final report is out
+  ReadyAnnouncer ready_;      // plant_sim waits for it before step 0
 };
 
 }  // namespace sowing_robot

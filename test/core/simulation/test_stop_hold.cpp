@@ -54,7 +54,7 @@ struct HoldFigures {
   bool flagged = false;                 ///< the reference said so (Reference::stop) from then on
   double max_v = 0.0, max_omega = 0.0;  ///< over [t_stop + kSettle, end]
   double drift = 0.0;                   ///< largest distance from the pose at t_stop + kSettle [m]
-  double max_wheel_rate = 0.0;          ///< largest |wheel spin| over the hold [rad/s]
+  double max_wheel_rate = 0.0;          ///< largest |wheel spin| over the hold, either wheel [rad/s]
   Eigen::Vector2d end = Eigen::Vector2d::Zero();
   AvoidanceStatus status;
   bool diverged = false;
@@ -66,6 +66,8 @@ HoldFigures runStop(const StopRun& run, const LoopConfig& config = {},
   HoldFigures f;
   Eigen::Vector2d settled(0.0, 0.0);
   bool has_settled = false;
+  bool has_prev = false;  // the hold's previous sample: its time and wheel angles
+  double prev_t = 0.0, prev_phi[2] = {0.0, 0.0};
   const LoopResult r = runClosedLoop(run.scenario, config, reference, false, [&](const EstimatedSample& es) {
     const LoopSample& s = *es.loop;
     const State& x = *s.state;
@@ -82,6 +84,14 @@ HoldFigures runStop(const StopRun& run, const LoopConfig& config = {},
     f.max_v = std::max(f.max_v, std::fabs(x[V]));
     f.max_omega = std::max(f.max_omega, std::fabs(x[OMEGA]));
     f.drift = std::max(f.drift, (p - settled).norm());
+    // The wheels' spin over each period of the hold, from their angles (what an encoder counts).
+    if (has_prev)
+      for (int w = 0; w < 2; ++w)
+        f.max_wheel_rate = std::max(f.max_wheel_rate, std::fabs(x[PHI_R + w] - prev_phi[w]) / (s.t - prev_t));
+    has_prev = true;
+    prev_t = s.t;
+    prev_phi[0] = x[PHI_R];
+    prev_phi[1] = x[PHI_L];
   });
   f.end = Eigen::Vector2d(r.run.final_state[X], r.run.final_state[Y]);
   f.status = reference.status();
@@ -98,10 +108,16 @@ void expectStandsStill(const HoldFigures& f, const StopRun& run, const std::stri
   EXPECT_LE(f.max_v, still_v) << what;
   EXPECT_LE(f.max_omega, still_omega) << what;
   EXPECT_LT(f.drift, 0.01) << what;
+  // The wheels stand still too: rolling without slip, a wheel spins at (v +- L omega) / R, so "still" for
+  // the body bounds it by (still_v + L still_omega) / R (1 % for the mean over a period against its ends).
+  // A wheel turning while the body stands (slip, or the hold dithering the wheels) would exceed it.
+  const RobotParams& robot = run.scenario.robot;
+  const double still_wheel = (still_v + robot.L * still_omega) / robot.R;
+  EXPECT_LE(f.max_wheel_rate, 1.01 * still_wheel) << what;
   std::printf(
-      "%s: stop at t = %.2f s, over the hold max |v| %.5f m/s, max |omega| %.5f rad/s, drift %.4f m, end (%.3f, "
-      "%.3f)\n",
-      what.c_str(), f.t_stop, f.max_v, f.max_omega, f.drift, f.end.x(), f.end.y());
+      "%s: stop at t = %.2f s, over the hold max |v| %.5f m/s, max |omega| %.5f rad/s, max wheel spin %.4f "
+      "rad/s (bound %.4f), drift %.4f m, end (%.3f, %.3f)\n",
+      what.c_str(), f.t_stop, f.max_v, f.max_omega, f.max_wheel_rate, still_wheel, f.drift, f.end.x(), f.end.y());
 }
 
 }  // namespace
