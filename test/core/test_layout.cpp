@@ -25,7 +25,7 @@ const fs::path kRoot = SOWING_SOURCE_DIR;
 /// Each room and the rooms it may include (besides itself).
 const std::map<std::string, std::set<std::string>>& allowedIncludes() {
   static const std::map<std::string, std::set<std::string>> m = [] {
-    const std::set<std::string> base{"numerics", "common"};
+    const std::set<std::string> base{"common"};
     std::set<std::string> behaviour = base;
     behaviour.insert("model");
     std::set<std::string> top = behaviour;
@@ -33,9 +33,14 @@ const std::map<std::string, std::set<std::string>>& allowedIncludes() {
     std::set<std::string> evaluation = top;
     evaluation.insert("simulation");
     return std::map<std::string, std::set<std::string>>{
-        {"numerics", {}},       {"common", {"numerics"}}, {"model", base},
-        {"control", behaviour}, {"planning", behaviour},  {"estimation", behaviour},
-        {"simulation", top},    {"settings", top},        {"evaluation", evaluation},
+        {"common", {}},
+        {"model", base},
+        {"control", behaviour},
+        {"planning", behaviour},
+        {"estimation", behaviour},
+        {"simulation", top},
+        {"settings", top},
+        {"evaluation", evaluation},
     };
   }();
   return m;
