@@ -149,7 +149,7 @@ py::dict runEstimatedPy(const std::string& controller, const py::object& params,
     profile_name = profile.cast<std::string>();
     try {  // the benchmark's reading of the file: its keys win over the call's
       sowing_robot::scenario_file::applyProfileTo(
-          sowing_robot::scenario_file::profilePath(profile_name, SOWING_PROFILE_DIR), cfg);
+          sowing_robot::scenario_file::resolveProfile(profile_name, SOWING_SOURCE_DIR).file, cfg);
     } catch (const std::invalid_argument& ex) {
       throw py::value_error(ex.what());
     }
