@@ -228,7 +228,8 @@ motor: plant_sim's motor/ keys ({"enabled": True}), limits: kinematic_controller
 command bounded), traction_control: torque_controller's traction_control/ keys,
 speed_governor: reference_generator's speed_governor/ keys, hitch_control: torque_controller's hitch_control/ keys. profile: a profile's name ("field":
 config/profiles/field.yaml, what sim.launch profile:=field and benchmark --profile apply) or a file path, read as
-the benchmark reads it and applied on top of the blocks above (its keys win; its feedback replaces feedback=);
+the benchmark reads it (scenario_file::resolveProfile) and applied on top of the blocks above (its keys win; its
+feedback replaces feedback=; its blocks only: the gains tuned for it, config/tuned/field/PAIR.yaml, go in params=);
 patches then take the traction in force. Other arguments as run()'s.
 Returns run()'s dict plus "feedback", "traction", "max_abs_slip", "tool_down_time", "fed_error_rms",
 "fed_error_max", "fed_heading_error_max" (the fed pose against the truth), "odometry_error_final",
