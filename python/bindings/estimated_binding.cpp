@@ -149,7 +149,7 @@ py::dict runEstimatedPy(const std::string& controller, const py::object& params,
     profile_name = profile.cast<std::string>();
     try {  // the benchmark's reading of the file: its keys win over the call's
       sowing_robot::scenario_file::applyProfileTo(
-          sowing_robot::scenario_file::profilePath(profile_name, SOWING_PROFILE_DIR), cfg);
+          sowing_robot::scenario_file::resolveProfile(profile_name, SOWING_SOURCE_DIR).file, cfg);
     } catch (const std::invalid_argument& ex) {
       throw py::value_error(ex.what());
     }
@@ -228,7 +228,8 @@ motor: plant_sim's motor/ keys ({"enabled": True}), limits: kinematic_controller
 command bounded), traction_control: torque_controller's traction_control/ keys,
 speed_governor: reference_generator's speed_governor/ keys, hitch_control: torque_controller's hitch_control/ keys. profile: a profile's name ("field":
 config/profiles/field.yaml, what sim.launch profile:=field and benchmark --profile apply) or a file path, read as
-the benchmark reads it and applied on top of the blocks above (its keys win; its feedback replaces feedback=);
+the benchmark reads it (scenario_file::resolveProfile) and applied on top of the blocks above (its keys win; its
+feedback replaces feedback=; its blocks only: the gains tuned for it, config/tuned/field/PAIR.yaml, go in params=);
 patches then take the traction in force. Other arguments as run()'s.
 Returns run()'s dict plus "feedback", "traction", "max_abs_slip", "tool_down_time", "fed_error_rms",
 "fed_error_max", "fed_heading_error_max" (the fed pose against the truth), "odometry_error_final",

@@ -68,6 +68,17 @@ bool fileExists(const std::string& path) {
   return ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
 }
 
+bool directoryExists(const std::string& path) {
+  struct stat st;
+  return ::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode);
+}
+
+/// A scenario's or a profile's argument is a file path (contains '/' or ends with .yaml), else a name.
+bool isPath(const std::string& name_or_path) {
+  return name_or_path.find('/') != std::string::npos ||
+         (name_or_path.size() > 5 && name_or_path.compare(name_or_path.size() - 5, 5, ".yaml") == 0);
+}
+
 /// A soil patch as the field file states it: a coefficient left out takes the traction block's value
 /// (as plant_sim's loadSoilPatches does), resolved once that block is read.
 struct PatchSpec {
@@ -397,17 +408,19 @@ core::BenchScenario loadScenarioFileImpl(const std::string& path, const std::str
   return b;
 }
 
-std::string profilePath(const std::string& name_or_path, const std::string& dir) {
-  const bool is_path = name_or_path.find('/') != std::string::npos ||
-                       (name_or_path.size() > 5 && name_or_path.compare(name_or_path.size() - 5, 5, ".yaml") == 0);
-  if (is_path) return name_or_path;
-  const std::string path = dir + "/" + name_or_path + ".yaml";
-  if (!fileExists(path)) {
+ProfileFiles resolveProfile(const std::string& name_or_path, const std::string& source_dir) {
+  if (isPath(name_or_path)) return {name_or_path, ""};
+  // What sim.launch profile:=NAME loads: config/profiles/NAME.yaml, then config/tuned/NAME/OUTER+INNER.yaml.
+  const std::string profiles = source_dir + "/config/profiles";
+  const std::string file = profiles + "/" + name_or_path + ".yaml";
+  if (!fileExists(file)) {
     std::string list;
-    for (const auto& n : scenarioNames(dir)) list += (list.empty() ? "" : ", ") + n;
-    throw std::invalid_argument("unknown profile '" + name_or_path + "' (known in " + dir + ": " + list + ")");
+    for (const auto& n : scenarioNames(profiles)) list += (list.empty() ? "" : ", ") + n;
+    throw std::invalid_argument("unknown profile '" + name_or_path + "' (available in " + profiles + ": " +
+                                (list.empty() ? "none" : list) + ")");
   }
-  return path;
+  const std::string gains = source_dir + "/config/tuned/" + name_or_path;
+  return {file, directoryExists(gains) ? gains : ""};
 }
 
 void applyProfileTo(const std::string& profile, core::LoopConfig& cfg) {
@@ -449,9 +462,7 @@ std::vector<std::string> scenarioNames(const std::string& dir) {
 }
 
 core::BenchScenario loadScenario(const std::string& name_or_path, const std::string& dir, const std::string& profile) {
-  const bool is_path = name_or_path.find('/') != std::string::npos ||
-                       (name_or_path.size() > 5 && name_or_path.compare(name_or_path.size() - 5, 5, ".yaml") == 0);
-  if (is_path) return loadScenarioFile(name_or_path, profile);
+  if (isPath(name_or_path)) return loadScenarioFile(name_or_path, profile);
   const std::string path = dir + "/" + name_or_path + ".yaml";
   if (!fileExists(path)) {
     std::string list;

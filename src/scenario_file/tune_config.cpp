@@ -40,7 +40,7 @@ std::string relativeTo(const std::string& dir, const std::string& file) {
 }
 
 /// The robust: block: the objective and the training set, each scenario driven by c.base's pair and gains.
-void loadRobust(const YAML::Node& r, const std::string& path, TuneConfig& c) {
+void loadRobust(const YAML::Node& r, const std::string& path, const std::string& source_dir, TuneConfig& c) {
   if (!r.IsMap())
     fail(path, "robust must be a mapping (aggregate, quantile, failure_penalty, max_slip_share, profile, training)");
   onlyKeys(r, {"aggregate", "quantile", "failure_penalty", "max_slip_share", "profile", "training"}, path, "robust/");
@@ -55,7 +55,19 @@ void loadRobust(const YAML::Node& r, const std::string& path, TuneConfig& c) {
   const std::string oe = c.robust.validate();
   if (!oe.empty()) fail(path, oe);
   const std::string dir = directoryOf(path);
-  const std::string profile = r["profile"] ? relativeTo(dir, r["profile"].as<std::string>()) : "";
+  // robust/profile: a name as benchmark --profile takes it (config/profiles/NAME.yaml; its gains directory is
+  // what this tuning writes, so it is not read), or a file relative to this file.
+  std::string profile;
+  if (const YAML::Node p = r["profile"]) {
+    const std::string given = p.as<std::string>();
+    ProfileFiles files;
+    try {
+      files = resolveProfile(given, source_dir);
+    } catch (const std::invalid_argument& e) {
+      fail(path, std::string("robust/profile: ") + e.what());
+    }
+    profile = files.file == given ? relativeTo(dir, given) : files.file;  // a path is taken as it is
+  }
   const YAML::Node t = r["training"];
   if (!t || !t.IsSequence() || t.size() == 0)
     fail(path, "robust/training must be a non-empty list of {scenario: FILE, runs: N, base_seed: S}");
@@ -111,7 +123,7 @@ std::string TuneConfig::scenarioText() const {
   return s;
 }
 
-TuneConfig loadTuneConfig(const std::string& path, const std::string& controller) {
+TuneConfig loadTuneConfig(const std::string& path, const std::string& controller, const std::string& source_dir) {
   TuneConfig c;
   {
     std::ifstream f(path, std::ios::binary);
@@ -211,7 +223,7 @@ TuneConfig loadTuneConfig(const std::string& path, const std::string& controller
   const std::string e =
       core::firstError({c.base.validate(), core::validateGainBounds(c.base, c.gains), c.objective.validate()});
   if (!e.empty()) fail(path, e);
-  if (robust) loadRobust(robust, path, c);
+  if (robust) loadRobust(robust, path, source_dir, c);
   for (const auto& b : c.gains) {
     c.pso.lower.push_back(b.lower);
     c.pso.upper.push_back(b.upper);

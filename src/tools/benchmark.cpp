@@ -3,7 +3,8 @@
 // Scenarios are names in the scenario directory (default: the package's config/scenarios; `all` for every
 // file there) or paths to scenario files; controllers are outer+inner pairs (kanayama|pure_pursuit|rpp +
 // atsmc|tsmc|pid). A pair's gains come from TUNED_DIR/OUTER+INNER.yaml when that file exists (default the
-// package's config/tuned), else from the parameter tables' defaults; the report says which.
+// package's config/tuned, or a named profile's gains directory), else from the parameter tables' defaults; the
+// report says which. --profile NAME reads a profile as sim.launch profile:=NAME does (scenario_file::resolveProfile).
 // Writes DIR/runs.csv (one row per run: scenario, controller, seed, the values drawn, every metric, contacts,
 // success and the failure reason), DIR/metrics.json (what each metric column is: core/evaluation/run_metrics.h,
 // read by benchmark_plots), DIR/envelopes.csv (per scenario, controller and time: quantiles of the
@@ -49,7 +50,7 @@ namespace scenario_file = sowing_robot::scenario_file;
 namespace {
 const char* const kUsage =
     "usage: benchmark --seeds N --output DIR [--scenarios A,B] [--controllers X,Y] [--threads K]\n"
-    "                 [--scenario-dir DIR] [--tuned-dir DIR] [--base-seed S] [--profile FILE]\n"
+    "                 [--scenario-dir DIR] [--tuned-dir DIR] [--base-seed S] [--profile NAME|FILE]\n"
     "Monte-Carlo statistics of controller pairs over the scenario suite, in-process (no ROS master).\n"
     "Writes DIR/runs.csv, DIR/metrics.json (its metric columns: name, unit, meaning, aggregation),\n"
     "DIR/envelopes.csv and DIR/report.md (the same whatever --threads).\n\n"
@@ -60,10 +61,12 @@ const char* const kUsage =
     "  --controllers X,Y    outer+inner pairs: kanayama|pure_pursuit|rpp + atsmc|tsmc|pid (default kanayama+atsmc)\n"
     "  --threads K          worker threads, 0 = all cores (default 0)\n"
     "  --scenario-dir DIR   default: the package's config/scenarios\n"
-    "  --tuned-dir DIR      OUTER+INNER.yaml gains when present, else the tables' defaults (default config/tuned)\n"
+    "  --tuned-dir DIR      OUTER+INNER.yaml gains when present, else the tables' defaults (default config/tuned,\n"
+    "                       or the profile's gains directory)\n"
     "  --base-seed S        overrides every scenario's base seed\n"
-    "  --profile FILE       a set-up on top of every scenario file's blocks (config/profiles/field.yaml:\n"
-    "                       the recommended drive train)\n"
+    "  --profile NAME|FILE  a set-up on top of every scenario file's blocks, as sim.launch profile:=NAME: a name\n"
+    "                       in the package's config/profiles (field: the recommended drive train), whose gains\n"
+    "                       config/tuned/NAME/ come with it (unless --tuned-dir), or a profile file's path\n"
     "  -h, --help           this text\n"
     "A bad request (unknown name, --seeds 0, a scenario file with a typo, an unwritable DIR) gives one error\n"
     "line, exit 2, and no report.\n";
@@ -182,6 +185,8 @@ struct Options {
   long long seeds = -1, threads = 0, base_seed = -1;
   std::string output, scenario_dir = SOWING_SOURCE_DIR "/config/scenarios",
                       tuned_dir = SOWING_SOURCE_DIR "/config/tuned", profile;
+  bool tuned_dir_given = false;
+  scenario_file::ProfileFiles profile_files;  // what --profile names (resolveProfile)
 };
 
 /// Reads and checks the options; false (with `exit_code` and the error line printed) on a bad request.
@@ -210,6 +215,7 @@ bool parseOptions(int argc, char** argv, Options& o, int& exit_code) {
       o.scenario_dir = v;
     } else if (a == "--tuned-dir") {
       o.tuned_dir = v;
+      o.tuned_dir_given = true;
     } else if (a == "--profile") {
       o.profile = v;
     } else {  // --seeds, --threads or --base-seed: kOptions has no other
@@ -234,6 +240,16 @@ bool parseOptions(int argc, char** argv, Options& o, int& exit_code) {
     exit_code = fail(error);
     return false;
   }
+  if (!o.profile.empty()) {
+    try {
+      o.profile_files = scenario_file::resolveProfile(o.profile, SOWING_SOURCE_DIR);
+    } catch (const std::exception& e) {
+      exit_code = fail(e.what());
+      return false;
+    }
+    // A named profile brings the gains tuned for it, as sim.launch profile:=NAME; --tuned-dir still wins.
+    if (!o.tuned_dir_given && !o.profile_files.gains_dir.empty()) o.tuned_dir = o.profile_files.gains_dir;
+  }
   if (o.scenario_names.size() == 1 && o.scenario_names[0] == "all")
     o.scenario_names = scenario_file::scenarioNames(o.scenario_dir);
   return true;
@@ -250,7 +266,7 @@ struct Suite {
 Suite loadSuite(const Options& o) {
   Suite suite;
   for (const auto& name : o.scenario_names) {
-    suite.scenarios.push_back(scenario_file::loadScenario(name, o.scenario_dir, o.profile));
+    suite.scenarios.push_back(scenario_file::loadScenario(name, o.scenario_dir, o.profile_files.file));
     if (o.base_seed >= 0) suite.scenarios.back().spec.base_seed = static_cast<std::uint64_t>(o.base_seed);
   }
   for (const auto& c : o.controllers) {
@@ -289,13 +305,31 @@ bool canWriteInto(const std::string& dir) {
   return true;
 }
 
-/// report.md up to its overview: how many runs, where each pair's gains come from (with what a robust
-/// tuning never saw), and what each scenario draws.
-std::string reportHead(const Suite& suite, long long seeds) {
+/// The report's line on --profile ("" without one): its file, and whether the gains are the ones tuned for it.
+std::string profileLine(const Options& o) {
+  if (o.profile.empty()) return "";
+  const scenario_file::ProfileFiles& p = o.profile_files;
+  std::string line = "Profile: `" + o.profile + "`";
+  if (p.file == o.profile)
+    line += " (a file, no gains of its own)";
+  else if (p.gains_dir.empty())
+    line += " (" + p.file + "), no gains of its own (no config/tuned/" + o.profile + "/)";
+  else if (o.tuned_dir_given)
+    line += " (" + p.file + "), its gains (" + p.gains_dir + ") replaced by --tuned-dir";
+  else
+    line += " (" + p.file + "), with its gains (" + p.gains_dir + ")";
+  return line + ".\n\n";
+}
+
+/// report.md up to its overview: the profile, how many runs, where each pair's gains come from (with what a
+/// robust tuning never saw), and what each scenario draws.
+std::string reportHead(const Suite& suite, const Options& o) {
+  const long long seeds = o.seeds;
   std::string report =
       "# Controller benchmark\n\n" + std::to_string(seeds) +
       " seeded runs per scenario and controller, in-process (`benchmark`, core/evaluation/benchmark.h); every "
-      "run can be repeated alone from its row of runs.csv.\n\nGains:\n\n";
+      "run can be repeated alone from its row of runs.csv.\n\n" +
+      profileLine(o) + "Gains:\n\n";
   std::string held_out;  // for gains from a robust tuning: which scenarios and draws it never saw
   for (std::size_t p = 0; p < suite.pairs.size(); ++p) {
     report += "- " + suite.pairs[p].controllerName() + ": " + suite.gains_source[p] + "\n";
@@ -474,7 +508,7 @@ int run(sowing_robot::farm::Farm& farm, int argc, char** argv) {
   out.csv = runsCsvHeader(realism);
   out.envelopes = envelopeCsvHeader();
   out.summary = summaryHeader();
-  std::string report = reportHead(suite, o.seeds);
+  std::string report = reportHead(suite, o);
 
   const long long total = o.seeds * static_cast<long long>(suite.scenarios.size() * suite.pairs.size());
   Progress progress(o.seeds, total);

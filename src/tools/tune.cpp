@@ -42,6 +42,10 @@
 using namespace sowing_robot;
 using core::TuningCost;
 
+#ifndef SOWING_SOURCE_DIR
+#define SOWING_SOURCE_DIR "."
+#endif
+
 namespace {
 
 const char* const kUsage =
@@ -49,7 +53,8 @@ const char* const kUsage =
     "            [--progress FILE.csv] [--threads N] [--stop-after K]\n"
     "       mpirun -np N tune ...   (an MPI evaluation farm: the same gains, bit for bit, for any N)\n"
     "The PSO gain tuner without a ROS master (config/tune.yaml: pso_tuner keys and the base scenario;\n"
-    "config/tuned/field/training.yaml: robust tuning over a training set of benchmark scenarios).\n\n"
+    "config/tuned/field/training.yaml: robust tuning over a training set of benchmark scenarios under a\n"
+    "profile, robust/profile: a name in the package's config/profiles as benchmark --profile, or a file).\n\n"
     "Options:\n"
     "  --config FILE       the tuning set-up (required)\n"
     "  --controller PAIR   the pair tuned (outer+inner), in place of the file's pso_tuner/controller\n"
@@ -379,7 +384,7 @@ int run(farm::Farm& farm, int argc, char** argv) {
   }
   scenario_file::TuneConfig cfg;
   try {
-    cfg = scenario_file::loadTuneConfig(args.config, args.controller);
+    cfg = scenario_file::loadTuneConfig(args.config, args.controller, SOWING_SOURCE_DIR);
   } catch (const std::exception& e) {
     // Every rank reads the same file: rank 0 says what is wrong, the others leave quietly.
     if (farm.root()) std::fprintf(stderr, "tune: %s\n", e.what());

@@ -102,3 +102,37 @@ TEST(BenchmarkCommand, TheFilesDoNotDependOnTheThreadCount) {
   const std::string csv = readFile(dir.path + "/one/runs.csv");
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 11);
 }
+
+// --profile NAME as sim.launch profile:=NAME: the package's config/profiles/NAME.yaml with its gains
+// config/tuned/NAME/, the same runs as the file's path with --tuned-dir; an unknown name is refused with one line
+// that lists the available profiles, exit 2 (as every bad request).
+TEST(BenchmarkCommand, AProfileIsChosenByNameAndBringsItsGains) {
+  TempDir dir;
+  const std::string args = "--scenarios wet_line --controllers rpp+pid --seeds 2 --threads 1 --output ";
+  Outcome o = run(dir, args + dir.path + "/by_name --profile field");
+  ASSERT_EQ(o.status, 0) << o.err;
+  o = run(dir, args + dir.path + "/by_path --profile " + kSource + "/config/profiles/field.yaml --tuned-dir " +
+                   kSource + "/config/tuned/field");
+  ASSERT_EQ(o.status, 0) << o.err;
+  const std::string by_name = readFile(dir.path + "/by_name/runs.csv");
+  EXPECT_FALSE(by_name.empty());
+  EXPECT_EQ(by_name, readFile(dir.path + "/by_path/runs.csv"));
+  // The report says where the gains came from: the profile's own.
+  const std::string report = readFile(dir.path + "/by_name/report.md");
+  EXPECT_NE(report.find("- rpp+pid: " + kSource + "/config/tuned/field/rpp+pid.yaml"), std::string::npos) << report;
+  EXPECT_NE(report.find("Profile: `field`"), std::string::npos) << report;
+  // An explicit --tuned-dir still wins over the profile's gains.
+  o = run(dir, args + dir.path + "/own_gains --profile field --tuned-dir " + dir.path);
+  ASSERT_EQ(o.status, 0) << o.err;
+  EXPECT_NE(readFile(dir.path + "/own_gains/report.md").find("- rpp+pid: the parameter tables' defaults"),
+            std::string::npos);
+
+  const std::string out = dir.path + "/nosuch";
+  o = run(dir, args + out + " --profile nosuch");
+  EXPECT_EQ(o.status, 2);
+  const std::string refusal = "benchmark: unknown profile 'nosuch' (available in " + kSource + "/config/profiles: ";
+  EXPECT_EQ(o.err.rfind(refusal, 0), 0u) << o.err;
+  EXPECT_NE(o.err.find("field", refusal.size()), std::string::npos) << o.err;
+  EXPECT_EQ(o.err.find('\n'), o.err.size() - 1) << "more than one line: " << o.err;
+  EXPECT_FALSE(exists(out + "/runs.csv"));
+}

@@ -229,6 +229,18 @@ TEST(TuneCommand, RobustTuningOnRanksGivesTheThreadedGainsAndRecordsItsTrainingS
   o = shell(dir, mpi(2, "--config " + config + " --controller kanayama+pid --output " + ranks));
   ASSERT_EQ(o.status, 0) << o.err;
   EXPECT_EQ(ref, gains(ranks));
+  // robust/profile by name (the package's config/profiles/field.yaml): the same gains as by the file's path.
+  std::string by_name = readFile(config);
+  by_name.replace(by_name.find("profile: ../../config/profiles/field.yaml"), 41, "profile: field");
+  by_name.replace(by_name.find("scenario: robust_line.yaml"), 26,
+                  "scenario: " + kSource + "/test/farm/robust_line.yaml");
+  std::ofstream(dir / "by_name.yaml") << by_name;
+  const std::string named = dir / "by_name_gains.yaml";
+  o = shell(dir,
+            tune("--config " + (dir / "by_name.yaml") + " --controller kanayama+pid --threads 2 --output " + named));
+  ASSERT_EQ(o.status, 0) << o.err;
+  const std::string from_name = gains(named);  // all but its "# config:" line
+  EXPECT_EQ(ref.substr(ref.find("# scenario:")), from_name.substr(from_name.find("# scenario:")));
   // A robust file that also sets the line scenario's keys is refused with one line.
   std::ofstream(dir / "both.yaml") << readFile(config) << "scenario:\n  start: {x: 0.0}\n";
   o = shell(dir, tune("--config " + (dir / "both.yaml")));

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <regex>
 #include <stdexcept>
@@ -14,6 +15,7 @@
 
 #include "sowing_robot/core/evaluation/bench_row.h"
 #include "sowing_robot/scenario_file/scenario_loader.h"
+#include "sowing_robot/scenario_file/tune_config.h"
 
 using namespace sowing_robot;
 using core::BenchScenario;
@@ -372,8 +374,7 @@ TEST(ScenarioLoader, AProfileGoesOnTopOfTheScenariosBlocks) {
 // The same profile onto an in-process configuration (Python's run_estimated(profile=)): its blocks over what the
 // configuration holds, through the same reading as the benchmark's.
 TEST(ScenarioLoader, AProfileAppliesToAnInProcessConfiguration) {
-  const std::string field = scenario_file::profilePath("field", kSource + "/config/profiles");
-  EXPECT_EQ(field, kSource + "/config/profiles/field.yaml");
+  const std::string field = scenario_file::resolveProfile("field", kSource).file;
   core::LoopConfig cfg;
   core::TractionParams wet;
   wet.mu_peak = 0.25;
@@ -393,7 +394,78 @@ TEST(ScenarioLoader, AProfileAppliesToAnInProcessConfiguration) {
   scenario_file::applyProfileTo(field, bare);
   ASSERT_TRUE(bare.traction);
   EXPECT_EQ(bare.traction->mu_peak, core::TractionParams().mu_peak);
-  EXPECT_THROW(scenario_file::profilePath("feild", kSource + "/config/profiles"), std::invalid_argument);
+}
+
+// A profile is chosen as sim.launch profile:=NAME chooses it: config/profiles/NAME.yaml with its gains
+// config/tuned/NAME/; a path is taken as it is, without gains; a name without a gains directory has none; an
+// unknown name is refused with one line that lists the available ones.
+TEST(ScenarioLoader, AProfileIsChosenByNameOrPath) {
+  const scenario_file::ProfileFiles field = scenario_file::resolveProfile("field", kSource);
+  EXPECT_EQ(field.file, kSource + "/config/profiles/field.yaml");
+  EXPECT_EQ(field.gains_dir, kSource + "/config/tuned/field");
+  const scenario_file::ProfileFiles path =
+      scenario_file::resolveProfile(kSource + "/config/profiles/field.yaml", kSource);
+  EXPECT_EQ(path.file, kSource + "/config/profiles/field.yaml");
+  EXPECT_EQ(path.gains_dir, "");
+  EXPECT_EQ(scenario_file::resolveProfile("mine.yaml", kSource).file, "mine.yaml");  // relative, as given
+  EXPECT_EQ(scenario_file::resolveProfile("mine.yaml", kSource).gains_dir, "");
+
+  TempDir tree;  // a source tree with two profiles, one with tuned gains
+  ASSERT_EQ(
+      std::system(("mkdir -p " + tree.path + "/config/profiles " + tree.path + "/config/tuned/tuned_one").c_str()), 0);
+  tree.write("config/profiles/tuned_one.yaml", "profile: {name: tuned_one}\n");
+  tree.write("config/profiles/bare.yaml", "profile: {name: bare}\n");
+  EXPECT_EQ(scenario_file::resolveProfile("tuned_one", tree.path).gains_dir, tree.path + "/config/tuned/tuned_one");
+  const scenario_file::ProfileFiles bare = scenario_file::resolveProfile("bare", tree.path);
+  EXPECT_EQ(bare.file, tree.path + "/config/profiles/bare.yaml");
+  EXPECT_EQ(bare.gains_dir, "");
+  try {
+    scenario_file::resolveProfile("nosuch", tree.path);
+    ADD_FAILURE() << "an unknown name taken";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "unknown profile 'nosuch' (available in " + tree.path + "/config/profiles: bare, tuned_one)");
+  }
+  EXPECT_THROW(scenario_file::resolveProfile("feild", kSource), std::invalid_argument);
+}
+
+// tune's robust/profile takes a name too (the package's config/profiles), or a file relative to the config.
+TEST(ScenarioLoader, ARobustTuningNamesItsProfile) {
+  TempDir dir;
+  const std::string head = "pso_tuner: {particles: 2, iterations: 0, controller: kanayama+atsmc}\nrobust:\n  profile: ";
+  const std::string training = "\n  training:\n    - {scenario: " + kSuite + "/wet_line.yaml, runs: 1, base_seed: 1}\n";
+  const scenario_file::TuneConfig by_name =
+      scenario_file::loadTuneConfig(dir.write("name.yaml", head + "field" + training), "", kSource);
+  const scenario_file::TuneConfig by_path = scenario_file::loadTuneConfig(
+      dir.write("path.yaml", head + kSource + "/config/profiles/field.yaml" + training), "", kSource);
+  const scenario_file::TuneConfig none = scenario_file::loadTuneConfig(
+      dir.write("none.yaml",
+                "pso_tuner: {particles: 2, iterations: 0, controller: kanayama+atsmc}\nrobust:" + training),
+      "", kSource);
+  for (const scenario_file::TuneConfig* c : {&by_name, &by_path}) {
+    ASSERT_EQ(c->training.size(), 1u);
+    ASSERT_TRUE(c->training[0].bench.realism);
+    EXPECT_TRUE(c->training[0].bench.realism->motor.enabled);
+    EXPECT_TRUE(c->training[0].bench.realism->traction_control.enabled);
+    EXPECT_EQ(c->training[0].bench.realism->feedback, core::Feedback::fused);
+  }
+  EXPECT_FALSE(none.training[0].bench.realism->motor.enabled);
+  // The shipped robust tuning names its profile.
+  const scenario_file::TuneConfig shipped =
+      scenario_file::loadTuneConfig(kSource + "/config/tuned/field/training.yaml", "", kSource);
+  ASSERT_FALSE(shipped.training.empty());
+  ASSERT_TRUE(shipped.training[0].bench.realism);
+  EXPECT_TRUE(shipped.training[0].bench.realism->traction_control.enabled);
+  try {
+    scenario_file::loadTuneConfig(dir.write("typo.yaml", head + "feild" + training), "", kSource);
+    ADD_FAILURE() << "an unknown profile name taken";
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("robust/profile: unknown profile 'feild' (available in " + kSource + "/config/profiles: field"),
+              std::string::npos)
+        << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+  }
 }
 
 // The hitch control's block in a scenario or a profile, through its table; the field profile turns it on.

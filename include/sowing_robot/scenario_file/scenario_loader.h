@@ -34,9 +34,18 @@ core::BenchScenario loadScenarioFile(const std::string& path, const std::string&
 /// Throws std::invalid_argument "FILE: what is wrong".
 void applyProfileTo(const std::string& profile, core::LoopConfig& cfg);
 
-/// A profile's file: `name_or_path` as it is when it is a path (contains '/' or ends with .yaml), else
-/// DIR/NAME.yaml (config/profiles: "field"); an unknown name lists the known ones (std::invalid_argument).
-std::string profilePath(const std::string& name_or_path, const std::string& dir);
+/// A profile's file and the directory of the gains tuned for it.
+struct ProfileFiles {
+  std::string file;       ///< the profile (a rosparam file: loadScenarioFile's, applyProfileTo's `profile`)
+  std::string gains_dir;  ///< its OUTER+INNER.yaml gains (tunedGainsFile's DIR); "" when it has none
+};
+
+/// The one reading of a profile argument (benchmark --profile, tune's robust/profile, run_estimated(profile=)),
+/// as sim.launch profile:=NAME reads it. `name_or_path` is a file path when it contains '/' or ends with .yaml:
+/// taken as it is, no gains directory. Else a name: SOURCE/config/profiles/NAME.yaml, its gains
+/// SOURCE/config/tuned/NAME/ when that directory exists (else "": the gains as without a profile). An unknown
+/// name: std::invalid_argument "unknown profile 'NAME' (available in SOURCE/config/profiles: field)".
+ProfileFiles resolveProfile(const std::string& name_or_path, const std::string& source_dir);
 
 /// `name_or_path`: a file path (contains '/' or ends with .yaml) or a scenario name looked up as
 /// DIR/NAME.yaml; an unknown name lists the known ones.

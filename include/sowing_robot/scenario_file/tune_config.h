@@ -14,7 +14,8 @@
 //     quantile: 0.9                                   # for quantile, in (0, 1]
 //     failure_penalty: 1.0                            # per failed run, and the tracking term's cap [m]
 //     max_slip_share: 1.0                             # a run longer beyond 2x the peak's slip fails (1: off)
-//     profile: ../profiles/field.yaml                 # applied on every training scenario ("" none)
+//     profile: field                                  # applied on every training scenario: a name in
+//                                                     # config/profiles, or a file relative to this file
 //     training:                                       # benchmark scenario files, relative to this file
 //       - {scenario: ../scenarios/training/wet_turns.yaml, runs: 4, base_seed: 1001}
 // With robust:, each evaluation is the mean (or quantile) over the training runs, each scenario with its own
@@ -56,7 +57,9 @@ struct TuneConfig {
 };
 
 /// `controller` (not ""): replaces pso_tuner/controller (tune --controller), before the gains are chosen.
-TuneConfig loadTuneConfig(const std::string& path, const std::string& controller = "");
+/// `source_dir`: the package's source tree, where a profile name in robust/profile is looked up
+/// (resolveProfile).
+TuneConfig loadTuneConfig(const std::string& path, const std::string& controller, const std::string& source_dir);
 
 }  // namespace scenario_file
 }  // namespace sowing_robot
