@@ -5,7 +5,7 @@
 //
 // A new controller: its own files in control/ (the class, its params struct and parameter table), and
 // its registration here: a kind, a params member of ControllerPair, and its row in the table of
-// controller_factory.cpp (name, build, validate). withControllers() hands the in-process loop the
+// controller_factory.cpp (name, build, parameter binding, validate). withControllers() hands the in-process loop the
 // concrete types it knows (direct calls); any other registered controller reaches the loop through the
 // run-time interfaces of controllers.h, so it runs without touching the loop.
 #pragma once
@@ -44,7 +44,8 @@ struct ControllerPair {
   /// "" or the first bad parameter: Kanayama's and the sliding mode's always (the thesis pair's), the
   /// others' when chosen.
   std::string validateControllers() const;
-  /// The chosen inner controller's per-wheel torque limit [N·m] (the standstill hold brakes up to it).
+  /// The chosen inner controller's per-wheel torque limit [N·m] (the standstill hold brakes up to it): the
+  /// PID's, else the sliding mode's, which torque_controller's one max_torque key sets for every controller.
   double innerMaxTorque() const { return inner == InnerKind::pid ? pid.max_torque : sliding.max_torque; }
 };
 
