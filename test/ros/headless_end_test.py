@@ -51,7 +51,7 @@ class HeadlessEnd(unittest.TestCase):
         self.assertLess(seconds, BOUND)
         last = last_line(out)
         self.assertIn("[FATAL]", last)
-        self.assertIn("/torque_controller: refusing to start: /torque_controller/mode = 'foo'", last)
+        self.assertIn("/torque_controller: refusing to start: /torque_controller/inner = 'foo'", last)
 
     def test_refusal_ends_the_run_at_once(self):
         self.check_refusal(11673)
@@ -81,7 +81,7 @@ class HeadlessEnd(unittest.TestCase):
         cmd = ["roslaunch", "-p", "11676", "sowing_robot", "sim.launch", "headless:=true", "controller:=foo"]
         code, out, seconds = node_process.run_on_master(11676, cmd, timeout=BOUND)
         self.assertLess(seconds, BOUND, out[-3000:])
-        self.assertIn("/torque_controller: refusing to start: /torque_controller/mode = 'foo'", out)
+        self.assertIn("/torque_controller: refusing to start: /torque_controller/inner = 'foo'", out)
         self.assertIn("REQUIRED process [torque_controller", out)  # as well as plain roslaunch can say it
 
 
