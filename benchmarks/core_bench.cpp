@@ -44,9 +44,10 @@ namespace {
 
 volatile double g_sink = 0.0;  // keeps results alive (see BM_ThesisRun25s)
 
-void BM_PlantRk4Step(benchmark::State& state) {
-  const Scenario sc = bench::thesisScenario();
-  Plant plant(sc.robot, sc.disturbance);
+// One plant step per iteration: small alternating torques that keep the state bounded over any number of
+// steps, the plant reset every 25,000 steps.
+template <typename PlantT>
+void stepLoop(benchmark::State& state, PlantT& plant) {
   State x0 = State::Zero();
   x0[X] = -1.0;
   x0[V] = 1.0;
@@ -54,7 +55,6 @@ void BM_PlantRk4Step(benchmark::State& state) {
   const double dt = 1e-3;
   std::int64_t k = 0;
   for (auto _ : state) {
-    // Small torques that keep the state bounded over any number of steps.
     plant.step(0.5 * ((k & 1) ? 1.0 : -1.0), 0.3, dt);
     if (++k == 25000) {
       plant.reset(x0, 0.0);
@@ -65,6 +65,12 @@ void BM_PlantRk4Step(benchmark::State& state) {
   }
   state.SetItemsProcessed(state.iterations());
 }
+
+void BM_PlantRk4Step(benchmark::State& state) {
+  const Scenario sc = bench::thesisScenario();
+  Plant plant(sc.robot, sc.disturbance);
+  stepLoop(state, plant);
+}
 BENCHMARK(BM_PlantRk4Step);
 
 // The traction plant's step beside BM_PlantRk4Step (the figure test_traction's CostBesidePlant printed):
@@ -72,22 +78,7 @@ BENCHMARK(BM_PlantRk4Step);
 void BM_TractionStep(benchmark::State& state) {
   const Scenario sc = bench::thesisScenario();
   TractionPlant plant(sc.robot, sc.disturbance, TractionParams{});
-  State x0 = State::Zero();
-  x0[X] = -1.0;
-  x0[V] = 1.0;
-  plant.reset(x0, 0.0);
-  const double dt = 1e-3;
-  std::int64_t k = 0;
-  for (auto _ : state) {
-    plant.step(0.5 * ((k & 1) ? 1.0 : -1.0), 0.3, dt);
-    if (++k == 25000) {
-      plant.reset(x0, 0.0);
-      k = 0;
-    }
-    benchmark::DoNotOptimize(plant.state().data());
-    benchmark::ClobberMemory();
-  }
-  state.SetItemsProcessed(state.iterations());
+  stepLoop(state, plant);
 }
 BENCHMARK(BM_TractionStep);
 
