@@ -31,13 +31,24 @@ const ParamTable<SeedingParams>& seedingTable() {
              "(the reference rejoins the row about 3 m after leaving the influence zone at 1 m/s)"),
       number("engage_distance", &P::engage_distance, 0.01, Limits::positive(), "m",
              "the tool is lowered once the tool point is this close to a row"),
+      number("depth_min", &P::depth_min, 0.03, Limits::positive(), "m",
+             "shallowest depth of the agronomic band (maize, sunflower: 3-5 cm; seeds above it are counted)"),
+      number("depth_max", &P::depth_max, 0.05, Limits::positive(), "m",
+             "deepest depth of the agronomic band (seeds below it are counted)"),
   });
   return table;
 }
 
 SeedingParams::SeedingParams() { seedingTable().applyDefaults(*this); }
 
-std::string SeedingParams::validate() const { return seedingTable().checkRanges(*this); }
+std::string SeedingParams::validate() const {
+  const std::string e = seedingTable().checkRanges(*this);
+  if (!e.empty()) return e;
+  if (!(depth_min < depth_max))
+    return "depth_min (" + std::to_string(depth_min) + " m) must be below depth_max (" + std::to_string(depth_max) +
+           " m): the agronomic depth band is empty";
+  return "";
+}
 
 SeedDrill::SeedDrill(const SeedingParams& params, std::vector<RowSegment> rows, std::vector<Obstacle> obstacles,
                      double influence)
@@ -70,8 +81,22 @@ bool SeedDrill::onRowSegment(const Eigen::Vector2d& p) const {
 
 bool SeedDrill::inDetour(const Eigen::Vector2d& p) const {
   for (const Obstacle& o : obstacles_)
-    if (std::hypot(p.x() - o.x, p.y() - o.y) < o.radius + influence_ + params_.detour_margin) return true;
+    if (std::hypot(p.x() - o.x, p.y() - o.y) < detourRadius(o)) return true;
   return false;
+}
+
+int SeedDrill::nearestRow(const Eigen::Vector2d& p) const {
+  int best = -1;
+  double best_d = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < rows_.size(); ++i) {
+    const RowSegment& r = rows_[i];
+    const double d = (p - (r.a + segmentParameter(p, r.a, r.b) * (r.b - r.a))).norm();
+    if (d < best_d) {
+      best_d = d;
+      best = static_cast<int>(i);
+    }
+  }
+  return best;
 }
 
 void SeedDrill::score(SeedStats& s, double& sum_sq, std::size_t& over, double e) {
@@ -81,6 +106,19 @@ void SeedDrill::score(SeedStats& s, double& sum_sq, std::size_t& over, double e)
   if (e > params_.tolerance) ++over;
   s.rms = std::sqrt(sum_sq / s.count);
   s.fraction_over = static_cast<double>(over) / s.count;
+}
+
+bool SeedDrill::drop(double t, const Eigen::Vector2d& truth, const Eigen::Vector2d& believed, bool tool_down,
+                     double depth, Seed& seed) {
+  Eigen::Vector2d p;
+  if (!update(truth, tool_down, p)) return false;
+  seed.t = t;
+  seed.truth = p;
+  seed.believed = believed;
+  seed.row = nearestRow(p);
+  seed.depth = depth;
+  seed.detour = inDetour(p);
+  return true;
 }
 
 bool SeedDrill::update(const Eigen::Vector2d& p, bool tool_down, Eigen::Vector2d& seed) {

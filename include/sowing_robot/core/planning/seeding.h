@@ -32,10 +32,24 @@ struct SeedingParams {
   /// reference says tool down, as an operator would: the approach from a start off the row and the
   /// end of a headland turn sow nothing [m] (> 0).
   double engage_distance;
+  /// The agronomic depth band the seed is to be placed in [m] (0 < depth_min < depth_max): seeds outside it
+  /// count against the run (seedFigures), and a depth control keeps the drill inside it.
+  double depth_min, depth_max;
   std::string validate() const;
 };
-/// spacing, tolerance, detour_margin, engage_distance (seed_drill's keys).
+/// spacing, tolerance, detour_margin, engage_distance, depth_min, depth_max (seed_drill's keys).
 const ParamTable<SeedingParams>& seedingTable();
+
+/// One seed as it fell: the record of a run (runs.csv's seed figures, the node pipeline's `seeds` topic, the
+/// CSV and GeoJSON seed maps are made from these).
+struct Seed {
+  double t = 0.0;                                      ///< when it fell [s]
+  Eigen::Vector2d truth = Eigen::Vector2d::Zero();     ///< where it fell, odom frame [m]
+  Eigen::Vector2d believed = Eigen::Vector2d::Zero();  ///< where the robot believed its tool was (fed pose) [m]
+  int row = -1;                                        ///< the plan's row it lies nearest (-1: no rows)
+  double depth = 0.0;                                  ///< depth it was placed at [m]
+  bool detour = false;                                 ///< in an obstacle's detour zone (SeedDrill::inDetour)
+};
 
 /// Cross-track figures of a set of seeds [m].
 struct SeedStats {
@@ -54,6 +68,11 @@ class SeedDrill {
   /// position) when a seed falls here. A non-finite p is refused (false, state untouched, counted by
   /// rejected()), so it can neither drop a seed nor spoil the distance travelled.
   bool update(const Eigen::Vector2d& p, bool tool_down, Eigen::Vector2d& seed);
+  /// The same rule for a seed record: `truth` is the tool point where it really is (it decides the drop, as
+  /// update()), `believed` the tool point on the pose the controllers were fed, `depth` the drill's depth
+  /// [m]. Returns true and fills `seed` (its row and detour flag from the plan) when a seed falls.
+  bool drop(double t, const Eigen::Vector2d& truth, const Eigen::Vector2d& believed, bool tool_down, double depth,
+            Seed& seed);
   /// A new plan (the obstacles changed at run time): seeds from now on are scored against it; the
   /// seeds already scored, the distance travelled and the tool's state are kept.
   void setPlan(std::vector<RowSegment> rows, std::vector<Obstacle> obstacles, double influence);
@@ -65,6 +84,14 @@ class SeedDrill {
   bool onRowSegment(const Eigen::Vector2d& p) const;
   /// True when p lies in an obstacle's detour zone.
   bool inDetour(const Eigen::Vector2d& p) const;
+  /// Index of the row nearest p (-1 without rows).
+  int nearestRow(const Eigen::Vector2d& p) const;
+  /// Radius of an obstacle's detour zone: radius + influence + detour_margin [m].
+  double detourRadius(const Obstacle& o) const { return o.radius + influence_ + params_.detour_margin; }
+
+  const std::vector<RowSegment>& rows() const { return rows_; }
+  const std::vector<Obstacle>& obstacles() const { return obstacles_; }
+  const SeedingParams& params() const { return params_; }
 
   const SeedStats& onRows() const { return rows_stats_; }     ///< seeds away from obstacles
   const SeedStats& detours() const { return detour_stats_; }  ///< seeds in detour zones
