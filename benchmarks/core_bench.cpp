@@ -36,6 +36,7 @@
 #include "sowing_robot/core/model/plant.h"
 #include "sowing_robot/core/model/traction.h"
 #include "sowing_robot/core/simulation/runner.h"
+#include "sowing_robot/core/simulation/seed_recorder.h"
 
 using namespace sowing_robot;
 using namespace sowing_robot::core;
@@ -212,6 +213,28 @@ void BM_FieldProfileRun25s(benchmark::State& state) {
   });
 }
 BENCHMARK(BM_FieldProfileRun25s)->ArgName("feedback")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+// The seed record's cost (its target: at most 15 % more per run): the field profile's run on the line without a
+// trace (record 0) against the same run with the benchmark's SeedRecorder in the trace (record 1).
+void BM_FieldProfileSeedRecord(benchmark::State& state) {
+  guarded(state, [&] {
+    const Scenario sc = bench::fieldProfileScenario();
+    LineReference ref = bench::thesisLine();
+    const LoopConfig cfg = bench::fieldProfileConfig();
+    const SeedDrill row(cfg.seeding, {RowSegment{Eigen::Vector2d(0.0, 3.0), Eigen::Vector2d(sc.duration, 3.0)}}, {},
+                        0.0);
+    double seeds = 0.0;
+    wholeRuns(state, sc, "itae_y", [&] {
+      if (state.range(0) == 0) return runClosedLoop(sc, cfg, ref, false).run.metrics[AXIS_Y].itae;
+      SeedRecorder record(row, cfg.tool);
+      const LoopResult r = runClosedLoop(sc, cfg, ref, false, [&record](const EstimatedSample& s) { record.add(s); });
+      seeds = static_cast<double>(record.seeds().size());
+      return r.run.metrics[AXIS_Y].itae;
+    });
+    state.counters["seeds"] = seeds;
+  });
+}
+BENCHMARK(BM_FieldProfileSeedRecord)->ArgName("record")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 void BM_WetLineFieldProfileRow(benchmark::State& state) {
   guarded(state, [&] {

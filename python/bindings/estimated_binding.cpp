@@ -9,7 +9,11 @@
 #include <vector>
 
 #include "core_bindings.h"
+#include "sowing_robot/core/evaluation/bench_row.h"
+#include "sowing_robot/core/evaluation/run_metrics.h"
+#include "sowing_robot/core/evaluation/seed_metrics.h"
 #include "sowing_robot/core/simulation/runner.h"
+#include "sowing_robot/core/simulation/seed_recorder.h"
 #include "sowing_robot/scenario_file/scenario_loader.h"
 
 namespace py_core {
@@ -109,6 +113,43 @@ py::dict fixCounts(const FixCounts& c, long lost_from_queue) {
   return d;
 }
 
+/// The seed record as columns (lists): t, x, y (where each seed fell), believed_x, believed_y, row, depth, detour.
+py::dict seedsDict(const std::vector<Seed>& seeds) {
+  std::vector<double> t, x, y, bx, by, depth;
+  std::vector<int> row;
+  std::vector<bool> detour;
+  for (const Seed& s : seeds) {
+    t.push_back(s.t);
+    x.push_back(s.truth.x());
+    y.push_back(s.truth.y());
+    bx.push_back(s.believed.x());
+    by.push_back(s.believed.y());
+    row.push_back(s.row);
+    depth.push_back(s.depth);
+    detour.push_back(s.detour);
+  }
+  py::dict d;
+  d["t"] = t;
+  d["x"] = x;
+  d["y"] = y;
+  d["believed_x"] = bx;
+  d["believed_y"] = by;
+  d["row"] = row;
+  d["depth"] = depth;
+  d["detour"] = detour;
+  return d;
+}
+
+/// The seed figures under the metric registry's names (run_metrics.h: its seed_figure entries), as runs.csv has them.
+py::dict seedFiguresDict(const SeedFigures& f) {
+  RunRow row;
+  storeSeedFigures(row, f);
+  py::dict d;
+  for (const RunMetric& m : runMetrics())
+    if (m.seed_figure) d[m.name.c_str()] = m.get(row);
+  return d;
+}
+
 py::dict runEstimatedPy(const std::string& controller, const py::object& params, const py::object& gains,
                         const std::string& feedback, const py::object& traction, const py::object& patches,
                         const py::object& sensors, const py::object& estimator, const py::object& motor,
@@ -163,17 +204,22 @@ py::dict runEstimatedPy(const std::string& controller, const py::object& params,
   if (!e.empty()) throw py::value_error(e);
 
   LineReference reference = lineOf(line);
+  // The line is the row the seed record is sown on, from the target's start to where it is at the end.
+  LineReference probe = reference;
+  const Pose2D from = probe.next(0.0).pose, to = probe.next(sc.duration).pose;
+  SeedRecorder seeds(
+      SeedDrill(cfg.seeding, {RowSegment{Eigen::Vector2d(from.x, from.y), Eigen::Vector2d(to.x, to.y)}}, {}, 0.0),
+      cfg.tool);
   EstimatedTrace columns;
   LoopResult r;
   {
     py::gil_scoped_release no_gil;  // pure C++ from here; the trace is collected in C++ vectors
     try {
-      if (trace) {
-        columns.reserve(static_cast<std::size_t>(sc.steps() + 1));
-        r = runClosedLoop(sc, cfg, reference, keep_samples, [&columns](const EstimatedSample& s) { columns.add(s); });
-      } else {
-        r = runClosedLoop(sc, cfg, reference, keep_samples);
-      }
+      if (trace) columns.reserve(static_cast<std::size_t>(sc.steps() + 1));
+      r = runClosedLoop(sc, cfg, reference, keep_samples, [&columns, &seeds, trace](const EstimatedSample& s) {
+        seeds.add(s);
+        if (trace) columns.add(s);
+      });
     } catch (const std::invalid_argument& ex) {
       py::gil_scoped_acquire gil;
       throw py::value_error(ex.what());
@@ -201,6 +247,8 @@ py::dict runEstimatedPy(const std::string& controller, const py::object& params,
   d["traction_control_time"] = r.traction_control_time;
   d["governor_min_rate"] = r.governor_min_rate;
   if (trace) d["trace"] = columns.toDict();
+  d["seeds"] = seedsDict(seeds.seeds());
+  d["seed_figures"] = seedFiguresDict(seedFigures(seeds.seeds(), seeds.drill()));
   return d;
 }
 

@@ -112,17 +112,17 @@ void SeedDrillNode::torqueCallback(const WheelTorque::ConstPtr& msg) {
 }
 
 void SeedDrillNode::updateHitchPair() {
-  update(hitch_inputs_.first().odom, hitch_inputs_.first().tool_down && !hitch_inputs_.second().tool_raised);
+  update(hitch_inputs_.first().odom, hitch_inputs_.first().tool_down, hitch_inputs_.second().tool_raised);
 }
 
-void SeedDrillNode::update(const nav_msgs::Odometry& odom, bool tool_down) {
+void SeedDrillNode::update(const nav_msgs::Odometry& odom, bool tool_down, bool held_up) {
   const core::Pose2D pose = poseOf(odom);
   double s, c;
   s = std::sin(pose.theta);
   c = std::cos(pose.theta);
   const Eigen::Vector2d tool(pose.x + c * tool_x_ - s * tool_y_, pose.y + s * tool_x_ + c * tool_y_);
   Eigen::Vector2d seed;
-  if (drill_->update(tool, tool_down, seed)) addSeed(seed, odom.header.stamp);
+  if (drill_->update(tool, tool_down, seed, held_up)) addSeed(seed, odom.header.stamp);
   if (!final_sent_ && end_ns_ >= 0 && static_cast<std::int64_t>(odom.header.stamp.toNSec()) >= end_ns_) {
     final_sent_ = true;
     publishReport(odom.header.stamp);

@@ -362,10 +362,32 @@ core::BenchScenario loadScenarioFileImpl(const std::string& path, const std::str
   s.start_dtheta = toUniform(required(draws, "start_dtheta", path, "draws/"), path, "draws/start_dtheta");
 
   const YAML::Node success = required(root, "success", path, "");
-  onlyKeys(success, {"settle_time", "cross_track_threshold"}, path, "success/");
+  onlyKeys(success,
+           {"settle_time", "cross_track_threshold", "rule", "min_sown_share", "min_quality_of_feed",
+            "max_seed_lateral_p95", "max_map_error_rms", "max_high_slip_share"},
+           path, "success/");
   s.settle_time = toDouble(required(success, "settle_time", path, "success/"), path, "success/settle_time");
   s.cross_track_threshold =
       toDouble(required(success, "cross_track_threshold", path, "success/"), path, "success/cross_track_threshold");
+  // A track with rows is judged by its seeds unless the file says otherwise; the sine track has no rows.
+  s.rule = b.track == core::TrackKind::sine ? core::SuccessRule::tracking : core::SuccessRule::sown;
+  if (success["rule"]) {
+    const std::string rule = success["rule"].as<std::string>("");
+    if (rule == "tracking")
+      s.rule = core::SuccessRule::tracking;
+    else if (rule == "sown" && b.track != core::TrackKind::sine)
+      s.rule = core::SuccessRule::sown;
+    else
+      fail(path, "success/rule must be tracking or sown (sown needs rows: a line or field track), not '" + rule + "'");
+  }
+  const auto optional = [&](const char* key, double& value) {
+    if (success[key]) value = toDouble(success[key], path, std::string("success/") + key);
+  };
+  optional("min_sown_share", s.min_sown_share);
+  optional("min_quality_of_feed", s.min_quality_of_feed);
+  optional("max_seed_lateral_p95", s.max_seed_lateral_p95);
+  optional("max_map_error_rms", s.max_map_error_rms);
+  optional("max_high_slip_share", s.max_high_slip_share);
   if (root["envelope_period"]) b.envelope_period = toDouble(root["envelope_period"], path, "envelope_period");
 
   // The loop's realism (BenchScenario::realism): the plant (traction:), the sensors (sensors:), the estimator

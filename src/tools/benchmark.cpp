@@ -122,8 +122,7 @@ std::string describe(const BenchScenario& b) {
          uniform(s.inertia_scale) + ", disturbance A " + uniform(s.amplitude) + " N·m at w " +
          num(b.base.disturbance.frequency) + " rad/s, phase " + uniform(s.phase) + " rad, wheel noise std " +
          num(s.noise_std) + " N·m (seed drawn), start + (" + uniform(s.start_dx) + ", " + uniform(s.start_dy) + ", " +
-         uniform(s.start_dtheta) + "); success: finished, no contact, |cross-track| < " + num(s.cross_track_threshold) +
-         " m from " + num(s.settle_time) + " s on";
+         uniform(s.start_dtheta) + "); success: " + describeSuccessRule(s);
   if (b.track == TrackKind::field) out += ", axle within " + num(b.finish_tolerance) + " m of the path's end";
   return out + ".\n";
 }

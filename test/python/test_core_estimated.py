@@ -121,3 +121,19 @@ def test_a_wet_patch_slips_more_and_the_odometry_drifts_more():
 def test_bad_blocks_raise_naming_the_key(kwargs, message):
     with pytest.raises(ValueError, match=message.replace("[", r"\[").replace("]", r"\]")):
         core.run_estimated(duration=1.0, **kwargs)
+
+
+def test_the_seed_record_comes_with_its_figures_under_the_registry_names():
+    r = core.run_estimated(feedback="fused", duration=10.0)
+    seeds, figures = r["seeds"], r["seed_figures"]
+    names = {m["name"] for m in core.run_metrics()}
+    assert set(figures) <= names and "sown_share" in figures and "quality_of_feed" in figures
+    n = len(seeds["t"])
+    assert n == figures["seeds"] > 0
+    assert all(len(seeds[k]) == n for k in ("x", "y", "believed_x", "believed_y", "row", "depth", "detour"))
+    # Fed the EKF's estimate, the robot believed its seeds a little off where they fell; fed the truth, exactly there.
+    assert 0.0 < figures["map_error_rms"] < 0.1
+    truth = core.run_estimated(feedback="ground_truth", duration=10.0)
+    assert truth["seed_figures"]["map_error_rms"] < 1e-12
+    # One seed per spacing (0.1 m) of the tool point's travel along the line while it is on it.
+    assert np.all(np.diff(seeds["t"]) > 0.0)

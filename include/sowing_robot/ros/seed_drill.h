@@ -47,7 +47,7 @@ class SeedDrillNode {
   void planCallback(const FieldPlan::ConstPtr& msg);
   /// The state and the reference for the same time: move the tool, maybe drop a seed; the final report
   /// after the run's final state.
-  void update(const nav_msgs::Odometry& odom, bool tool_down);
+  void update(const nav_msgs::Odometry& odom, bool tool_down, bool held_up = false);
   /// A seed dropped by the state stamped `stamp`: shown, and every 50th reported.
   void addSeed(const Eigen::Vector2d& seed, const ros::Time& stamp);
   void publishReport(const ros::Time& stamp);

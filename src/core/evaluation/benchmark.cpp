@@ -151,13 +151,35 @@ std::string shortNumber(double v) {
   return buf;
 }
 
+const char* successRuleName(SuccessRule r) { return r == SuccessRule::tracking ? "tracking" : "sown"; }
+
+std::string describeSuccessRule(const MonteCarloSpec& s) {
+  if (s.rule == SuccessRule::tracking)
+    return "finished, no contact, |cross-track| < " + shortNumber(s.cross_track_threshold) + " m from " +
+           shortNumber(s.settle_time) + " s on (rule tracking)";
+  return "finished, no contact, every row sown >= " + shortNumber(100.0 * s.min_sown_share) +
+         " % outside obstacle stretches, quality of feed >= " + shortNumber(s.min_quality_of_feed) +
+         " %, seeds' lateral offset p95 <= " + shortNumber(s.max_seed_lateral_p95) +
+         " m, seed-map error RMS <= " + shortNumber(s.max_map_error_rms) +
+         " m, with traction the high-slip share <= " + shortNumber(s.max_high_slip_share) +
+         " (rule sown: the seed record)";
+}
+
 std::string MonteCarloSpec::validate() const {
   std::string e = firstError(
       {checkUniform("mass_scale", mass_scale), checkUniform("inertia_scale", inertia_scale),
        checkUniform("amplitude", amplitude), checkUniform("phase", phase), checkUniform("start_dx", start_dx),
        checkUniform("start_dy", start_dy), checkUniform("start_dtheta", start_dtheta),
        checkNonNegative("noise_std", noise_std, "N·m"), checkNonNegative("settle_time", settle_time, "s"),
-       checkPositive("cross_track_threshold", cross_track_threshold, "m")});
+       checkPositive("cross_track_threshold", cross_track_threshold, "m"),
+       checkPositive("max_seed_lateral_p95", max_seed_lateral_p95, "m"),
+       checkPositive("max_map_error_rms", max_map_error_rms, "m")});
+  if (e.empty() && !(min_sown_share >= 0.0 && min_sown_share <= 1.0))
+    e = "min_sown_share must be in [0, 1] (a share of each row), not " + shortNumber(min_sown_share);
+  if (e.empty() && !(min_quality_of_feed >= 0.0 && min_quality_of_feed <= 100.0))
+    e = "min_quality_of_feed must be in [0, 100] %, not " + shortNumber(min_quality_of_feed);
+  if (e.empty() && !(max_high_slip_share >= 0.0 && max_high_slip_share <= 1.0))
+    e = "max_high_slip_share must be in [0, 1] (a share of the run), not " + shortNumber(max_high_slip_share);
   if (e.empty() && !(mass_scale.lo > 0.0 && inertia_scale.lo > 0.0)) e = "mass_scale and inertia_scale must be > 0";
   if (e.empty() && amplitude.lo < 0.0) e = "amplitude must be >= 0";
   return e;
@@ -256,9 +278,13 @@ std::function<RunRow(std::int64_t)> benchmarkWorker(const BenchScenario& scenari
     else
       proto = std::make_unique<SineReference>(bench->sine);
     std::shared_ptr<ReferenceSource> ref = proto->clone();
-    return [bench, extras, ref](std::int64_t i) {
+    std::shared_ptr<const SeedDrill> plan;  // a line is a row to sow; the sine track has none
+    if (bench->track == TrackKind::line) plan = std::make_shared<const SeedDrill>(lineSeedPlan(*bench));
+    return [bench, extras, ref, plan](std::int64_t i) {
       const RunDraw draw = drawRun(bench->spec, bench->base, i);
-      return measure(applyDraw(bench->base, bench->spec, draw), *ref, bench->spec, draw, extras);
+      RunExtras e = extras;
+      e.seed_plan = plan.get();
+      return measure(applyDraw(bench->base, bench->spec, draw), *ref, bench->spec, draw, e);
     };
   }
   // Field: the path starts at the drawn start (the approach), so each run builds its own reference, and its

@@ -27,12 +27,11 @@ RunRow measureEstimated(const Scenario& sc, const LoopConfig& cfg, ReferenceSour
   RunRow row;
   row.draw = draw;
   RowMeter meter(row, sc, spec, extras);
-  const LoopResult er =
-      runClosedLoop(sc, cfg, reference, true, [&](const EstimatedSample& es) { meter.add(*es.loop); });
+  const LoopResult er = runClosedLoop(sc, cfg, reference, true, [&](const EstimatedSample& es) { meter.add(es); });
   meter.finish(er.run);
-  // No traction is why the run ended early: it comes before a cross-track failure (and the finish check,
+  // No traction is why the run ended early: it comes before a performance verdict (and the finish check,
   // which leaves it be), after a divergence or a contact.
-  if (er.no_traction.detected && (row.failure.empty() || row.failure == "cross-track")) {
+  if (er.no_traction.detected && (row.failure.empty() || performanceFailure(row.failure))) {
     row.failure = er.no_traction.text();
     row.success = false;
   }
@@ -49,6 +48,12 @@ RunRow measureEstimated(const Scenario& sc, const LoopConfig& cfg, ReferenceSour
   row.fixes_refused = er.fixes.refused();
   row.unsown_distance = er.unsown_distance;
   row.seeds_unsown = er.unsown_distance / cfg.seeding.spacing;
+  // The sown rule's slip bound, once the rest of the run has passed (the traction plant only: NaN otherwise).
+  if (row.failure.empty() && spec.rule == SuccessRule::sown && extras.seed_plan != nullptr &&
+      row.high_slip_share > spec.max_high_slip_share) {
+    row.failure = "slip";
+    row.success = false;
+  }
   return row;
 }
 
@@ -81,6 +86,9 @@ RunRow estimatedBenchRow(const BenchScenario& bench, std::int64_t index) {
     cfg.tool_rows = {RowSegment{Eigen::Vector2d(bench.line_x0, bench.line_y),
                                 Eigen::Vector2d(bench.line_x0 + bench.line_v_r * sc.duration, bench.line_y)}};
     LineReference reference(bench.line_v_r, bench.line_y, bench.line_x0);
+    const SeedDrill plan = lineSeedPlan(bench);
+    extras.seed_plan = &plan;
+    extras.tool = cfg.tool;
     return measureEstimated(sc, cfg, reference, spec, draw, extras);
   }
   if (bench.track == TrackKind::sine) {

@@ -109,9 +109,9 @@ void SeedDrill::score(SeedStats& s, double& sum_sq, std::size_t& over, double e)
 }
 
 bool SeedDrill::drop(double t, const Eigen::Vector2d& truth, const Eigen::Vector2d& believed, bool tool_down,
-                     double depth, Seed& seed) {
+                     bool held_up, double depth, Seed& seed) {
   Eigen::Vector2d p;
-  if (!update(truth, tool_down, p)) return false;
+  if (!update(truth, tool_down, p, held_up)) return false;
   seed.t = t;
   seed.truth = p;
   seed.believed = believed;
@@ -121,7 +121,18 @@ bool SeedDrill::drop(double t, const Eigen::Vector2d& truth, const Eigen::Vector
   return true;
 }
 
-bool SeedDrill::update(const Eigen::Vector2d& p, bool tool_down, Eigen::Vector2d& seed) {
+bool SeedDrill::withinRowSpan(const Eigen::Vector2d& p) const {
+  for (const RowSegment& r : rows_) {
+    const Eigen::Vector2d ab = r.b - r.a;
+    const double len2 = ab.squaredNorm();
+    if (!(len2 > 0.0)) continue;
+    const double u = (p - r.a).dot(ab) / len2;
+    if (u > 0.0 && u < 1.0) return true;
+  }
+  return false;
+}
+
+bool SeedDrill::update(const Eigen::Vector2d& p, bool tool_down, Eigen::Vector2d& seed, bool held_up) {
   if (!p.allFinite()) {
     ++rejected_;
     return false;
@@ -130,8 +141,10 @@ bool SeedDrill::update(const Eigen::Vector2d& p, bool tool_down, Eigen::Vector2d
   const Eigen::Vector2d last = last_;
   has_last_ = true;
   last_ = p;
-  if (!tool_down) lowered_ = false;
-  if (tool_down && !lowered_ && onRowSegment(p)) {
+  // After the plan's request has ended the drill stays down only while the tool point is still on the row's
+  // stretch and on its line (within tolerance): a path that rounds its corner before the row's end leaves it there.
+  if (held_up || (!tool_down && !(withinRowSpan(p) && crossTrack(p) <= params_.tolerance))) lowered_ = false;
+  if (tool_down && !held_up && !lowered_ && onRowSegment(p)) {
     lowered_ = true;
     travelled_ = 0.0;
   }

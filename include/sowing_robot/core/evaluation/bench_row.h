@@ -8,14 +8,17 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <string>
 
 #include "sowing_robot/core/evaluation/benchmark.h"
+#include "sowing_robot/core/evaluation/seed_metrics.h"
 #include "sowing_robot/core/model/contact.h"
 #include "sowing_robot/core/planning/field.h"
 #include "sowing_robot/core/planning/field_path_follower.h"
 #include "sowing_robot/core/simulation/field_run.h"
 #include "sowing_robot/core/simulation/runner.h"
+#include "sowing_robot/core/simulation/seed_recorder.h"
 
 namespace sowing_robot {
 namespace core {
@@ -36,7 +39,46 @@ struct RunExtras {
   ContactMonitor* contacts = nullptr;  ///< field tracks: the body against the obstacles
   std::int64_t series_every = 0;       ///< sample the cross-track every this many periods (0: none)
   Pose2D* last_reference = nullptr;    ///< gets the last reference pose (the finish check)
+  /// Tracks with rows: the plan the run's seed record is sown against (a fresh drill) and the seed-drop point in
+  /// base_link; null: no seed record (its figures NaN).
+  const SeedDrill* seed_plan = nullptr;
+  Eigen::Vector2d tool{-0.45, 0.0};
+  bool keep_seeds = false;  ///< the seeds themselves into RunRow::seed_record
 };
+
+/// A failure that a run's own end explains better: a performance verdict (cross-track under the tracking rule, the
+/// seed record's under the sown rule) yields to "not finished" and "no traction".
+inline bool performanceFailure(const std::string& failure) {
+  return failure == "cross-track" || failure == "row unsown" || failure == "seed spacing" || failure == "off the row" ||
+         failure == "seed map" || failure == "slip";
+}
+
+/// The seed figures into the row.
+inline void storeSeedFigures(RunRow& row, const SeedFigures& f) {
+  row.seeds = static_cast<long>(f.seeds);
+  row.sown_share = f.sown_share;
+  row.worst_row_share = f.worst_row_share;
+  row.detour_sown_share = f.detour_sown_share;
+  row.multiples_index = f.multiples;
+  row.miss_index = f.misses;
+  row.quality_of_feed = f.quality_of_feed;
+  row.precision = f.precision;
+  row.seed_lateral_rms = f.lateral_rms;
+  row.seed_lateral_p95 = f.lateral_p95;
+  row.seed_lateral_max = f.lateral_max;
+  row.depth_outside_share = f.depth_outside;
+  row.map_error_rms = f.map_error_rms;
+  row.map_error_p95 = f.map_error_p95;
+}
+
+/// The sown rule's verdict on the seed figures ("" when they pass; the slip is judged where it is known).
+inline std::string seedFailure(const RunRow& row, const MonteCarloSpec& spec) {
+  if (!(row.worst_row_share >= spec.min_sown_share)) return "row unsown";
+  if (!(row.quality_of_feed >= spec.min_quality_of_feed)) return "seed spacing";
+  if (!(row.seed_lateral_p95 <= spec.max_seed_lateral_p95)) return "off the row";
+  if (!(row.map_error_rms <= spec.max_map_error_rms)) return "seed map";
+  return "";
+}
 
 /// A row's figures, fed every period's sample (add(), inline: it runs in the loop's callback), then
 /// written into the row with the failure reason (finish()). The effort, chattering and cross-track are a
@@ -52,11 +94,14 @@ class RowMeter {
     tally_.series = &row.cross_track_series;
     if (extras.series_every > 0)
       row.cross_track_series.reserve(static_cast<std::size_t>(sc.steps() / extras.series_every + 1));
+    if (extras.seed_plan != nullptr) seeds_.emplace(*extras.seed_plan, extras.tool);
   }
 
   /// Whether add() does more per period than tally().add() (the body against obstacles, the last
   /// reference): then the loop must call add().
-  bool needsEveryPeriod() const { return extras_.contacts != nullptr || extras_.last_reference != nullptr; }
+  bool needsEveryPeriod() const {
+    return extras_.contacts != nullptr || extras_.last_reference != nullptr || extras_.seed_plan != nullptr;
+  }
   /// The per-period figures, for runClosedLoop(scenario, reference, keep_samples, tally) when
   /// !needsEveryPeriod(); finish() reads them either way.
   RunTally& tally() { return tally_; }
@@ -65,6 +110,15 @@ class RowMeter {
     tally_.add(s);
     if (extras_.contacts) extras_.contacts->update(s.t, {(*s.state)[X], (*s.state)[Y], (*s.state)[THETA]});
     if (extras_.last_reference) *extras_.last_reference = s.reference->pose;
+    if (seeds_) seeds_->add(s);
+  }
+  /// A period of the loop with a feedback source and layers: the seeds from the fed pose and the hitch.
+  void add(const EstimatedSample& s) {
+    const LoopSample& l = *s.loop;
+    tally_.add(l);
+    if (extras_.contacts) extras_.contacts->update(l.t, {(*l.state)[X], (*l.state)[Y], (*l.state)[THETA]});
+    if (extras_.last_reference) *extras_.last_reference = l.reference->pose;
+    if (seeds_) seeds_->add(s);
   }
 
   /// The run's metrics, time at the limit, cross-track, body and end distance into the row, and its
@@ -92,8 +146,17 @@ class RowMeter {
       row_.failure = "diverged";
     } else if (row_.contacts > 0) {
       row_.failure = "contact";
-    } else if (!(tally_.worst_cross_track < spec_.cross_track_threshold)) {
-      row_.failure = "cross-track";
+    }
+    if (seeds_) {
+      storeSeedFigures(row_, seedFigures(seeds_->seeds(), seeds_->drill()));
+      if (extras_.keep_seeds) row_.seed_record = seeds_->takeSeeds();
+    }
+    if (row_.failure.empty()) {
+      if (spec_.rule == SuccessRule::tracking || !seeds_) {
+        if (!(tally_.worst_cross_track < spec_.cross_track_threshold)) row_.failure = "cross-track";
+      } else {
+        row_.failure = seedFailure(row_, spec_);
+      }
     }
     row_.success = row_.failure.empty();
   }
@@ -104,7 +167,18 @@ class RowMeter {
   const RunExtras& extras_;
   const double dt_;
   RunTally tally_;
+  std::optional<SeedRecorder> seeds_;
 };
+
+/// The row a line track's seeds are judged on: the line between the reference's positions at settle_time and 2 s
+/// before the end (the approach to the line is not a row, and at the end the tool point trails the target by its
+/// 0.45 m behind the axle plus the tracking lag), sown against no obstacles.
+inline SeedDrill lineSeedPlan(const BenchScenario& bench) {
+  const double from = bench.line_x0 + bench.line_v_r * bench.spec.settle_time;
+  const double to = bench.line_x0 + bench.line_v_r * std::max(bench.spec.settle_time, bench.base.duration - 2.0);
+  return SeedDrill(bench.realism ? bench.realism->seeding : SeedingParams(),
+                   {RowSegment{Eigen::Vector2d(from, bench.line_y), Eigen::Vector2d(to, bench.line_y)}}, {}, 0.0);
+}
 
 /// A field run's finish check: not finished when the plan stops short of a row end, the path had not
 /// ended, or the robot is not within `tolerance` of its end. A contact or a divergence is the reason
@@ -113,7 +187,7 @@ class RowMeter {
 /// slows the path's own time, and a robot close to a slowed target that is still short of the path's
 /// end has not finished.
 inline void markNotFinished(RunRow& row, const FieldSource& reference, double duration, double tolerance) {
-  if (!row.failure.empty() && row.failure != "cross-track") return;
+  if (!row.failure.empty() && !performanceFailure(row.failure)) return;
   const bool stopped = reference.status().code != AvoidanceStatus::Code::kOk;
   const bool ended = reference.finished(std::min(duration, reference.lastTime()));
   if (stopped || !ended || !(row.end_distance < tolerance)) {
@@ -137,6 +211,10 @@ RunRow fieldRow(const BenchScenario& bench, Scenario sc, RunExtras extras, Measu
   Pose2D last_ref;
   extras.contacts = &contacts;
   extras.last_reference = &last_ref;
+  const SeedDrill plan(bench.realism ? bench.realism->seeding : SeedingParams(), rowsOf(bench.field), bench.obstacles,
+                       bench.field.potential.influence_distance);
+  extras.seed_plan = &plan;
+  if (bench.realism) extras.tool = bench.realism->tool;
   RunRow row = measure(sc, reference, extras);
   markNotFinished(row, reference, sc.duration, bench.finish_tolerance);
   return row;

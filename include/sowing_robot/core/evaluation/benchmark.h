@@ -33,6 +33,9 @@ struct Uniform {
 };
 
 /// What is drawn per run, and how success is judged. Defaults: around the thesis line scenario.
+/// See MonteCarloSpec::rule.
+enum class SuccessRule { tracking, sown };
+
 struct MonteCarloSpec {
   std::uint64_t base_seed = 1;
   Uniform mass_scale{0.8, 1.5};           ///< true m0 / nominal
@@ -44,10 +47,26 @@ struct MonteCarloSpec {
   Uniform start_dy{-0.5, 0.5};            ///< added to the start y [m]
   Uniform start_dtheta{-0.3, 0.3};        ///< added to the start heading [rad]
   double settle_time = 15.0;              ///< success is judged from here to the end [s]
-  double cross_track_threshold = 0.05;    ///< success: |e_y| below this after settle_time [m]
+  double cross_track_threshold = 0.05;    ///< success (rule tracking): |e_y| below this after settle_time [m]
+  /// How a run's success is judged beyond "not diverged, no contact, finished": tracking (|cross-track| below the
+  /// threshold from settle_time on, the thesis's figure) or sown (the seed record: every row sown, the spacing and
+  /// the line kept, the slip and the seed map within bounds). Default: sown for tracks with rows (field, line),
+  /// tracking for the sine track, which has none.
+  SuccessRule rule = SuccessRule::sown;
+  double min_sown_share = 0.98;        ///< rule sown: each row's sown share outside detour stretches at least this
+  double min_quality_of_feed = 95.0;   ///< rule sown: ISO 7256-1 quality of feed at least this [%]
+  double max_seed_lateral_p95 = 0.05;  ///< rule sown: p95 of the seeds' offset from their row's line [m]
+  double max_map_error_rms = 0.04;     ///< rule sown: RMS of |believed - true seed position| [m]
+  /// rule sown, traction plant: share of the run either wheel slips beyond twice the friction peak's slip, at most.
+  double max_high_slip_share = 0.05;
 
   std::string validate() const;
 };
+
+/// "tracking", "sown".
+const char* successRuleName(SuccessRule r);
+/// The rule's one-line statement for the report.
+std::string describeSuccessRule(const MonteCarloSpec& spec);
 
 /// What run `index` draws (the CSV's drawn columns).
 struct RunDraw {
@@ -95,6 +114,23 @@ struct RunRow {
   /// fallen there (that length over the seed drill's spacing). 0 without the hitch control.
   double unsown_distance = std::numeric_limits<double>::quiet_NaN();
   double seeds_unsown = std::numeric_limits<double>::quiet_NaN();
+  /// The seed record's figures (seed_metrics.h: SeedFigures): tracks with rows to sow; NaN (count 0) without.
+  long seeds = 0;
+  double sown_share = std::numeric_limits<double>::quiet_NaN();
+  double worst_row_share = std::numeric_limits<double>::quiet_NaN();
+  double detour_sown_share = std::numeric_limits<double>::quiet_NaN();
+  double multiples_index = std::numeric_limits<double>::quiet_NaN();
+  double miss_index = std::numeric_limits<double>::quiet_NaN();
+  double quality_of_feed = std::numeric_limits<double>::quiet_NaN();
+  double precision = std::numeric_limits<double>::quiet_NaN();
+  double seed_lateral_rms = std::numeric_limits<double>::quiet_NaN();
+  double seed_lateral_p95 = std::numeric_limits<double>::quiet_NaN();
+  double seed_lateral_max = std::numeric_limits<double>::quiet_NaN();
+  double depth_outside_share = std::numeric_limits<double>::quiet_NaN();
+  double map_error_rms = std::numeric_limits<double>::quiet_NaN();
+  double map_error_p95 = std::numeric_limits<double>::quiet_NaN();
+  /// The seeds themselves, when the caller asked for them (RunExtras::keep_seeds; empty otherwise).
+  std::vector<Seed> seed_record;
 };
 
 /// What one worker thread of a benchmark did: how many runs, and the CPU time its thread used

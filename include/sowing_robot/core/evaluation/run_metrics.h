@@ -52,6 +52,7 @@ struct RunMetric {
   Better better = Better::lower;
   bool compared = false;  ///< in benchmark_plots' comparison of pairs
   unsigned plots = kNoPlot;
+  bool seed_figure = false;  ///< one of the seed record's figures (SeedFigures: what Python's seed_figures holds)
 };
 
 /// Every per-run metric, in runs.csv order within its group.

@@ -67,12 +67,19 @@ class SeedDrill {
   /// Advance the tool point to p; tool_down is the reference's request. Returns true (and the seed
   /// position) when a seed falls here. A non-finite p is refused (false, state untouched, counted by
   /// rejected()), so it can neither drop a seed nor spoil the distance travelled.
-  bool update(const Eigen::Vector2d& p, bool tool_down, Eigen::Vector2d& seed);
+  ///
+  /// The drill is lowered where the plan asks for the tool (tool_down) and the tool point is on a row (onRowSegment);
+  /// it is lifted when held_up (the hitch holds it up: at once), or when the plan no longer asks for it and the
+  /// tool point has left the rows' span (withinRowSpan) or the row's line (beyond tolerance): the plan's request
+  /// turns with the axle's target into the headland at a row's end, while the tool point trails the axle by the
+  /// drill's offset and has that stretch of the row still to sow -- as the plant's tool rule (tool_engagement.h)
+  /// keeps the draft on until there.
+  bool update(const Eigen::Vector2d& p, bool tool_down, Eigen::Vector2d& seed, bool held_up = false);
   /// The same rule for a seed record: `truth` is the tool point where it really is (it decides the drop, as
   /// update()), `believed` the tool point on the pose the controllers were fed, `depth` the drill's depth
   /// [m]. Returns true and fills `seed` (its row and detour flag from the plan) when a seed falls.
-  bool drop(double t, const Eigen::Vector2d& truth, const Eigen::Vector2d& believed, bool tool_down, double depth,
-            Seed& seed);
+  bool drop(double t, const Eigen::Vector2d& truth, const Eigen::Vector2d& believed, bool tool_down, bool held_up,
+            double depth, Seed& seed);
   /// A new plan (the obstacles changed at run time): seeds from now on are scored against it; the
   /// seeds already scored, the distance travelled and the tool's state are kept.
   void setPlan(std::vector<RowSegment> rows, std::vector<Obstacle> obstacles, double influence);
@@ -82,6 +89,8 @@ class SeedDrill {
   /// True when p is within engage_distance of a row and between its ends (not beyond them, as in a
   /// headland turn): where the tool may be lowered.
   bool onRowSegment(const Eigen::Vector2d& p) const;
+  /// True when p's projection lies strictly between the ends of some row (at any distance from it).
+  bool withinRowSpan(const Eigen::Vector2d& p) const;
   /// True when p lies in an obstacle's detour zone.
   bool inDetour(const Eigen::Vector2d& p) const;
   /// Index of the row nearest p (-1 without rows).

@@ -1,0 +1,65 @@
+// A run's seed record, kept beside the loop from the periods it hands its trace: the seed drill's own rule
+// (SeedDrill::drop) on the tool point of the TRUE pose (where the seed really falls), with the tool point of the
+// FED pose as where the robot believed it fell. The drill sows where the reference asks for the tool and the
+// hitch does not hold it up -- what the node pipeline's seed_drill does with follow_hitch -- at the depth the
+// drill runs at (the middle of the agronomic band while no depth control sets it).
+// Used by the benchmark's rows (RowMeter), hence the tuner, and by the Python module: one record, one rule.
+#pragma once
+
+#include <cmath>
+#include <utility>
+#include <vector>
+
+#include "sowing_robot/core/control/hitch_control.h"
+#include "sowing_robot/core/planning/seeding.h"
+#include "sowing_robot/core/simulation/closed_loop.h"
+#include "sowing_robot/core/simulation/loop_types.h"
+
+namespace sowing_robot {
+namespace core {
+
+class SeedRecorder {
+ public:
+  /// plan: the rows and obstacles sown against (a fresh drill: nothing travelled yet); tool: the seed-drop point
+  /// in base_link [m].
+  SeedRecorder(SeedDrill plan, const Eigen::Vector2d& tool)
+      : drill_(std::move(plan)), tool_(tool), depth_(0.5 * (drill_.params().depth_min + drill_.params().depth_max)) {}
+
+  /// A period of a truth-fed loop: the robot believed what was true (its yaw through the quaternion of
+  /// nav_msgs/Odometry, as the loop feeds it).
+  void add(const LoopSample& s) {
+    const State& x = *s.state;
+    drop(s.t, toolPoint(x[X], x[Y], x[THETA]), toolPoint(x[X], x[Y], yawThroughQuaternion(x[THETA])),
+         s.reference->tool_down, false);
+  }
+  /// A period of a loop with a feedback source and layers: the believed point from the fed pose, the tool held up
+  /// by the hitch control sows nothing.
+  void add(const EstimatedSample& s) {
+    const State& x = *s.loop->state;
+    const bool raised = s.layers != nullptr && s.layers->hitch != nullptr && s.layers->hitch->raised();
+    drop(s.loop->t, toolPoint(x[X], x[Y], x[THETA]), toolPoint(s.fed.x, s.fed.y, s.fed.theta),
+         s.loop->reference->tool_down, raised);
+  }
+
+  const std::vector<Seed>& seeds() const { return seeds_; }
+  std::vector<Seed> takeSeeds() { return std::move(seeds_); }
+  const SeedDrill& drill() const { return drill_; }
+
+ private:
+  Eigen::Vector2d toolPoint(double x, double y, double theta) const {
+    const double sn = std::sin(theta), c = std::cos(theta);
+    return {x + c * tool_.x() - sn * tool_.y(), y + sn * tool_.x() + c * tool_.y()};
+  }
+  void drop(double t, const Eigen::Vector2d& truth, const Eigen::Vector2d& believed, bool tool_down, bool held_up) {
+    Seed seed;
+    if (drill_.drop(t, truth, believed, tool_down, held_up, depth_, seed)) seeds_.push_back(seed);
+  }
+
+  SeedDrill drill_;
+  Eigen::Vector2d tool_;
+  double depth_;
+  std::vector<Seed> seeds_;
+};
+
+}  // namespace core
+}  // namespace sowing_robot

@@ -1,0 +1,172 @@
+// Seed figures: sown share on the row's geometry, ISO 7256-1 indices, lateral offset, depth band, map error,
+// each against seed records whose answer is known by construction.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "sowing_robot/core/evaluation/seed_metrics.h"
+
+using namespace sowing_robot::core;
+
+namespace {
+
+SeedingParams params() {
+  SeedingParams p;
+  p.spacing = 0.1;
+  p.detour_margin = 0.5;
+  p.depth_min = 0.03;
+  p.depth_max = 0.05;
+  return p;
+}
+
+/// A 10 m row along x at y = 3 (and an optional obstacle).
+SeedDrill plan(std::vector<Obstacle> obstacles = {}) {
+  return SeedDrill(params(), {{Eigen::Vector2d(0, 3), Eigen::Vector2d(10, 3)}}, std::move(obstacles), 0.5);
+}
+
+/// Seeds at x = from + k step < to on the row (lateral offset dy, depth 4 cm, map error 0).
+void sow(std::vector<Seed>& seeds, const SeedDrill& drill, double from, double to, double step, double dy = 0.0) {
+  for (int k = 0; from + k * step < to - 1e-9; ++k) {
+    const double x = from + k * step;
+    Seed s;
+    s.truth = s.believed = Eigen::Vector2d(x, 3.0 + dy);
+    s.row = drill.nearestRow(s.truth);
+    s.depth = 0.04;
+    s.detour = drill.inDetour(s.truth);
+    seeds.push_back(s);
+  }
+}
+
+}  // namespace
+
+TEST(SeedMetrics, ARowSownEndToEndIsAllButHalfASpacingAtEachEnd) {
+  const SeedDrill d = plan();
+  std::vector<Seed> seeds;
+  sow(seeds, d, 0.1, 10.0, 0.1);  // 0.1 .. 9.9: the drill's first seed falls a spacing after lowering
+  const SeedFigures f = seedFigures(seeds, d);
+  EXPECT_EQ(f.seeds, 99u);
+  ASSERT_EQ(f.rows.size(), 1u);
+  // Sown [0.05, 9.95]: 9.9 of 10 m.
+  EXPECT_NEAR(f.sown_share, 0.99, 1e-9);
+  EXPECT_NEAR(f.worst_row_share, 0.99, 1e-9);
+  EXPECT_NEAR(f.quality_of_feed, 100.0, 1e-9);
+  EXPECT_NEAR(f.multiples, 0.0, 1e-12);
+  EXPECT_NEAR(f.misses, 0.0, 1e-12);
+  EXPECT_LT(f.precision, 1e-6);  // every spacing the same (to rounding)
+  EXPECT_NEAR(f.lateral_max, 0.0, 1e-12);
+  EXPECT_EQ(f.depth_outside, 0.0);
+  EXPECT_EQ(f.map_error_rms, 0.0);
+  EXPECT_TRUE(std::isnan(f.detour_sown_share));  // no obstacle
+}
+
+TEST(SeedMetrics, AGapOverOneAndAHalfSpacingsIsUnsownAndOneMiss) {
+  const SeedDrill d = plan();
+  std::vector<Seed> seeds;
+  sow(seeds, d, 0.1, 4.05, 0.1);  // 0.1 .. 4.0
+  sow(seeds, d, 7.0, 10.0, 0.1);  // 7.0 .. 9.9: a 3 m gap
+  const SeedFigures f = seedFigures(seeds, d);
+  // Sown [0.05, 4.05] and [6.95, 9.95]: 7 of 10 m.
+  EXPECT_NEAR(f.sown_share, 0.70, 1e-9);
+  // 40 + 30 seeds: 69 spacings, one of them the 3 m gap: M = 1/69.
+  EXPECT_NEAR(f.misses, 100.0 / 69.0, 1e-9);
+  EXPECT_NEAR(f.quality_of_feed, 100.0 - 100.0 / 69.0, 1e-9);
+}
+
+TEST(SeedMetrics, AGapOfOneAndAHalfSpacingsStillCountsAsSown) {
+  const SeedDrill d = plan();
+  std::vector<Seed> seeds;
+  sow(seeds, d, 0.1, 5.05, 0.1);    // ... 5.0
+  sow(seeds, d, 5.149, 10.0, 0.1);  // 5.149 ...: a spacing of 0.149, just under 1.5 x
+  SeedFigures f = seedFigures(seeds, d);
+  EXPECT_NEAR(f.sown_share, 0.9949, 1e-9);  // sown [0.05, 9.999]: the last seed at 9.949
+  EXPECT_NEAR(f.misses, 0.0, 1e-12);
+  seeds.clear();
+  sow(seeds, d, 0.1, 5.05, 0.1);
+  sow(seeds, d, 5.151, 10.0, 0.1);  // 0.151: over 1.5 x, a miss, and the stretch between is unsown
+  f = seedFigures(seeds, d);
+  EXPECT_NEAR(f.misses, 100.0 / 98.0, 1e-9);
+  EXPECT_NEAR(f.sown_share, 0.9899, 1e-9);  // [0.05, 5.05] and [5.101, 10]
+}
+
+TEST(SeedMetrics, DoublesAreMultiplesAndSpreadIsPrecision) {
+  const SeedDrill d = plan();
+  std::vector<Seed> seeds;
+  sow(seeds, d, 0.1, 10.0, 0.1);
+  Seed twin = seeds[10];
+  twin.truth.x() += 0.01;  // a double drop 1 cm behind
+  twin.believed = twin.truth;
+  seeds.push_back(twin);
+  SeedFigures f = seedFigures(seeds, d);
+  // 100 seeds, 99 spacings: one of 0.01 (multiple); the next 0.09 (accepted).
+  EXPECT_NEAR(f.multiples, 100.0 / 99.0, 1e-9);
+  EXPECT_GT(f.precision, 0.0);
+  // Alternating 0.08 / 0.12 spacings: every one accepted, precision = their std / x_ref = 20 %.
+  std::vector<Seed> jitter;
+  for (int k = 0; k < 50; ++k) {
+    sow(jitter, d, 0.1 + 0.2 * k, 0.1 + 0.2 * k + 0.01, 1.0);
+    sow(jitter, d, 0.18 + 0.2 * k, 0.18 + 0.2 * k + 0.01, 1.0);
+  }
+  f = seedFigures(jitter, d);
+  EXPECT_NEAR(f.quality_of_feed, 100.0, 1e-9);
+  EXPECT_NEAR(f.precision, 20.0, 0.3);  // sample std of alternating +-0.02 around 0.1
+}
+
+TEST(SeedMetrics, DetourStretchesAreReportedApart) {
+  // An obstacle of 0.3 m on the row at x = 5: detour radius 0.3 + 0.5 + 0.5 = 1.3 m, i.e. [3.7, 6.3].
+  const SeedDrill d = plan({{5.0, 3.0, 0.3}});
+  std::vector<Seed> seeds;
+  sow(seeds, d, 0.1, 3.65, 0.1);  // up to 3.6
+  sow(seeds, d, 6.4, 10.0, 0.1);  // from 6.4: the robot went round, sowing nothing on the line
+  const SeedFigures f = seedFigures(seeds, d);
+  ASSERT_EQ(f.rows.size(), 1u);
+  EXPECT_NEAR(f.rows[0].detour_length, 2.6, 1e-9);
+  EXPECT_NEAR(f.rows[0].length, 7.4, 1e-9);
+  // Sown [0.05, 3.65] and [6.35, 9.95] less the detour part [6.3, 6.35] = 0: 3.6 + 3.6 = 7.2 of 7.4.
+  EXPECT_NEAR(f.sown_share, 7.2 / 7.4, 1e-9);
+  EXPECT_NEAR(f.detour_sown_share, 0.0, 1e-9);
+  // The gap across the detour stretch is not an ISO miss (its seeds border the obstacle, not a fault).
+  EXPECT_NEAR(f.misses, 0.0, 1e-12);
+}
+
+TEST(SeedMetrics, LateralDepthAndMapError) {
+  const SeedDrill d = plan();
+  std::vector<Seed> seeds;
+  sow(seeds, d, 0.1, 5.05, 0.1, 0.02);                         // 50 seeds 2 cm left
+  sow(seeds, d, 5.1, 10.0, 0.1, -0.04);                        // 49 seeds 4 cm right
+  for (std::size_t i = 0; i < 10; ++i) seeds[i].depth = 0.02;  // 10 too shallow
+  for (Seed& s : seeds) s.believed = s.truth + Eigen::Vector2d(0.03, 0.0);
+  const SeedFigures f = seedFigures(seeds, d);
+  EXPECT_NEAR(f.lateral_max, 0.04, 1e-9);
+  EXPECT_NEAR(f.lateral_p95, 0.04, 1e-9);
+  EXPECT_NEAR(f.lateral_rms, std::sqrt((50 * 0.0004 + 49 * 0.0016) / 99.0), 1e-9);
+  EXPECT_NEAR(f.depth_outside, 10.0 / 99.0, 1e-12);
+  EXPECT_NEAR(f.map_error_rms, 0.03, 1e-9);
+  EXPECT_NEAR(f.map_error_p95, 0.03, 1e-9);
+}
+
+TEST(SeedMetrics, NoSeedsMeansNothingSownAndNoIndices) {
+  const SeedDrill d = plan();
+  const SeedFigures f = seedFigures({}, d);
+  EXPECT_EQ(f.sown_share, 0.0);
+  EXPECT_EQ(f.worst_row_share, 0.0);
+  EXPECT_TRUE(std::isnan(f.quality_of_feed));
+  EXPECT_TRUE(std::isnan(f.lateral_rms));
+  EXPECT_TRUE(std::isnan(f.map_error_rms));
+}
+
+TEST(SeedMetrics, SeedsFromTheDrillItselfSowTheRow) {
+  // The drill's own rule on a tool point driven along the row at 1 mm steps: the record is what the drill drops.
+  SeedDrill d = plan();
+  std::vector<Seed> seeds;
+  Seed s;
+  for (int i = 0; i <= 10050; ++i) {  // to 10.05 m: the 100th seed clear of rounding at 10 m
+    const Eigen::Vector2d p(i * 1e-3, 3.0);
+    if (d.drop(i * 1e-3, p, p, true, false, 0.04, s)) seeds.push_back(s);
+  }
+  const SeedFigures f = seedFigures(seeds, d);
+  EXPECT_EQ(f.seeds, 100u);
+  EXPECT_NEAR(f.sown_share, 0.995, 1e-9);  // [0.05, 10]: the last seed at 10.0, the row's end
+  EXPECT_NEAR(f.quality_of_feed, 100.0, 1e-9);
+  EXPECT_EQ(seeds.front().row, 0);
+  EXPECT_DOUBLE_EQ(seeds.back().t, seeds.back().truth.x());
+}
