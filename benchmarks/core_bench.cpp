@@ -218,7 +218,8 @@ BENCHMARK(BM_FieldProfileRun25s)->ArgName("feedback")->Arg(0)->Arg(1)->Unit(benc
 // trace (record 0) against the same run with the benchmark's SeedRecorder in the trace (record 1).
 void BM_FieldProfileSeedRecord(benchmark::State& state) {
   guarded(state, [&] {
-    const Scenario sc = bench::fieldProfileScenario();
+    Scenario sc = bench::fieldProfileScenario();
+    sc.start = {0.0, 3.0, 0.0};  // on the row from the start, so that the drill sows the whole run
     LineReference ref = bench::thesisLine();
     const LoopConfig cfg = bench::fieldProfileConfig();
     const SeedDrill row(cfg.seeding, {RowSegment{Eigen::Vector2d(0.0, 3.0), Eigen::Vector2d(sc.duration, 3.0)}}, {},
