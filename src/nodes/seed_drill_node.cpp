@@ -6,7 +6,7 @@ namespace {
 const char* const kUsage =
     SOWING_NODE_USAGE("seed_drill",
                       "The seed drill: drops seeds at the tool point of the true pose while the tool is down on a row\n"
-                      "(`seeds`, `seed_report`).\n");
+                      "(`seeds`, `seed_report`) and records each seed, true and believed position (`seeds/record`).\n");
 }  // namespace
 
 int main(int argc, char** argv) {

@@ -47,6 +47,8 @@ SeedDrillNode::SeedDrillNode(ros::NodeHandle nh, ros::NodeHandle pnh) {
   chunk_.color.b = 0.3f;
   chunk_.color.a = 1.0f;
   seeds_pub_ = nh.advertise<visualization_msgs::MarkerArray>("seeds", kLockstepQueue);
+  record_pub_ = nh.advertise<Seed>("seeds/record", kLockstepQueue);
+  odom_frame_ = run.odom_frame;
   report_pub_ = nh.advertise<std_msgs::Float64MultiArray>("seed_report", 100, true);
   // Subscribed here, not from the plan's callback: a subscription made from a callback of the shared
   // nodelet thread while the plant publishes its state hung a nodelet run (1 in ~10 under load). States that
@@ -58,8 +60,15 @@ SeedDrillNode::SeedDrillNode(ros::NodeHandle nh, ros::NodeHandle pnh) {
   ref_sub_ = nh.subscribe("reference", kLockstepQueue, &SeedDrillNode::referenceCallback, this, hints);
   if (settings_.follow_hitch)
     torque_sub_ = nh.subscribe("wheel_torque", kLockstepQueue, &SeedDrillNode::torqueCallback, this, hints);
+  // The believed pose: what the controllers are fed (the launch remaps their `feedback`, and this node's, to
+  // ground_truth, odom or odometry/filtered). Paired by stamp, so a lockstep run records the same seeds.
+  const std::string fed = nh.resolveName("feedback");
+  believed_is_truth_ = fed == nh.resolveName("ground_truth") || fed == nh.resolveName("feedback", false);
+  if (!believed_is_truth_)
+    believed_sub_ = nh.subscribe("feedback", kLockstepQueue, &SeedDrillNode::believedCallback, this, hints);
+  ROS_INFO("seed_drill: believed tool position from %s", believed_is_truth_ ? "the true pose" : fed.c_str());
   ready_ = ReadyAnnouncer(nh, pnh, run.lockstep,
-                          {odom_sub_, ref_sub_, torque_sub_});  // last: all subscribed (ready_roster.h)
+                          {odom_sub_, ref_sub_, torque_sub_, believed_sub_});  // last: all subscribed (ready_roster.h)
 }
 
 void SeedDrillNode::planCallback(const FieldPlan::ConstPtr& msg) {
@@ -100,7 +109,7 @@ void SeedDrillNode::referenceCallback(const ReferenceState::ConstPtr& msg) {
 
 void SeedDrillNode::paired(const nav_msgs::Odometry& odom, bool tool_down) {
   if (!settings_.follow_hitch) {
-    update(odom, tool_down);
+    update(odom, tool_down, false);
     return;
   }
   if (hitch_inputs_.setFirst({odom.header, odom, tool_down})) updateHitchPair();
@@ -116,27 +125,66 @@ void SeedDrillNode::updateHitchPair() {
 }
 
 void SeedDrillNode::update(const nav_msgs::Odometry& odom, bool tool_down, bool held_up) {
+  if (believed_is_truth_) {
+    sow(odom, odom, tool_down, held_up);
+    return;
+  }
+  if (believed_inputs_.setFirst({odom.header, odom, tool_down, held_up}))
+    sow(believed_inputs_.first().truth, believed_inputs_.second(), believed_inputs_.first().tool_down,
+        believed_inputs_.first().held_up);
+}
+
+void SeedDrillNode::believedCallback(const nav_msgs::Odometry::ConstPtr& msg) {
+  // Kept even before the plan: the state of the same stamp may come after it (another connection).
+  if (believed_inputs_.setSecond(*msg))
+    sow(believed_inputs_.first().truth, believed_inputs_.second(), believed_inputs_.first().tool_down,
+        believed_inputs_.first().held_up);
+}
+
+Eigen::Vector2d SeedDrillNode::toolPoint(const nav_msgs::Odometry& odom) const {
   const core::Pose2D pose = poseOf(odom);
   double s, c;
   s = std::sin(pose.theta);
   c = std::cos(pose.theta);
-  const Eigen::Vector2d tool(pose.x + c * tool_x_ - s * tool_y_, pose.y + s * tool_x_ + c * tool_y_);
-  Eigen::Vector2d seed;
-  if (drill_->update(tool, tool_down, seed, held_up)) addSeed(seed, odom.header.stamp);
-  if (!final_sent_ && end_ns_ >= 0 && static_cast<std::int64_t>(odom.header.stamp.toNSec()) >= end_ns_) {
+  return Eigen::Vector2d(pose.x + c * tool_x_ - s * tool_y_, pose.y + s * tool_x_ + c * tool_y_);
+}
+
+double SeedDrillNode::seedDepth(const ros::Time& /*stamp*/) const {
+  const core::SeedingParams& p = settings_.seeding;
+  return 0.5 * (p.depth_min + p.depth_max);
+}
+
+void SeedDrillNode::sow(const nav_msgs::Odometry& truth, const nav_msgs::Odometry& believed, bool tool_down,
+                        bool held_up) {
+  const ros::Time& stamp = truth.header.stamp;
+  core::Seed seed;
+  if (drill_->drop(stamp.toSec(), toolPoint(truth), toolPoint(believed), tool_down, held_up, seedDepth(stamp), seed))
+    addSeed(seed, stamp);
+  if (!final_sent_ && end_ns_ >= 0 && static_cast<std::int64_t>(stamp.toNSec()) >= end_ns_) {
     final_sent_ = true;
-    publishReport(odom.header.stamp);
+    publishReport(stamp);
   }
 }
 
-void SeedDrillNode::addSeed(const Eigen::Vector2d& seed, const ros::Time& stamp) {
+void SeedDrillNode::addSeed(const core::Seed& seed, const ros::Time& stamp) {
+  Seed record;
+  record.header.stamp = stamp;
+  record.header.frame_id = odom_frame_;
+  record.position.x = seed.truth.x();
+  record.position.y = seed.truth.y();
+  record.believed.x = seed.believed.x();
+  record.believed.y = seed.believed.y();
+  record.row = seed.row;
+  record.depth = seed.depth;
+  record.detour = seed.detour;
+  record_pub_.publish(record);
   if (chunk_.points.size() >= kChunk) {
     chunk_.points.clear();
     ++chunk_id_;
   }
   geometry_msgs::Point pt;
-  pt.x = seed.x();
-  pt.y = seed.y();
+  pt.x = seed.truth.x();
+  pt.y = seed.truth.y();
   chunk_.points.push_back(pt);
   chunk_.id = chunk_id_;
   chunk_.header.stamp = stamp;

@@ -5,7 +5,10 @@ the generator's latched `plan`), its smallest clearance from every obstacle surf
 reported no contact; optionally (~max_yaw_rate, ~max_lateral_accel) that the robot's |omega| and
 |v omega| stayed within bounds over the whole run; that it ends near (end_x, end_y); and the seed
 drill's cross-track report for seeds away from obstacles: its final report (stamped at the run's end, sent
-once the drill has taken the final state), checked to count every seed the drill showed on `seeds`."""
+once the drill has taken the final state), checked to count every seed the drill showed on `seeds` and every
+seed of its record on `seeds/record`; each recorded seed in time order, on its row (its nearest row of the plan,
+within ~max_row_error unless a detour seed, the farthest at the report's rows_max), at a depth inside the
+agronomic band, and believed where it fell (the controllers are fed the true state here)."""
 import math
 import time
 import unittest
@@ -14,9 +17,11 @@ import rospy
 import rostest
 from geometry_msgs.msg import PolygonStamped
 from nav_msgs.msg import Odometry
-from sowing_robot.msg import Contact, FieldPlan
+from sowing_robot.msg import Contact, FieldPlan, Seed
 from std_msgs.msg import Float64MultiArray
 from visualization_msgs.msg import MarkerArray
+
+import links
 
 TIMEOUT = 60.0  # [s wall] for the latched footprint and plan
 # [s wall] for the drill's final report once the run has ended: only bounds a hang (the drill, which the
@@ -58,7 +63,7 @@ class FieldRun(unittest.TestCase):
         obstacles = [(c.x, c.y, r) for c, r in zip(plan.obstacle_centres, plan.obstacle_radii)]
         self.assertGreater(len(polygon), 2, "no footprint from plant_sim")
         state = {"min_clear": float("inf"), "last": None, "report": None, "yaw": 0.0, "lateral": 0.0, "contacts": [],
-                 "chunks": {}}
+                 "chunks": {}, "records": []}
 
         def on_seeds(m):  # each message: the chunk of seeds that grew by one; seeds = the chunks' sizes added up
             for marker in m.markers:
@@ -85,6 +90,9 @@ class FieldRun(unittest.TestCase):
             state["lateral"] = max(state["lateral"], abs(v * w))
             state["last"] = m
 
+        # One message per seed, from the first: linked before the tester's ground_truth lets the plant start.
+        rospy.Subscriber("seeds/record", Seed, state["records"].append, queue_size=100000)
+        self.assertIsNone(links.wait_until_linked(["seeds/record"], TIMEOUT), "seeds/record not linked")
         rospy.Subscriber("ground_truth", Odometry, on_odom, queue_size=100000)
         rospy.Subscriber("contacts", Contact, lambda m: state["contacts"].append(m), queue_size=100)
         rospy.Subscriber("seed_report", Float64MultiArray, on_report, queue_size=100)
@@ -96,16 +104,16 @@ class FieldRun(unittest.TestCase):
                 break
             self.assertLess(time.time() - t0, 360.0, "the run did not reach t = %.1f s" % duration)
             time.sleep(0.05)
-        # The drill's final report, and every seed it showed counted in it (the report and the seeds come on
-        # two topics: wait for both).
+        # The drill's final report, and every seed it showed and recorded counted in it (the report, the seeds
+        # and the record come on three topics: wait for all).
         t1 = time.time()
         while not rospy.is_shutdown():
             r = final_report()
-            if r is not None and r[0] + r[4] == seeds_shown():
+            if r is not None and r[0] + r[4] == seeds_shown() == len(state["records"]):
                 break
             self.assertLess(time.time() - t1, REPORT_TIMEOUT,
-                            "no final seed report counting all %d seeds shown (latest report: %s)" %
-                            (seeds_shown(), state["report"]))
+                            "no final seed report counting all %d seeds shown and %d recorded (latest report: %s)" %
+                            (seeds_shown(), len(state["records"]), state["report"]))
             time.sleep(0.05)
         p = state["last"].pose.pose.position
         rows_count, rows_max, rows_rms, rows_over, det_count, det_max, det_rms, _stamp = final_report()
@@ -122,6 +130,28 @@ class FieldRun(unittest.TestCase):
         self.assertLess(math.hypot(p.x - rospy.get_param("~end_x"), p.y - rospy.get_param("~end_y")), 1.0)
         self.assertGreaterEqual(rows_count, rospy.get_param("~min_row_seeds"))
         self.assertLess(rows_max, rospy.get_param("~max_row_error"))
+        self.check_record(state["records"], plan, rows_count, rows_max, det_count)
+
+    def check_record(self, records, plan, rows_count, rows_max, det_count):
+        rows = [(a.x, a.y, b.x, b.y) for a, b in zip(plan.row_starts, plan.row_ends)]
+        depth_min = rospy.get_param("/seed_drill/depth_min", 0.03)
+        depth_max = rospy.get_param("/seed_drill/depth_max", 0.05)
+        stamps = [m.header.stamp for m in records]
+        self.assertEqual(stamps, sorted(stamps), "seed record out of time order")
+        self.assertEqual(sum(1 for m in records if m.detour), det_count)
+        farthest = 0.0
+        for m in records:
+            p = m.position
+            self.assertTrue(0 <= m.row < len(rows), "seed at (%.3f, %.3f) on row %d of %d" % (p.x, p.y, m.row, len(rows)))
+            self.assertEqual(m.header.frame_id, rospy.get_param("/run/odom_frame", "odom"))
+            self.assertTrue(depth_min <= m.depth <= depth_max, "depth %.4f m outside the band" % m.depth)
+            self.assertEqual((m.believed.x, m.believed.y), (p.x, p.y), "believed elsewhere than the truth")
+            d = segment_distance(p.x, p.y, *rows[m.row])
+            self.assertAlmostEqual(d, min(segment_distance(p.x, p.y, *r) for r in rows), delta=1e-12)
+            if not m.detour:
+                farthest = max(farthest, d)
+        self.assertEqual(len(records) - det_count, rows_count)
+        self.assertAlmostEqual(farthest, rows_max, delta=1e-9)
 
 
 if __name__ == "__main__":

@@ -6,8 +6,8 @@ its own at a free port:
     summary compares every period of both (15001 stamps), with the closest approach the robots' lane spacing
     (1 m, at the start) and no encounter;
   * run B (safety_distance 1.2 m, record:=true): the same metrics bit for bit; the same messages in each robot's
-    bag on every period topic, bit for bit and in the same order, and the same bag files byte for byte (the
-    fleet's recorders write in stamp order: bag_recorder ~deterministic); fleet_monitor warns of the robots closer
+    bag on every period topic, bit for bit and in the same order, and the same bag files byte for byte, seed record
+    (`seeds/record`) included (the fleet's recorders write in stamp order: bag_recorder ~deterministic); fleet_monitor warns of the robots closer
     than 1.2 m and counts the encounters;
   * robot_0 alone (sim.launch with the same row): the same metrics as robot_0 in the fleet, bit for bit (the
     fleet's namespaces, frames and clocks change nothing in a robot's run);
@@ -114,6 +114,8 @@ class Fleet(unittest.TestCase):
                 self.assertGreaterEqual(len(ma[topic]), PERIODS, "%s/%s" % (robot, topic))
                 self.assertTrue(ma[topic] == mb[topic], "%s/%s differs between the runs" % (robot, topic))
             bag_a, bag_b = os.path.join(da, robot + ".bag"), os.path.join(db, robot + ".bag")
+            # the seed record too (one message per seed, at the state's stamp), so a repeat sows the same seeds
+            self.assertGreater(topic_counts(bag_a).get("/%s/seeds/record" % robot, 0), 0, "%s recorded no seed" % robot)
             self.assertTrue(read_bytes(bag_a) == read_bytes(bag_b), "%s's bag files differ: messages per topic %s against %s"
                             % (robot, topic_counts(bag_a), topic_counts(bag_b)))
         # run B only widened the safety distance: the robots start 1 m apart, so it reports them

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """rostest: recording. (1) `sim.launch headless:=true record:=true field:=line duration:=10` leaves a bag
 whose analyze_bag metrics (full precision, --yaml) equal run_monitor's metrics_output and the in-process
-runner's (run_scenario --yaml) exactly, with no missing period. (2) SIGINT in the middle of a recorded
+runner's (run_scenario --yaml) exactly, with no missing period, and whose seed record (`seeds/record`) seed_map
+reads into a CSV of seeds on the line. (2) SIGINT in the middle of a recorded
 run leaves a closed bag (no .active file) that analyze_bag reads."""
 import os
 import signal
@@ -53,6 +54,19 @@ class Record(unittest.TestCase):
         print("bag:", b["y"], "\nrun_monitor:", m["y"], "\nin-process:", i["y"])
         self.assertEqual(b, m)
         self.assertEqual(m, i)
+        csv = os.path.join(self.tmp, "seeds.csv")
+        s = subprocess.run([node("seed_map"), bag, "--csv", csv], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                           universal_newlines=True, timeout=120)
+        self.assertEqual(s.returncode, 0, s.stderr)
+        with open(csv) as f:
+            lines = f.read().splitlines()
+        print(s.stdout.strip())
+        self.assertEqual(lines[0], "t,x,y,believed_x,believed_y,row,depth,detour")
+        self.assertGreater(len(lines), 10, "hardly a seed recorded")
+        for line in lines[1:]:
+            t, x, y, bx, by, row, depth, detour = line.split(",")
+            self.assertEqual(row, "0")
+            self.assertLess(abs(float(y) - float(by)) + abs(float(x) - float(bx)), 1e-12)  # fed the truth
 
     def test_sigint_leaves_a_readable_bag(self):
         bag = os.path.join(self.tmp, "interrupted.bag")

@@ -10,6 +10,11 @@
 // rows_rms, rows_fraction_over, detour_count, detour_max, detour_rms [m], stamp [s, of the state that sowed
 // the last seed; of the final state in the final report]). A tester waits for the report stamped at the
 // run's end instead of guessing when the drill has caught up (the plant does not wait for this node).
+// And `seeds/record` (sowing_robot/Seed, one message per seed, stamped with the state it fell at, in the odom
+// frame): where it fell (the tool point on ground_truth), where the robot believed its tool was (the tool point
+// on `feedback`, the pose the controllers are fed, paired with the true state by stamp), its row, depth and
+// detour flag: the run's seed record, which bags keep and `seed_map` exports (docs/seed_map.md). Without a
+// remapping of `feedback` (a launch whose controllers read ground_truth) the believed position is the true one.
 #pragma once
 
 #include <nav_msgs/Odometry.h>
@@ -20,6 +25,7 @@
 
 #include "sowing_robot/FieldPlan.h"
 #include "sowing_robot/ReferenceState.h"
+#include "sowing_robot/Seed.h"
 #include "sowing_robot/WheelTorque.h"
 #include "sowing_robot/core/planning/seeding.h"
 #include "sowing_robot/core/settings/node_settings.h"
@@ -45,11 +51,21 @@ class SeedDrillNode {
   /// The reference generator's plan: the first one starts the drill, later ones replace its rows and
   /// obstacles (run-time obstacle changes).
   void planCallback(const FieldPlan::ConstPtr& msg);
-  /// The state and the reference for the same time: move the tool, maybe drop a seed; the final report
-  /// after the run's final state.
-  void update(const nav_msgs::Odometry& odom, bool tool_down, bool held_up = false);
-  /// A seed dropped by the state stamped `stamp`: shown, and every 50th reported.
-  void addSeed(const Eigen::Vector2d& seed, const ros::Time& stamp);
+  /// The state and whether the tool is down for the same time: sown now, or once the believed pose of
+  /// its stamp is here (`feedback` other than ground_truth).
+  void update(const nav_msgs::Odometry& odom, bool tool_down, bool held_up);
+  /// The pose the controllers are fed (`feedback`), when it is not ground_truth itself.
+  void believedCallback(const nav_msgs::Odometry::ConstPtr& msg);
+  /// The true and the believed state of one stamp: move the tool, maybe drop a seed; the final report after
+  /// the run's final state.
+  void sow(const nav_msgs::Odometry& truth, const nav_msgs::Odometry& believed, bool tool_down, bool held_up);
+  /// The tool point (odom frame) on a state's pose.
+  Eigen::Vector2d toolPoint(const nav_msgs::Odometry& odom) const;
+  /// The depth the seed falling at `stamp` is placed at [m]: the one place it comes from. Today the middle of
+  /// the agronomic band (seed_drill/depth_min..depth_max); a depth control will send it with the wheel torque.
+  double seedDepth(const ros::Time& stamp) const;
+  /// A seed dropped by the state stamped `stamp`: recorded, shown, and every 50th reported.
+  void addSeed(const core::Seed& seed, const ros::Time& stamp);
   void publishReport(const ros::Time& stamp);
 
   core::SeedDrillSettings settings_;
@@ -64,8 +80,19 @@ class SeedDrillNode {
     bool tool_down = false;
   };
   ListenerPair<Paired, WheelTorque> hitch_inputs_;
-  ros::Subscriber plan_sub_, odom_sub_, ref_sub_, torque_sub_;
-  ros::Publisher seeds_pub_, report_pub_;
+  // What is to be sown (the true state and the tool), waiting for the believed pose of its stamp. That comes
+  // from another connection or process (the estimator) at its own pace: both sides hold a whole lookahead.
+  struct Sowing {
+    std_msgs::Header header;
+    nav_msgs::Odometry truth;
+    bool tool_down = false;
+    bool held_up = false;  ///< the hitch holds the tool up
+  };
+  ListenerPair<Sowing, nav_msgs::Odometry> believed_inputs_;
+  bool believed_is_truth_ = true;  ///< `feedback` is ground_truth (or not remapped): no second subscription
+  ros::Subscriber plan_sub_, odom_sub_, ref_sub_, torque_sub_, believed_sub_;
+  ros::Publisher seeds_pub_, record_pub_, report_pub_;
+  std::string odom_frame_;
   visualization_msgs::Marker chunk_;  // the current SPHERE_LIST of up to kChunk seeds
   int chunk_id_ = 0;
   std::size_t seeds_ = 0;
