@@ -64,7 +64,9 @@ std::vector<std::string> split(const std::string& text, char sep) {
 }
 
 /// A number for JSON: NaN and infinities have no JSON form (RFC 8259), so they become null.
-nlohmann::json number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
+nlohmann::ordered_json number(double v) {
+  return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json();
+}
 
 }  // namespace
 
@@ -129,20 +131,22 @@ std::string geoJsonText(const std::vector<core::Seed>& seeds, const GeoOrigin& o
     double lat, lon, h, blat, blon, bh;
     local.Reverse(s.truth.x(), s.truth.y(), 0.0, lat, lon, h);
     local.Reverse(s.believed.x(), s.believed.y(), 0.0, blat, blon, bh);
-    const nlohmann::json feature = {{"type", "Feature"},
-                                    {"geometry", {{"type", "Point"}, {"coordinates", {number(lon), number(lat)}}}},
-                                    {"properties",
-                                     {{"t", number(s.t)},
-                                      {"row", s.row},
-                                      {"depth", number(s.depth)},
-                                      {"detour", s.detour},
-                                      {"x", number(s.truth.x())},
-                                      {"y", number(s.truth.y())},
-                                      {"believed_x", number(s.believed.x())},
-                                      {"believed_y", number(s.believed.y())},
-                                      {"believed_lon", number(blon)},
-                                      {"believed_lat", number(blat)},
-                                      {"believed_offset", number((s.believed - s.truth).norm())}}}};
+    // In the order of RFC 7946's examples and as listed in seed_map.h, not sorted by key.
+    const nlohmann::ordered_json feature = {
+        {"type", "Feature"},
+        {"geometry", {{"type", "Point"}, {"coordinates", {number(lon), number(lat)}}}},
+        {"properties",
+         {{"t", number(s.t)},
+          {"row", s.row},
+          {"depth", number(s.depth)},
+          {"detour", s.detour},
+          {"x", number(s.truth.x())},
+          {"y", number(s.truth.y())},
+          {"believed_x", number(s.believed.x())},
+          {"believed_y", number(s.believed.y())},
+          {"believed_lon", number(blon)},
+          {"believed_lat", number(blat)},
+          {"believed_offset", number((s.believed - s.truth).norm())}}}};
     out += feature.dump();
     out += i + 1 < seeds.size() ? ",\n" : "\n";
   }

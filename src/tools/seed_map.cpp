@@ -25,8 +25,9 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "seed_map: %s\n", error.c_str());
     return 1;
   }
-  std::printf("seed_map: %zu seeds from %s (t = %.3f .. %.3f s)%s%s%s%s\n", seeds.size(), topic.c_str(),
-              seeds.front().t, seeds.back().t, options.csv.empty() ? "" : " -> ", options.csv.c_str(),
-              options.geojson.empty() ? "" : " -> ", options.geojson.c_str());
+  std::string written = options.csv;
+  if (!options.geojson.empty()) written += (written.empty() ? "" : ", ") + options.geojson;
+  std::printf("seed_map: %zu seeds from %s (t = %.3f .. %.3f s) -> %s\n", seeds.size(), topic.c_str(), seeds.front().t,
+              seeds.back().t, written.c_str());
   return 0;
 }
