@@ -36,6 +36,8 @@ RunMonitor::RunMonitor(ros::NodeHandle nh, ros::NodeHandle pnh) : pnh_(pnh) {
   // Subscribed from the start: the recorder's latched stamp is then already here when the run ends.
   if (!recorder_topic_.empty()) recorder_sub_ = nh.subscribe(recorder_topic_, 10, &RunMonitor::recordedCallback, this);
   status_pub_ = pnh.advertise<std_msgs::String>("status", 1, true);
+  // Latched: the plan in force when the run ends says whether the field was completed or stopped short of.
+  plan_sub_ = nh.subscribe("plan", 1, &RunMonitor::planCallback, this);
   const auto hints = ros::TransportHints().tcpNoDelay();
   truth_sub_ = nh.subscribe("ground_truth", kLockstepQueue, &RunMonitor::truthCallback, this, hints);
   ref_sub_ = nh.subscribe("reference", kLockstepQueue, &RunMonitor::referenceCallback, this, hints);
@@ -107,6 +109,12 @@ void RunMonitor::tractionCallback(const TractionControlState::ConstPtr& msg) {
   flush();
 }
 
+void RunMonitor::planCallback(const FieldPlan::ConstPtr& msg) {
+  std::lock_guard<std::mutex> lock(wait_mutex_);
+  plan_status_ = msg->status;
+  plan_reason_ = msg->reason;
+}
+
 void RunMonitor::flush() {
   while (!done_ && !held_.empty() && held_.front().stamp <= traction_until_) {
     const Held h = held_.front();
@@ -134,7 +142,23 @@ void RunMonitor::finish() {
   std_msgs::String status;
   char at[64];
   std::snprintf(at, sizeof at, "t = %.3f s", last_.toSec());
-  status.data = end_at_ ? no_traction_ + "; ended at " + at : std::string("completed at ") + at;
+  {
+    // How the run ended, as the exit code (node_failure.h): no traction (5), the plan stopped short of its field
+    // (6: stopped_short or no_safe_way, the robot held at the stop), or completed (0).
+    std::lock_guard<std::mutex> lock(wait_mutex_);
+    const bool short_of_field = plan_status_ == "stopped_short" || plan_status_ == "no_safe_way";
+    if (end_at_)
+      status.data = no_traction_ + "; ended at " + at;
+    else if (short_of_field)
+      status.data = plan_status_ + ": " + plan_reason_ + "; ended at " + at;
+    else
+      status.data = std::string("completed at ") + at;
+    if (end_at_)
+      failure_.emplace(ExitCode::kNoTraction, "the run ended on no traction: " + status.data);
+    else if (short_of_field)
+      failure_.emplace(ExitCode::kStoppedShort, "the run stopped short of its field: " + status.data);
+    if (failure_) logFailure(pnh_.getNamespace(), *failure_);
+  }
   status_pub_.publish(status);
   std::printf("%s", core::metricsTable({label_}, {m}).c_str());
   std::fflush(stdout);

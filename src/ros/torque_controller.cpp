@@ -74,6 +74,8 @@ TorqueController::TorqueController(ros::NodeHandle nh, ros::NodeHandle pnh) {
     // loop cannot pass that period without it, so the latched one is the one it waits for).
     traction_pub_ = nh.advertise<TractionControlState>("traction_control/state", kLockstepQueue, true);
     fed_is_odom_ = nh.resolveName("feedback") == nh.resolveName("odom");
+    // Fed neither the encoders nor the truth: the EKF's estimate (feedback:=fused), as the in-process loop decides.
+    hold_on_wheels_ = !fed_is_odom_ && nh.resolveName("feedback") != nh.resolveName("ground_truth");
     if (!fed_is_odom_)
       encoder_sub_ = nh.subscribe("odom", kLockstepQueue, &TorqueController::encoderCallback, this, hints);
     ROS_INFO("torque_controller: traction control on: wheel speeds from %s, ground speed from %s",
@@ -167,7 +169,13 @@ void TorqueController::compute() {
   core::InnerOutput out = inner_->update(cmd, v, omega, dt_);
   if (out.holding) {  // a stop: the inner loop is frozen, the brake holds the robot (closed_loop.h, step 4)
     if (!holding_) hold_->engage();  // the robot is held where the hold began
-    const core::HoldTorques h = hold_->update(v, omega, dt_);
+    double hold_v = v;
+    if (hold_on_wheels_) {  // the encoders' wheel speeds of this state (paired with it by feed())
+      while (!wheel_speeds_.empty() && wheel_speeds_.front().stamp < odom.header.stamp) wheel_speeds_.pop_front();
+      if (!wheel_speeds_.empty() && wheel_speeds_.front().stamp == odom.header.stamp)
+        hold_v = core::StandstillHold::wheelSpeed(wheel_speeds_.front().right, wheel_speeds_.front().left);
+    }
+    const core::HoldTorques h = hold_->update(hold_v, omega, dt_);
     out.torques = h.torques;
     out.u1 = h.u1;
     out.u2 = h.u2;
@@ -177,8 +185,11 @@ void TorqueController::compute() {
   core::WheelTorques sent = out.torques;
   if (traction_control_) {
     sent = limitTraction(out.torques, odom, !cmd.hold);
-    // As the in-process loop (closed_loop.h, step 4): the inner loop learns which torques were held back.
+    // As the in-process loop (closed_loop.h, step 4): held on the wheels the brake is not capped; the inner loop
+    // and the brake learn which torques were held back.
+    if (out.holding && hold_on_wheels_) sent = out.torques;
     if (traction_control_->params().anti_windup) inner_->heldBack(sent);
+    if (out.holding) hold_->heldBack(sent);
     // As the in-process loop (closed_loop.h): this period's verdict and the fed speed's travel decide the
     // tool for the step this torque drives.
     if (hitch_) torque_.tool_raised = hitch_->update(traction_control_->limiting(), std::fabs(v) * dt_, dt_);

@@ -11,6 +11,9 @@
 // (fused_field_lockstep.test: sim.launch profile:=field on a wet stretch of the line). ~expect_drive_train: the
 // in-process run must show the traction control cutting and the governor slowing the target, so the comparison
 // covers them at work.
+// The reference is reference_generator's: the line, or with its type field the field's plan (its field/, potential/,
+// obstacles and the URDF's footprint, as the node reads them; fused_field_wet_lockstep.test: sim.launch
+// profile:=field outer:=rpp inner:=pid on the wet thesis field, to its end and the stop hold there).
 #include <gtest/gtest.h>
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
@@ -18,13 +21,16 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <memory>
 
 #include "sowing_robot/core/common/validation.h"
+#include "sowing_robot/core/planning/field_path_follower.h"
 #include "sowing_robot/core/simulation/runner.h"
 #include "sowing_robot/ros/common/component_params.h"
 #include "sowing_robot/ros/common/msg_checks.h"
 #include "sowing_robot/ros/common/param_reader.h"
 #include "sowing_robot/ros/common/publisher_links.h"
+#include "sowing_robot/ros/common/urdf_params.h"
 #include "sowing_robot/ros/plant_sim/traction.h"
 
 using namespace sowing_robot;
@@ -102,11 +108,37 @@ TEST(FusedLockstep, NodePipelineEqualsTheInProcessEstimatedLoop) {
     ASSERT_LT((ros::WallTime::now() - start).toSec(), timeout) << "the pipeline did not finish the scenario";
   }
 
-  core::LineReference ref(1.0, 3.0, 0.0);
-  double truth_diff = 0.0, estimate_diff = 0.0, fed_max = 0.0;
-  std::int64_t compared = 0, unequal = 0, missing = 0;
+  // reference_generator's reference (src/ros/reference_generator.cpp reads it so): the line, or the field's plan.
+  std::unique_ptr<core::ReferenceSource> source = std::make_unique<core::LineReference>(1.0, 3.0, 0.0);
+  std::string type = "line";
+  ros::param::get("/reference_generator/type", type);
+  core::FieldSource* field_source = nullptr;
+  if (type == "field") {
+    ParamReader fieldp(ros::NodeHandle("/reference_generator"));
+    core::FieldParams field;
+    loadTable(fieldp, core::fieldTable(), field);
+    std::vector<core::Obstacle> obstacles;
+    std::string xml;
+    ASSERT_TRUE(ros::param::get("/robot_description", xml));
+    core::Footprint footprint;
+    ASSERT_EQ(core::firstError(
+                  {fieldp.error(), loadObstacles(fieldp, "obstacles", obstacles), footprintFromUrdf(xml, footprint)}),
+              "");
+    field.avoidance.footprint_radius = footprint.circumscribedRadius();
+    field.start_pose = sc.start;
+    std::unique_ptr<core::FieldSource> f = core::makeFieldSource(field, obstacles);
+    field_source = f.get();
+    source = std::move(f);
+  }
+  core::ReferenceSource& ref = *source;
+  double truth_diff = 0.0, estimate_diff = 0.0, fed_max = 0.0, first_stop = -1.0;
+  std::int64_t compared = 0, unequal = 0, missing = 0, holding = 0;
   const core::LoopResult in_process = core::runClosedLoop(sc, cfg, ref, false, [&](const core::EstimatedSample& s) {
     const std::uint64_t k = static_cast<std::uint64_t>(std::llround(s.loop->t * 1e9));
+    if (s.loop->control->holding) {  // the standstill hold at work (a stop)
+      ++holding;
+      if (first_stop < 0.0) first_stop = s.loop->t;
+    }
     const auto t = rec.truth.find(k);
     const auto e = rec.estimate.find(k);
     if (t == rec.truth.end() || e == rec.estimate.end()) {
@@ -132,6 +164,14 @@ TEST(FusedLockstep, NodePipelineEqualsTheInProcessEstimatedLoop) {
   std::printf(
       "fused lockstep: in-process max |slip| %.3f, traction control cutting %.3f s, slowest governed rate %.3f\n",
       in_process.max_abs_slip, in_process.traction_control_time, in_process.governor_min_rate);
+  if (field_source)
+    std::printf("fused lockstep: field plan %s (%s)\n", core::AvoidanceStatus::name(field_source->status().code),
+                field_source->status().reason.c_str());
+  std::printf("fused lockstep: the standstill hold at work in %lld periods, from t = %.3f s\n",
+              static_cast<long long>(holding), first_stop);
+  bool expect_hold = false;  // ~expect_hold: the run must reach a stop, so the comparison covers the hold
+  pnh.getParam("expect_hold", expect_hold);
+  if (expect_hold) EXPECT_GT(holding, 1000) << "the run never held the robot at a stop for a second";
   if (expect_drive_train) {
     EXPECT_TRUE(cfg.traction && cfg.motor.enabled && cfg.traction_control.enabled && cfg.speed_governor.enabled);
     EXPECT_GT(in_process.traction_control_time, 0.0) << "the traction control never cut: the comparison misses it";

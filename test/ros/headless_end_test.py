@@ -4,7 +4,10 @@
   * `controller:=foo` (as processes and as nodelets) ends at once with exit 1 and torque_controller's FATAL
     line as the last line;
   * a lockstep give-up (plant_sim waiting for 50 odom subscribers, lockstep_give_up 3 s) exits 3 with
-    plant_sim's FATAL line last.
+    plant_sim's FATAL line last;
+  * a run that does not complete its field: one that ends on "no traction" exits 5, one whose plan stops short
+    of the field (a row end inside an obstacle) exits 6, each with run_monitor's FATAL line (where and why) last,
+    as processes and as nodelets. (Before, both exited 0 like a completed run.)
 Through plain `roslaunch sim.launch headless:=true controller:=foo`: the launch ends at once (every node
 is required when headless), not after lockstep_give_up (120 s).
 
@@ -76,6 +79,31 @@ class HeadlessEnd(unittest.TestCase):
     def test_give_up_of_a_plant_nodelet_ends_the_run(self):
         # The plant nodelet stops only its run (the manager lives on); the runner ends the run with 3.
         self.check_give_up(11677, "nodelets:=true")
+
+    def check_end_code(self, port, overlay, duration, code, words, *args):
+        ros_dir = os.path.dirname(os.path.abspath(__file__))
+        got, out, _ = sim(port, "field:=line", "config:=" + os.path.join(ros_dir, overlay), "duration:=%g" % duration,
+                          *args)
+        self.assertEqual(got, code, out[-4000:])
+        self.assertNotIn("REQUIRED process", out)
+        last = last_line(out)
+        self.assertIn("[FATAL]", last)
+        for w in words:
+            self.assertIn(w, last)
+
+    def test_no_traction_exits_5(self):
+        # no_traction.test's field: the verdict at t = 19.6 s, the run ends 3 s later, before its duration.
+        self.check_end_code(11678, "no_traction_overlay.yaml", 40.0, 5,
+                            ["run_monitor: the run ended on no traction: no traction at (", "ended at t = 22."])
+
+    def test_stopped_short_exits_6(self):
+        # stop_hold.test's field: a 20 m row whose end lies inside an obstacle; the robot held at the stop point.
+        self.check_end_code(11679, "stop_hold_field.yaml", 30.0, 6,
+                            ["run_monitor: the run stopped short of its field: stopped_short", "ended at t = 30.000 s"])
+
+    def test_stopped_short_exits_6_nodelets(self):
+        self.check_end_code(11680, "stop_hold_field.yaml", 30.0, 6,
+                            ["run_monitor: the run stopped short of its field: stopped_short"], "nodelets:=true")
 
     def test_plain_roslaunch_refusal_ends_at_once(self):
         cmd = ["roslaunch", "-p", "11676", "sowing_robot", "sim.launch", "headless:=true", "controller:=foo"]

@@ -25,6 +25,7 @@
 #include <string>
 #include <thread>
 
+#include "sowing_robot/FieldPlan.h"
 #include "sowing_robot/ReferenceState.h"
 #include "sowing_robot/TractionControlState.h"
 #include "sowing_robot/core/simulation/metrics.h"
@@ -69,7 +70,10 @@ class RunMonitor {
   ListenerPair<nav_msgs::Odometry, ReferenceState> inputs_;
   std::int64_t expected_samples_ = 0;  // lockstep: every period of the run, both ends included (0: not checked)
   ros::Subscriber truth_sub_, ref_sub_, recorder_sub_, traction_sub_;
-  ros::Publisher status_pub_;  ///< ~status
+  ros::Publisher status_pub_;              ///< ~status
+  ros::Subscriber plan_sub_;               ///< the reference generator's plan: whether it stops short of the field
+  std::string plan_status_, plan_reason_;  ///< the last plan's status (ok | stopped_short | no_safe_way) and reason
+  void planCallback(const FieldPlan::ConstPtr& msg);
   // No traction (torque_controller's traction control on).
   struct Held {
     ros::Time stamp;

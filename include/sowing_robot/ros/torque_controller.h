@@ -89,6 +89,9 @@ class TorqueController {
   std::optional<core::HitchControl> hitch_;
   double L_ = 0.0;            // nominal half track [m] (URDF): R W = v ± L w of the encoders' twist
   bool fed_is_odom_ = false;  // the feedback topic is odom itself: no pairing needed
+  // The standstill hold closes its along axis on the encoders' wheel speeds and the traction control does not cap
+  // it: fed the EKF with the traction control on (LoopLayers::hold_on_wheels, closed_loop.h).
+  bool hold_on_wheels_ = false;
   StampPair<nav_msgs::Odometry, nav_msgs::Odometry, 16, 16> fed_encoders_;  // (feedback, odom) by stamp
   struct WheelSpeeds {
     ros::Time stamp;

@@ -33,6 +33,14 @@ StandstillHold::StandstillHold(const StandstillHoldParams& params, const RobotPa
   if (!(max_torque > 0.0)) throw std::invalid_argument("standstill hold: max_torque must be > 0");
 }
 
+namespace {
+/// `spring` moved to `target` if that lies between zero and it; to zero if `target` is beyond zero; else unchanged.
+double towardZero(double spring, double target) {
+  if (spring * target <= 0.0) return 0.0;
+  return std::fabs(target) < std::fabs(spring) ? target : spring;
+}
+}  // namespace
+
 HoldTorques StandstillHold::update(double v, double omega, double dt) {
   if (!std::isfinite(v)) v = 0.0;  // a lost reading: taken as standing still
   if (!std::isfinite(omega)) omega = 0.0;
@@ -40,6 +48,10 @@ HoldTorques StandstillHold::update(double v, double omega, double dt) {
   theta_ += omega * dt;
   const double wn = std::min(params_.bandwidth, kMaxBandwidthPeriods / dt);
   const double damp = 2.0 * params_.damping * wn, stiff = wn * wn;
+  v_ = v;
+  omega_ = omega;
+  damp_ = damp;
+  stiff_ = stiff;
   HoldTorques out;
   out.u1 = -m0R_ * (damp * v + stiff * x_);
   out.u2 = -i0RL_ * (damp * omega + stiff * theta_);
@@ -47,7 +59,23 @@ HoldTorques StandstillHold::update(double v, double omega, double dt) {
   out.torques.right = std::clamp(right, -max_torque_, max_torque_);
   out.torques.left = std::clamp(left, -max_torque_, max_torque_);
   out.saturated = out.torques.right != right || out.torques.left != left;
+  last_ = out;
+  if (out.saturated) backCalculate(out.torques.right + out.torques.left, out.torques.right - out.torques.left);
   return out;
+}
+
+void StandstillHold::heldBack(const WheelTorques& sent) {
+  if (sent.right == last_.torques.right && sent.left == last_.torques.left) return;  // all of it went out
+  backCalculate(sent.right + sent.left, sent.right - sent.left);
+}
+
+void StandstillHold::backCalculate(double sent_u1, double sent_u2) {
+  // On each axis that asked more than went out, the spring's stretch at which the brake would have asked
+  // exactly that, if it is nearer zero than the spring's own (never past zero: with the damping alone beyond
+  // the limit the spring is emptied). So x, theta never store torque the wheels did not get.
+  if (std::fabs(last_.u1) > std::fabs(sent_u1)) x_ = towardZero(x_, (-sent_u1 / m0R_ - damp_ * v_) / stiff_);
+  if (std::fabs(last_.u2) > std::fabs(sent_u2))
+    theta_ = towardZero(theta_, (-sent_u2 / i0RL_ - damp_ * omega_) / stiff_);
 }
 
 }  // namespace core

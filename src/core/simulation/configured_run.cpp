@@ -52,6 +52,7 @@ LoopResult run(const Scenario& sc, const LoopConfig& cfg, PlantT& plant, Referen
     layers.traction_control = &*traction_control;
     monitor.emplace(cfg.traction_control);
     layers.monitor = &*monitor;
+    layers.hold_on_wheels = cfg.feedback == Feedback::fused;
   }
   std::optional<HitchControl> hitch;
   if (cfg.hitch_control.enabled) {

@@ -105,6 +105,10 @@ struct LoopLayers {
   bool governed_time_back = false;
   /// Traction plant: a period after which either wheel's |slip ratio| exceeds this counts to high_slip_time.
   double high_slip = std::numeric_limits<double>::infinity();
+  /// The standstill hold closes its along axis on the wheels' own rates (the encoders', Fed::speeds) instead of the
+  /// fed speed, and the traction control does not cap it: fed the EKF with the traction control on (the estimate's
+  /// noise is beyond what the stiff brake can hold on; standstill_hold.h, docs/stops.md).
+  bool hold_on_wheels = false;
 };
 
 namespace loop_detail {
@@ -174,7 +178,10 @@ LoopResult closedLoop(const Scenario& sc, PlantT& plant, Feed& feed, Outer& oute
     InnerOutput u = inner.update(cmd, fed.v, fed.omega, dt);
     if (u.holding) {  // a stop: the inner loop is frozen, the brake holds the robot where it is
       if (!holding) hold.engage();
-      const HoldTorques h = hold.update(fed.v, fed.omega, dt);
+      const bool on_wheels = layers.hold_on_wheels;
+      const double hold_v =
+          on_wheels ? StandstillHold::wheelSpeed(fed.speeds.wheel_right, fed.speeds.wheel_left) : fed.v;
+      const HoldTorques h = hold.update(hold_v, fed.omega, dt);
       u.torques = h.torques;
       u.u1 = h.u1;
       u.u2 = h.u2;
@@ -185,7 +192,12 @@ LoopResult closedLoop(const Scenario& sc, PlantT& plant, Feed& feed, Outer& oute
     WheelTorques sent = u.torques;
     if (TractionControl* tc = layers.traction_control) {
       sent = tc->limit(u.torques, fed.speeds, dt);
+      // Held on the wheels' own counts the brake is a lock on each wheel, which keeps its grip by itself; the
+      // ceiling would cut it on false slips (at rest the encoders' speed quantum against the EKF's ground speed
+      // reads as a slip of about slip_target) to below the disturbance it must hold against.
+      if (u.holding && layers.hold_on_wheels) sent = u.torques;
       if (tc->params().anti_windup) inner.heldBack(sent);
+      if (u.holding) hold.heldBack(sent);  // the brake's spring keeps only what reached the wheels (always)
       if (tc->slipping()) out.traction_control_time += dt;
       if (layers.governor) {
         layers.governor->report(tc->slipping(), tc->limiting(), dt);

@@ -15,6 +15,10 @@ enum class ExitCode : int {
   kBadParameter = 1,  ///< refused to start: a parameter (or the URDF) is invalid
   kDiverged = 2,      ///< the simulated state became non-finite or too fast
   kGaveUp = 3,        ///< lockstep: an input stayed missing longer than lockstep_give_up
+  // 4: the sim runner's own (--local-only refused).
+  kNoTraction = 5,  ///< run_monitor: the run ended on the traction control's "no traction" verdict
+  kStoppedShort =
+      6,  ///< run_monitor: the run completed, but the plan stopped short of its field (stopped_short, no_safe_way)
 };
 
 class NodeFailure : public std::runtime_error {
