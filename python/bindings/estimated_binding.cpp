@@ -43,8 +43,8 @@ void applyTableDict(const ParamTable<S>& table, S& s, const std::string& prefix,
   }
 }
 
-/// {"polygon": [[x, y], ...], "mu_peak": .., "mu_slide": .., "rolling_resistance": ..}; a coefficient left out
-/// is the traction block's (as plant_sim reads field/patches).
+/// {"polygon": [[x, y], ...], "mu_peak": .., "mu_slide": .., "rolling_resistance": .., "draft_factor": ..}; a
+/// coefficient left out is the traction block's (as plant_sim reads field/patches).
 SoilPatch patchOf(const py::handle& item, const TractionParams& ground, std::size_t i) {
   const std::string name = "patches[" + std::to_string(i) + "]";
   if (!py::isinstance<py::dict>(item)) throw py::type_error(name + " must be a dict with a polygon");
@@ -67,8 +67,11 @@ SoilPatch patchOf(const py::handle& item, const TractionParams& ground, std::siz
       p.mu_slide = kv.second.cast<double>();
     } else if (key == "rolling_resistance") {
       p.rolling_resistance = kv.second.cast<double>();
+    } else if (key == "draft_factor") {
+      p.draft_factor = kv.second.cast<double>();
     } else {
-      throw py::value_error(name + ": unknown key '" + key + "' (polygon, mu_peak, mu_slide, rolling_resistance)");
+      throw py::value_error(name + ": unknown key '" + key +
+                            "' (polygon, mu_peak, mu_slide, rolling_resistance, draft_factor)");
     }
   }
   const std::string e = p.validate(name);
@@ -79,8 +82,8 @@ SoilPatch patchOf(const py::handle& item, const TractionParams& ground, std::siz
 /// The loop's trace (Trace's columns) and what the controllers were fed, the slip and the tool.
 struct EstimatedTrace {
   Trace loop;
-  std::vector<std::string> names = {"fed_x",     "fed_y",      "fed_theta", "fed_v",
-                                    "fed_omega", "slip_right", "slip_left", "tool_down"};
+  std::vector<std::string> names = {"fed_x",      "fed_y",     "fed_theta", "fed_v",     "fed_omega",
+                                    "slip_right", "slip_left", "tool_down", "tool_depth"};
   std::vector<std::vector<double>> columns = std::vector<std::vector<double>>(names.size());
 
   void reserve(std::size_t n) {
@@ -90,7 +93,8 @@ struct EstimatedTrace {
   void add(const EstimatedSample& s) {
     loop.add(*s.loop);
     const double row[] = {s.fed.x,     s.fed.y,      s.fed.theta, s.fed_v,
-                          s.fed_omega, s.slip_right, s.slip_left, s.tool_down ? 1.0 : 0.0};
+                          s.fed_omega, s.slip_right, s.slip_left, s.tool_down ? 1.0 : 0.0,
+                          s.tool_depth};
     for (std::size_t i = 0; i < columns.size(); ++i) columns[i].push_back(row[i]);
   }
   py::dict toDict() const {
@@ -244,6 +248,7 @@ py::dict runEstimatedPy(const std::string& controller, const py::object& params,
   d["hitch_control"] = cfg.hitch_control.enabled;
   d["hitch_raises"] = r.hitch_raises;
   d["unsown_distance"] = r.unsown_distance;
+  d["mean_sowing_depth"] = r.meanSowingDepth();
   d["traction_control_time"] = r.traction_control_time;
   d["governor_min_rate"] = r.governor_min_rate;
   if (trace) d["trace"] = columns.toDict();
@@ -284,8 +289,8 @@ Returns run()'s dict plus "feedback", "traction", "max_abs_slip", "tool_down_tim
 "odometry_error_max", "fixes" ({"applied", "reanchored", "slip_onsets", "gated", "too_old", "future",
 "invalid", "lost_from_queue"}), "profile" (its name, "" for none), "motor", "limits", "traction_control", "speed_governor", "hitch_control" (on
 or off), "traction_control_time" (s a wheel slipped beyond the target), "governor_min_rate", "hitch_raises",
-"unsown_distance" (m of row the raised tool missed); with trace=True run()'s columns plus fed_x, fed_y, fed_theta, fed_v, fed_omega,
-slip_right, slip_left, tool_down. Raises ValueError for a bad name, key or value (naming the key).)doc");
+"unsown_distance" (m of row the raised tool missed), "mean_sowing_depth" (m); with trace=True run()'s columns plus fed_x, fed_y, fed_theta, fed_v, fed_omega,
+slip_right, slip_left, tool_down, tool_depth (m, 0 with the tool up). Raises ValueError for a bad name, key or value (naming the key).)doc");
   });
 }
 

@@ -84,6 +84,7 @@ bool isPath(const std::string& name_or_path) {
 struct PatchSpec {
   std::vector<Eigen::Vector2d> polygon;
   std::optional<double> mu_peak, mu_slide, rolling_resistance;
+  double draft_factor = 1.0;  // the drill's draft against the field's (SoilPatch::draft_factor)
 };
 
 /// plant_sim/field/patches of a field config (config/field_thesis_wet.yaml): the keys plant_sim reads.
@@ -94,12 +95,14 @@ void loadPatches(const YAML::Node& plant_sim, const std::string& path, std::vect
   const YAML::Node list = field["patches"];
   if (!list) return;
   if (!list.IsSequence())
-    fail(path, "plant_sim/field/patches must be a list of {polygon, mu_peak, mu_slide, rolling_resistance}");
+    fail(path,
+         "plant_sim/field/patches must be a list of {polygon, mu_peak, mu_slide, rolling_resistance, draft_factor}");
   for (std::size_t i = 0; i < list.size(); ++i) {
     const std::string name = "field/patches[" + std::to_string(i) + "]";
     const YAML::Node item = list[i];
-    if (!item.IsMap()) fail(path, name + " must be a map {polygon, mu_peak, mu_slide, rolling_resistance}");
-    onlyKeys(item, {"polygon", "mu_peak", "mu_slide", "rolling_resistance"}, path, name + "/");
+    if (!item.IsMap())
+      fail(path, name + " must be a map {polygon, mu_peak, mu_slide, rolling_resistance, draft_factor}");
+    onlyKeys(item, {"polygon", "mu_peak", "mu_slide", "rolling_resistance", "draft_factor"}, path, name + "/");
     PatchSpec p;
     const YAML::Node poly = required(item, "polygon", path, name + "/");
     if (!poly.IsSequence()) fail(path, name + "/polygon must be a list of [x, y] vertices");
@@ -112,6 +115,7 @@ void loadPatches(const YAML::Node& plant_sim, const std::string& path, std::vect
     if (item["mu_slide"]) p.mu_slide = toDouble(item["mu_slide"], path, name + "/mu_slide");
     if (item["rolling_resistance"])
       p.rolling_resistance = toDouble(item["rolling_resistance"], path, name + "/rolling_resistance");
+    if (item["draft_factor"]) p.draft_factor = toDouble(item["draft_factor"], path, name + "/draft_factor");
     out.push_back(p);
   }
 }
@@ -128,6 +132,7 @@ std::vector<core::SoilPatch> resolvePatches(const std::vector<PatchSpec>& specs,
     patch.mu_peak = specs[i].mu_peak.value_or(ground.mu_peak);
     patch.mu_slide = specs[i].mu_slide.value_or(ground.mu_slide);
     patch.rolling_resistance = specs[i].rolling_resistance.value_or(ground.rolling_resistance);
+    patch.draft_factor = specs[i].draft_factor;
     std::string e = patch.validate(name);
     if (!e.empty()) fail(path, e);
     core::TractionParams t = ground;

@@ -235,6 +235,16 @@ TEST(ScenarioLoader, BadTractionSensorAndEstimatorKeysAreRefusedNamingTheKey) {
   dir.write("field_thesis_wet.yaml", bad);
   e = loadError(dir.path + "/wet_soil.yaml");
   EXPECT_NE(e.find("unknown key 'field/patches[0]/rolling_resistence'"), std::string::npos) << e;
+  // The drill's draft factor on a patch (SoilPatch::draft_factor): read when given, 1 when not, >= 0.
+  bad = std::regex_replace(wet, std::regex("rolling_resistance: 0.08"), "rolling_resistance: 0.08, draft_factor: 1.2");
+  dir.write("field_thesis_wet.yaml", bad);
+  ASSERT_EQ(loadError(dir.path + "/wet_soil.yaml"), "");
+  EXPECT_EQ(scenario_file::loadScenario("wet_soil", dir.path).realism->patches[0].draft_factor, 1.2);
+  EXPECT_EQ(scenario_file::loadScenario("wet_soil", kSuite).realism->patches[0].draft_factor, 1.0);
+  bad = std::regex_replace(wet, std::regex("rolling_resistance: 0.08"), "rolling_resistance: 0.08, draft_factor: -1");
+  dir.write("field_thesis_wet.yaml", bad);
+  e = loadError(dir.path + "/wet_soil.yaml");
+  EXPECT_NE(e.find("field/patches[0]/draft_factor"), std::string::npos) << e;
   dir.write("field_thesis_wet.yaml", wet);  // the unmodified copy loads: each failure above was the edit's
   EXPECT_EQ(loadError(dir.path + "/wet_soil.yaml"), "");
 }

@@ -169,6 +169,10 @@ std::string describeRealism(const BenchScenario& b) {
     for (std::size_t i = 0; i < c.patches.size(); ++i)
       out += "; patch " + std::to_string(i) +
              budget("", c.patches[i].mu_peak, c.patches[i].mu_slide, c.patches[i].rolling_resistance);
+    // The field check: can each soil pull the drill at the band's shallowest depth (the least a depth control
+    // can ask), at the nominal speed? One that cannot is where the tool must be lifted.
+    for (const DraftCheck& d : checkFieldDraft(b.base.robot, 1.0, *c.traction, c.patches, c.seeding.depth_min))
+      out += "; field check: " + d.why;
   } else {
     out += "no slip";
   }
@@ -183,7 +187,13 @@ std::string describeRealism(const BenchScenario& b) {
                               shortNumber(c.limits.max_angular_accel) + " rad/s^2)"
                         : "off") +
       ", traction control " + (c.traction_control.enabled ? "on" : "off") + ", speed governor " +
-      (c.speed_governor.enabled ? "on" : "off") + ", hitch control " + (c.hitch_control.enabled ? "on" : "off");
+      (c.speed_governor.enabled ? "on" : "off") + ", hitch control " +
+      (c.hitch_control.enabled
+           ? (c.hitch_control.depth_control
+                  ? "on with depth control (" + shortNumber(100.0 * c.hitch_control.depth_nominal) + " cm, down to " +
+                        shortNumber(100.0 * c.hitch_control.depth_shallowest) + " cm before lifting)"
+                  : "on")
+           : "off");
   out += "; feedback " + std::string(feedbackName(c.feedback)) +
          " (sensors: " + std::to_string(c.sensors.encoder.ticks_per_turn) + " ticks/turn, gyro noise " +
          shortNumber(c.sensors.imu.noise) + " rad/s bias " + shortNumber(c.sensors.imu.bias) + " rad/s, fix " +

@@ -16,7 +16,10 @@ std::string SoilPatch::validate(const std::string& key) const {
   const struct {
     const char* name;
     double value;
-  } coefficients[] = {{"mu_peak", mu_peak}, {"mu_slide", mu_slide}, {"rolling_resistance", rolling_resistance}};
+  } coefficients[] = {{"mu_peak", mu_peak},
+                      {"mu_slide", mu_slide},
+                      {"rolling_resistance", rolling_resistance},
+                      {"draft_factor", draft_factor}};
   for (const auto& c : coefficients)
     if (!std::isfinite(c.value) || c.value < 0.0)
       return key + "/" + c.name + " = " + formatNumber(c.value) + " must be finite and >= 0";

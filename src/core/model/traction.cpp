@@ -40,9 +40,27 @@ const ParamTable<TractionParams>& tractionTable() {
              "caster contact ahead of the axle, for the normal loads (URDF caster_joint x)"),
       integer("traction/substeps", &T::substeps, 4, Limits::closed(1.0, 1000.0), "",
               "linearly implicit integration sub-steps per plant step"),
-      number("traction/draft_force", &T::draft_force, 0.0, Limits::closed(0.0, 1e5), "N",
-             "draft of the seed drill's tool while it is down, at the tool point (URDF tool_link) against its "
-             "motion; 0 = none (a furrow opener in loose soil: some 10..100 N)"),
+      number(
+          "traction/draft_force", &T::draft_force, 0.0, Limits::closed(0.0, 1e5), "N",
+          "draft of the seed drill's tool while it is down, at the tool point (URDF tool_link) against its "
+          "motion, at the drill's nominal working depth (draft_depth) and speed (draft_speed) on the field's soil; 0 = "
+          "none (a furrow opener in loose soil: some 10..100 N)"),
+      number("traction/draft_depth", &T::draft_depth, 0.04, Limits::positive(), "m",
+             "the seed drill's nominal working depth, the depth draft_force is for; the draft grows in proportion to "
+             "the depth (ASABE D497), and the drill runs at this depth unless a depth control "
+             "(torque_controller/hitch_control/depth_control) sets it shallower"),
+      number("traction/draft_speed", &T::draft_speed, 1.0, Limits::positive(), "m/s",
+             "the tool point's speed draft_force is for (the row speed)"),
+      number("traction/draft_speed_linear", &T::draft_speed_linear, 0.0, Limits::closed(0.0, 100.0), "s/m",
+             "the draft's linear rise with speed, B/A of ASABE D497's D = F (A + B S + C S^2) W T; 0: none (D497's "
+             "seeding implements have B = C = 0; a tine opener tilling its slot has more)"),
+      number("traction/draft_speed_quadratic", &T::draft_speed_quadratic, 0.0, Limits::closed(0.0, 100.0), "s^2/m^2",
+             "the draft's quadratic rise with speed, C/A of ASABE D497's law (soil thrown aside); 0: none"),
+      number("traction/tool_depth_min", &T::tool_depth_min, 0.01, Limits::nonNegative(), "m",
+             "shallowest depth the seed drill can mechanically be set to (a depth asked for outside the range is "
+             "clamped to it)"),
+      number("traction/tool_depth_max", &T::tool_depth_max, 0.08, Limits::positive(), "m",
+             "deepest depth the seed drill can mechanically be set to"),
   });
   return table;
 }
@@ -57,7 +75,21 @@ std::string TractionParams::validate() const {
   if (slip_stiffness * slip_peak < mu_peak)
     return "traction/slip_stiffness = " + formatNumber(slip_stiffness) +
            " must be >= traction/mu_peak / traction/slip_peak = " + formatNumber(mu_peak / slip_peak);
+  if (!(tool_depth_min < tool_depth_max))
+    return "traction/tool_depth_min = " + formatNumber(tool_depth_min) +
+           " must be below traction/tool_depth_max = " + formatNumber(tool_depth_max) +
+           " (the drill's mechanical depth range)";
+  if (draft_depth < tool_depth_min || draft_depth > tool_depth_max)
+    return "traction/draft_depth = " + formatNumber(draft_depth) + " must lie in the drill's mechanical range [" +
+           formatNumber(tool_depth_min) + ", " + formatNumber(tool_depth_max) + "] (traction/tool_depth_min, max)";
   return "";
+}
+
+double toolDraft(const TractionParams& p, double depth, double speed, double soil_factor) {
+  // D497's speed polynomial relative to its value at the nominal speed (1 when b = c = 0, exactly).
+  const double b = p.draft_speed_linear, c = p.draft_speed_quadratic, s = std::fabs(speed), s0 = p.draft_speed;
+  const double shape = (1.0 + (b + c * s) * s) / (1.0 + (b + c * s0) * s0);
+  return p.draft_force * soil_factor * (depth / p.draft_depth) * shape;
 }
 
 double tractionFriction(const TractionParams& p, double kappa, double* slope) {
@@ -81,6 +113,8 @@ TractionPlant::TractionPlant(const RobotParams& nominal, const PlantDisturbance&
       traction_(traction),
       curves_{FrictionCurve(traction)},
       rr_{traction.rolling_resistance},
+      draft_factor_{1.0},
+      tool_depth_(traction.draft_depth),
       rng_(disturbance.seed) {
   const std::string error = firstError({nominal.validate(), disturbance.validate(), traction.validate()});
   if (!error.empty()) throw std::invalid_argument(error);
@@ -114,7 +148,7 @@ void TractionPlant::setNormalLoads(const NormalLoads& loads) {
 
 void TractionPlant::setSoil(const SoilMap& soil) {
   std::vector<FrictionCurve> curves{FrictionCurve(traction_)};
-  std::vector<double> rr{traction_.rolling_resistance};
+  std::vector<double> rr{traction_.rolling_resistance}, draft_factor{1.0};
   for (std::size_t i = 0; i < soil.patches().size(); ++i) {
     const SoilPatch& patch = soil.patches()[i];
     TractionParams p = traction_;
@@ -126,11 +160,13 @@ void TractionPlant::setSoil(const SoilMap& soil) {
       throw std::invalid_argument("field/patches[" + std::to_string(i) + "] does not fit the slip curve: " + e);
     curves.emplace_back(p);
     rr.push_back(patch.rolling_resistance);
+    draft_factor.push_back(patch.draft_factor);
   }
   soil_ = soil;
   curves_ = std::move(curves);
   rr_ = std::move(rr);
-  ground_[0] = ground_[1] = ground_[2] = 0;
+  draft_factor_ = std::move(draft_factor);
+  ground_[0] = ground_[1] = ground_[2] = ground_tool_ = 0;
   locateContacts();
 }
 
@@ -144,6 +180,15 @@ void TractionPlant::locateContacts() {
   ground_[RIGHT] = 1 + soil_.patchAt(axle - left);
   ground_[LEFT] = 1 + soil_.patchAt(axle + left);
   ground_[kCaster] = 1 + soil_.patchAt(axle + traction_.caster_x * Eigen::Vector2d(c, s));
+  if (traction_.draft_force > 0.0)
+    ground_tool_ =
+        1 + soil_.patchAt(axle + Eigen::Vector2d(c * tool_.x() - s * tool_.y(), s * tool_.x() + c * tool_.y()));
+}
+
+bool TractionPlant::setToolDepth(double depth) {
+  if (!std::isfinite(depth)) return false;
+  tool_depth_ = std::clamp(depth, traction_.tool_depth_min, traction_.tool_depth_max);
+  return true;
 }
 
 void TractionPlant::reset(const State& initial, double t) {
@@ -177,6 +222,55 @@ GripBudget gripBudget(const RobotParams& robot, double mass_scale, const Tractio
   b.slide = mu_slide * drive;
   b.needed = rolling_resistance * (drive + n.caster) + traction.draft_force;
   return b;
+}
+
+GripBudget gripBudget(const RobotParams& robot, double mass_scale, const TractionParams& traction, double mu_peak,
+                      double mu_slide, double rolling_resistance, double draft) {
+  TractionParams t = traction;
+  t.draft_force = draft;
+  return gripBudget(robot, mass_scale, t, mu_peak, mu_slide, rolling_resistance);
+}
+
+std::vector<DraftCheck> checkFieldDraft(const RobotParams& robot, double mass_scale, const TractionParams& traction,
+                                        const std::vector<SoilPatch>& patches, double depth) {
+  std::vector<DraftCheck> out;
+  if (!(traction.draft_force > 0.0)) return out;
+  const double d = std::clamp(depth, traction.tool_depth_min, traction.tool_depth_max);
+  const auto check = [&](int index, double mu_peak, double mu_slide, double rolling, double factor) {
+    DraftCheck c;
+    c.patch = index;
+    c.depth = d;
+    c.draft = toolDraft(traction, d, traction.draft_speed, factor);
+    c.budget = gripBudget(robot, mass_scale, traction, mu_peak, mu_slide, rolling, c.draft);
+    c.carried = c.budget.peak >= c.budget.needed;
+    const double rolling_force = c.budget.needed - c.draft;
+    char b[400];
+    std::snprintf(b, sizeof b,
+                  "%s (mu %.2f/%.2f, rolling resistance %.2f, draft factor %.2f): peak traction %.1f N (sliding %.1f "
+                  "N) against %.1f N rolling + %.1f N draft at %.1f cm and %.2f m/s = %.1f N: %s %.1f N",
+                  index < 0 ? "field soil" : ("soil patch " + std::to_string(index)).c_str(), mu_peak, mu_slide,
+                  rolling, factor, c.budget.peak, c.budget.slide, rolling_force, c.draft, 100.0 * d,
+                  traction.draft_speed, c.budget.needed,
+                  c.carried ? "carries the drill, margin" : "cannot carry the drill even at its shallowest, short by",
+                  std::fabs(c.budget.margin()));
+    c.why = b;
+    if (!c.carried)
+      c.why += rolling_force > c.budget.peak ? " (not even the rolling resistance: the robot cannot cross it)"
+                                             : " (the tool must be lifted there: that stretch goes unsown)";
+    out.push_back(c);
+  };
+  check(-1, traction.mu_peak, traction.mu_slide, traction.rolling_resistance, 1.0);
+  for (std::size_t i = 0; i < patches.size(); ++i)
+    check(static_cast<int>(i), patches[i].mu_peak, patches[i].mu_slide, patches[i].rolling_resistance,
+          patches[i].draft_factor);
+  return out;
+}
+
+std::string fieldDraftWarnings(const std::vector<DraftCheck>& checks) {
+  std::string out;
+  for (const DraftCheck& c : checks)
+    if (!c.carried) out += (out.empty() ? "" : "\n") + c.why;
+  return out;
 }
 
 std::string gripDiagnosis(const RobotParams& robot, double mass_scale, const TractionParams& traction,
@@ -272,7 +366,8 @@ constexpr double kDraftRestSpeed = 1e-150;  // [m/s] below it the tool's damper 
 void TractionPlant::draft(double dt, double& force, double& moment) const {
   const double xt = tool_.x(), yt = tool_.y(), v = state_[V], w = state_[OMEGA];
   const double vx = v - w * yt, vy = w * xt, speed = std::hypot(vx, vy);
-  const double D = traction_.draft_force, floor = traction_.slip_speed_floor;
+  const double D = toolDraft(traction_, tool_depth_, speed, draft_factor_[ground_tool_]),
+               floor = traction_.slip_speed_floor;
   // Force = −c (vx, vy), c = D / max(speed, floor): full D when moving, a linear damper below the floor.
   // Stiff when D is large against the body (c dt / m >> 1), so semi-implicit, with the tool point's
   // mobility along the motion, M = (vx²/m + (xt vy − yt vx)²/I) / speed²: c / (1 + dt c M) cannot reverse

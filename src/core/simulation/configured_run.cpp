@@ -78,9 +78,14 @@ LoopResult runClosedLoop(const Scenario& sc, const LoopConfig& cfg, ReferenceSou
                          const std::function<void(const EstimatedSample&)>& trace) {
   std::string e = firstError({sc.validate(), cfg.validate()});
   if (e.empty() && cfg.traction) {  // the motors against the heaviest going: the worst soil's rolling resistance
-    double rolling = cfg.traction->rolling_resistance;
-    for (const SoilPatch& p : cfg.patches) rolling = std::max(rolling, p.rolling_resistance);
-    e = checkMotorsCanMove(cfg.motor, sc.robot, sc.disturbance.mass_scale, rolling, cfg.traction->draft_force);
+    double rolling = cfg.traction->rolling_resistance, draft_factor = 1.0;
+    for (const SoilPatch& p : cfg.patches) {
+      rolling = std::max(rolling, p.rolling_resistance);
+      draft_factor = std::max(draft_factor, p.draft_factor);
+    }
+    // The draft at the nominal depth on the stickiest soil (toolDraft: draft_force on the field's soil).
+    e = checkMotorsCanMove(cfg.motor, sc.robot, sc.disturbance.mass_scale, rolling,
+                           cfg.traction->draft_force * draft_factor);
   }
   if (!e.empty()) throw std::invalid_argument(e);
   if (!cfg.traction) {

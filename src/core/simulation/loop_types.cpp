@@ -46,6 +46,20 @@ std::string LoopConfig::validate() const {
     return "speed_governor/enabled needs traction_control/enabled (the governor acts on its slip verdict)";
   if (hitch_control.enabled && !traction_control.enabled)
     return "hitch_control/enabled needs traction_control/enabled (the hitch acts on its grip verdict)";
+  if (hitch_control.enabled && hitch_control.depth_control) {
+    e = seeding.validate();
+    if (!e.empty()) return e;
+    const HitchControlParams& h = hitch_control;
+    if (h.depth_shallowest < seeding.depth_min || h.depth_nominal > seeding.depth_max)
+      return "hitch_control/depth_shallowest = " + formatNumber(h.depth_shallowest) +
+             " and depth_nominal = " + formatNumber(h.depth_nominal) + " must lie in the agronomic band [" +
+             formatNumber(seeding.depth_min) + ", " + formatNumber(seeding.depth_max) +
+             "] (seed_drill/depth_min, depth_max)";
+    if (traction && (h.depth_shallowest < traction->tool_depth_min || h.depth_nominal > traction->tool_depth_max))
+      return "hitch_control/depth_shallowest .. depth_nominal must lie in the drill's mechanical range [" +
+             formatNumber(traction->tool_depth_min) + ", " + formatNumber(traction->tool_depth_max) +
+             "] (traction/tool_depth_min, max)";
+  }
   if (!allFinite(tool.x(), tool.y())) return "the tool point must be finite";
   for (std::size_t i = 0; i < patches.size(); ++i) {
     e = patches[i].validate("field/patches[" + std::to_string(i) + "]");

@@ -605,3 +605,101 @@ TEST(TractionDraft, ClosedLoopAgainstAnInsurmountableDraftEndsAndReportsSaturati
               static_cast<long long>(r.run.saturated_steps), static_cast<long long>(sc.steps() + 1),
               r.run.final_state[X]);
 }
+
+// --- The draft's law (ASABE D497 form) and the field check -------------------------------------------------
+
+// Calibrated on draft_force at the nominal depth and speed on the field's soil, to the bit (so a run without
+// depth control keeps today's draft); deeper, faster (with D497's speed terms) and a stickier soil pull more.
+TEST(TractionDraftLaw, CalibratedAtNominalAndDeeperFasterWetterPullMore) {
+  TractionParams t;
+  t.draft_force = 10.0;
+  EXPECT_EQ(toolDraft(t, t.draft_depth, t.draft_speed), 10.0);
+  EXPECT_EQ(toolDraft(t, t.draft_depth, 0.3), 10.0);  // the defaults: D497's seeding rows, no speed terms
+  EXPECT_DOUBLE_EQ(toolDraft(t, 0.03, 1.0), 7.5);     // in proportion to the depth
+  EXPECT_GT(toolDraft(t, 0.05, 1.0), toolDraft(t, 0.04, 1.0));
+  t.draft_speed_linear = 0.2;  // a tine opener
+  t.draft_speed_quadratic = 0.05;
+  EXPECT_DOUBLE_EQ(toolDraft(t, t.draft_depth, t.draft_speed), 10.0);
+  EXPECT_GT(toolDraft(t, 0.04, 1.5), 10.0);
+  EXPECT_LT(toolDraft(t, 0.04, 0.5), 10.0);
+  EXPECT_DOUBLE_EQ(toolDraft(t, 0.04, -1.5), toolDraft(t, 0.04, 1.5));  // the speed's magnitude
+  EXPECT_DOUBLE_EQ(toolDraft(t, 0.04, 1.0, 1.3), 13.0);                 // a sticky patch
+  // The mechanical range must hold the nominal depth.
+  t.draft_depth = 0.1;
+  EXPECT_NE(t.validate().find("traction/draft_depth"), std::string::npos) << t.validate();
+  t.draft_depth = 0.04;
+  t.tool_depth_min = 0.09;
+  EXPECT_NE(t.validate().find("traction/tool_depth_min"), std::string::npos) << t.validate();
+}
+
+// In the plant: the drill's depth scales the draft it pulls (clamped to the mechanical range; a non-finite depth is
+// refused), and a patch's draft factor applies where the tool point is.
+TEST(TractionDraftLaw, ThePlantPullsTheDraftOfItsDepthAndSoil) {
+  const auto drive = [](double depth, const std::vector<SoilPatch>& patches) {
+    TractionParams t;
+    t.draft_force = 10.0;
+    TractionPlant plant(RobotParams{}, PlantDisturbance{}, t);
+    plant.setSoil(SoilMap(patches));
+    plant.setToolDown(true);
+    EXPECT_TRUE(plant.setToolDepth(depth));
+    plant.reset(State::Zero());
+    for (int i = 0; i < 3000; ++i) plant.step(1.5, 1.5, kDt);  // moving well above slip_speed_floor
+    return plant;
+  };
+  const TractionPlant nominal = drive(0.04, {}), shallow = drive(0.03, {});
+  EXPECT_NEAR(nominal.draftForce(), -10.0, 0.02);
+  EXPECT_NEAR(shallow.draftForce(), -7.5, 0.02);
+  EXPECT_GT(shallow.state()[V], nominal.state()[V]);
+  SoilPatch sticky;  // under the whole run, grip as the field's: only the draft differs
+  sticky.polygon = {{-5.0, -5.0}, {50.0, -5.0}, {50.0, 5.0}, {-5.0, 5.0}};
+  sticky.mu_peak = 0.6;
+  sticky.mu_slide = 0.45;
+  sticky.draft_factor = 1.3;
+  const TractionPlant wet = drive(0.04, {sticky});
+  EXPECT_EQ(wet.patchUnderTool(), 0);
+  EXPECT_NEAR(wet.draftForce(), -13.0, 0.03);
+  TractionPlant p(RobotParams{}, PlantDisturbance{}, TractionParams{});
+  EXPECT_EQ(p.toolDepth(), TractionParams{}.draft_depth);
+  EXPECT_TRUE(p.setToolDepth(1.0));
+  EXPECT_EQ(p.toolDepth(), TractionParams{}.tool_depth_max);
+  EXPECT_TRUE(p.setToolDepth(0.0));
+  EXPECT_EQ(p.toolDepth(), TractionParams{}.tool_depth_min);
+  EXPECT_FALSE(p.setToolDepth(std::nan("")));
+  EXPECT_EQ(p.toolDepth(), TractionParams{}.tool_depth_min);
+}
+
+// The field check before a run, on FIELD.md's thesis wet patch (mu 0.2 / 0.15, rolling resistance 0.08, 10 N at
+// the nominal 4 cm): at the band's shallowest 3 cm the draft is 7.5 N and the peak grip (29.8 N) carries it;
+// a wetter patch (mu 0.1: 14.9 N) cannot carry the drill even at its shallowest, and says so.
+TEST(TractionDraftLaw, TheFieldCheckNamesThePatchThatCannotCarryTheDrill) {
+  TractionParams t;
+  t.draft_force = 10.0;
+  SoilPatch thesis, wetter;
+  thesis.polygon = wetter.polygon = {{0.0, 0.0}, {1.0, 0.0}, {1.0, 1.0}};
+  thesis.mu_peak = 0.2;
+  thesis.mu_slide = 0.15;
+  thesis.rolling_resistance = 0.08;
+  wetter = thesis;
+  wetter.mu_peak = 0.1;
+  wetter.mu_slide = 0.08;
+  const std::vector<DraftCheck> c = checkFieldDraft(RobotParams{}, 1.0, t, {thesis, wetter}, 0.03);
+  ASSERT_EQ(c.size(), 3u);
+  for (const DraftCheck& d : c) std::printf("%s\n", d.why.c_str());
+  EXPECT_EQ(c[0].patch, -1);
+  EXPECT_TRUE(c[0].carried);
+  EXPECT_EQ(c[1].patch, 0);
+  EXPECT_DOUBLE_EQ(c[1].draft, 7.5);
+  EXPECT_NEAR(c[1].budget.peak, 29.8, 0.05);
+  EXPECT_NEAR(c[1].budget.needed, 14.1 + 7.5, 0.05);
+  EXPECT_TRUE(c[1].carried);
+  EXPECT_FALSE(c[2].carried);
+  EXPECT_NE(c[2].why.find("soil patch 1"), std::string::npos) << c[2].why;
+  EXPECT_NE(c[2].why.find("cannot carry"), std::string::npos) << c[2].why;
+  EXPECT_EQ(fieldDraftWarnings(c), c[2].why);
+  // At the nominal depth the thesis patch carries it too (24.1 N needed), a 40 N draft not.
+  EXPECT_TRUE(checkFieldDraft(RobotParams{}, 1.0, t, {thesis}, 0.04)[1].carried);
+  t.draft_force = 40.0;
+  EXPECT_FALSE(checkFieldDraft(RobotParams{}, 1.0, t, {thesis}, 0.03)[1].carried);
+  t.draft_force = 0.0;  // no tool: nothing to check
+  EXPECT_TRUE(checkFieldDraft(RobotParams{}, 1.0, t, {thesis}, 0.03).empty());
+}

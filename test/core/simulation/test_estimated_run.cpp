@@ -5,6 +5,7 @@
 // stalls on the patch is counted as not finished.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -424,6 +425,73 @@ TEST(EstimatedRun, TheHitchControlLiftsTheToolThroughAPatchTheDraftCannotBePulle
   EXPECT_LT(hitch.tool_down_time, down.tool_down_time);
   cfg.traction_control.enabled = false;
   EXPECT_THROW(runClosedLoop(sc, cfg, ref, false), std::invalid_argument);
+}
+
+// Depth control in the loop, on the hitch test's patch (mu 0.2 at mass 1.3: 38.7 N of peak grip against 18.4 N of
+// rolling resistance plus 25 N of draft at the nominal 4 cm): run at 2 cm the draft is 12.5 N and the grip
+// carries it, so the drill runs through the patch shallower instead of being lifted, and leaves far less of the
+// row unsown than the hitch alone. The trace's tool_depth is 0 with the tool up and the nominal depth without
+// depth control.
+TEST(EstimatedRun, DepthControlRunsTheDrillShallowerBeforeLiftingIt) {
+  Scenario sc = line(OuterKind::kanayama, InnerKind::pid);
+  sc.duration = 14.0;
+  LoopConfig cfg;
+  TractionParams t;
+  t.draft_force = 25.0;
+  cfg.traction = t;
+  SoilPatch wet;
+  wet.polygon = {{4.0, 0.0}, {9.0, 0.0}, {9.0, 6.0}, {4.0, 6.0}};
+  wet.mu_peak = 0.2;
+  wet.mu_slide = 0.15;
+  wet.rolling_resistance = 0.08;
+  cfg.patches = {wet};
+  cfg.tool_rows = {RowSegment{Eigen::Vector2d(0.0, 3.0), Eigen::Vector2d(100.0, 3.0)}};
+  cfg.tool_rows_open_ended = true;
+  cfg.motor.enabled = true;
+  cfg.traction_control.enabled = true;
+  cfg.traction_control.raise_rate = 10.0;
+  cfg.hitch_control.enabled = true;
+  struct Depths {
+    double min_down = 1.0, max_down = 0.0;
+    bool up_is_zero = true;
+  };
+  const auto trace = [](Depths& d) {
+    return [&d](const EstimatedSample& e) {
+      if (e.tool_down) {
+        d.min_down = std::min(d.min_down, e.tool_depth);
+        d.max_down = std::max(d.max_down, e.tool_depth);
+      } else if (e.tool_depth != 0.0) {
+        d.up_is_zero = false;
+      }
+    };
+  };
+  LineReference ref;
+  Depths hitch_depths, depth_depths;
+  const LoopResult hitch = runClosedLoop(sc, cfg, ref, false, trace(hitch_depths));
+  cfg.seeding.depth_min = 0.02;  // a band down to 2 cm
+  cfg.hitch_control.depth_control = true;
+  cfg.hitch_control.depth_shallowest = 0.02;
+  const LoopResult depth = runClosedLoop(sc, cfg, ref, false, trace(depth_depths));
+  std::printf(
+      "hitch alone: %.2f m unsown (%d raises); depth control: %.2f m unsown (%d raises), depth %.3f..%.3f m, "
+      "mean sowing depth %.4f m, end x %.2f m\n",
+      hitch.unsown_distance, hitch.hitch_raises, depth.unsown_distance, depth.hitch_raises, depth_depths.min_down,
+      depth_depths.max_down, depth.meanSowingDepth(), depth.run.final_state[X]);
+  EXPECT_EQ(hitch_depths.min_down, t.draft_depth);  // no depth control: the nominal depth throughout
+  EXPECT_EQ(hitch_depths.max_down, t.draft_depth);
+  EXPECT_TRUE(hitch_depths.up_is_zero);
+  EXPECT_TRUE(depth_depths.up_is_zero);
+  EXPECT_NEAR(depth_depths.min_down, 0.02, 1e-4);  // down to the band's shallowest (deepening from there)
+  EXPECT_EQ(depth_depths.max_down, 0.04);
+  EXPECT_LT(depth.meanSowingDepth(), 0.04);
+  EXPECT_GT(depth.run.final_state[X], 13.0);  // crossed
+  EXPECT_LT(depth.unsown_distance, 0.5 * hitch.unsown_distance);
+  // Both raise the tool once on the start's acceleration (the hitch follows the verdict whether or not the tool
+  // is down: torque_controller cannot see the drill's rule); only the hitch alone raises it again in the patch.
+  EXPECT_LT(depth.hitch_raises, hitch.hitch_raises);
+  // Depths outside the agronomic band are refused.
+  cfg.hitch_control.depth_shallowest = 0.01;
+  EXPECT_NE(cfg.validate().find("agronomic band"), std::string::npos) << cfg.validate();
 }
 
 // The traction control's anti-windup reaches the inner loop: with it the run differs (the integrators

@@ -16,6 +16,20 @@
 // stands still does not lower the tool into a patch it could not pull through. The rows the tool misses
 // while raised are unsown: the closed loop counts that distance (LoopResult::unsown_distance);
 // the seed drill keeps its spacing by distance, so the seeds after the stretch fall where they would.
+//
+// Depth control (depth_control): real drills set their depth with down-pressure and run shallower in wet
+// ground, lifting only at the headland (FIELD.md). The draft grows with the depth (ASABE D497, traction.h's
+// toolDraft), so a shallower drill leaves more of the grip to the drive. With depth_control the verdict
+// first drives the drill shallower, within the agronomic band, and lifts it only as a last resort. Per period:
+//   - the verdict stands and the tool is down: the depth falls at depth_rate toward depth_shallowest (the
+//     band's shallowest, seed_drill/depth_min); there, once the verdict has stood raise_after seconds without
+//     a break, the tool is raised (as without depth control, but only from the shallowest depth);
+//   - raised: lowered after lower_after metres without the verdict, at the shallowest depth;
+//   - down and the robot has travelled deepen_after metres without the verdict: the depth rises at
+//     depth_rate back to depth_nominal (the drill's working depth, traction/draft_depth).
+// The speed governor, which slows the target on the same grip verdicts, acts first through the loop's order
+// (its verdict is the one of the period before). depth() is the working depth set, also while the tool is
+// raised (the depth it comes down at); raised() says whether it is up.
 #pragma once
 
 #include <string>
@@ -28,13 +42,19 @@ namespace core {
 /// Defaults, ranges, units and meanings: hitchControlTable().
 struct HitchControlParams {
   HitchControlParams();
-  bool enabled;        ///< false: the tool follows the seed drill's rule alone
-  double raise_after;  ///< [s] the grip verdict must stand this long before the tool is raised
-  double lower_after;  ///< [m] travel without the verdict before the tool is lowered again
+  bool enabled;             ///< false: the tool follows the seed drill's rule alone
+  double raise_after;       ///< [s] the grip verdict must stand this long before the tool is raised
+  double lower_after;       ///< [m] travel without the verdict before the tool is lowered again
+  bool depth_control;       ///< run the drill shallower within the band before raising it
+  double depth_nominal;     ///< [m] the drill's working depth with grip (as traction/draft_depth)
+  double depth_shallowest;  ///< [m] the shallowest depth it runs at before it is raised (seed_drill/depth_min)
+  double depth_rate;        ///< [m/s] how fast the down-pressure changes the depth
+  double deepen_after;      ///< [m] travel without the verdict before the drill goes back deeper
 
   std::string validate() const;
 };
-/// hitch_control/{enabled, raise_after, lower_after}.
+/// hitch_control/{enabled, raise_after, lower_after, depth_control, depth_nominal, depth_shallowest, depth_rate,
+/// deepen_after}.
 const ParamTable<HitchControlParams>& hitchControlTable();
 
 class HitchControl {
@@ -47,6 +67,11 @@ class HitchControl {
   bool update(bool grip_limited, double travelled, double dt);
   /// The tool is held up (whatever the seed drill's rule says).
   bool raised() const { return raised_; }
+  /// The drill's working depth [m]: depth_nominal without depth control; with it, between depth_shallowest and
+  /// depth_nominal (while raised: the depth the tool comes down at).
+  double depth() const { return depth_; }
+  /// Whether depth control is on (enabled and depth_control).
+  bool controlsDepth() const { return params_.enabled && params_.depth_control; }
   /// Times the tool was raised since reset().
   int raises() const { return raises_; }
   const HitchControlParams& params() const { return params_; }
@@ -57,6 +82,7 @@ class HitchControl {
   int raises_ = 0;
   double limited_for_ = 0.0;  // [s] the verdict has stood without a break
   double gripped_for_ = 0.0;  // [m] travelled since the verdict last stood
+  double depth_;              // [m] see depth()
 };
 
 }  // namespace core

@@ -17,9 +17,16 @@ struct SoilPatch {
   double mu_peak = 0.2;              ///< peak friction coefficient (as traction/mu_peak)
   double mu_slide = 0.15;            ///< sliding friction coefficient, <= mu_peak (as traction/mu_slide)
   double rolling_resistance = 0.05;  ///< rolling-resistance coefficient (as traction/rolling_resistance)
+  /// The seed drill's draft here against the field's soil at the same depth and speed (the texture factor F_i of
+  /// ASABE D497's draft law, traction.h's toolDraft). 1: a patch pulls as the field. Why 1 is the default for a
+  /// wet patch: D497 gives seeding implements the same constant in every texture, and wetting a soil pulls both
+  /// ways (a weaker soil cuts more easily, a sticky one adheres to the opener), so without a measurement of the
+  /// patch the field's draft is the best guess; a sticky clay patch takes more (e.g. 1.2), a loose sand less.
+  double draft_factor = 1.0;
 
   /// "" or one line naming `key` (e.g. "field/patches[1]") and what is wrong: fewer than 3 vertices, a
-  /// non-finite vertex, a negative or non-finite coefficient, mu_slide > mu_peak, rolling_resistance > 1.
+  /// non-finite vertex, a negative or non-finite coefficient (draft_factor included), mu_slide > mu_peak,
+  /// rolling_resistance > 1.
   std::string validate(const std::string& key) const;
 };
 

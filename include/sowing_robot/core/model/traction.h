@@ -34,7 +34,7 @@
 // midpoint ± L sideways; right wheel at −L in base_link, URDF) and the caster's are looked up; a wheel
 // in a patch uses its mu_peak, mu_slide and rolling_resistance (the slip curve's shape, slip_peak and
 // slip_stiffness, stays the field's), elsewhere the traction/ values.
-// The tool's draft (setToolDown, traction/draft_force D): while the tool is down, a force of magnitude
+// The tool's draft (setToolDown, setToolDepth; toolDraft()): while the tool is down, a force of magnitude
 // D acts at the tool point (xt, yt) in base_link against that point's velocity (v − w yt, w xt),
 // regularised linearly below slip_speed_floor and semi-implicit, so that a draft far beyond the motors
 // stays stable (at the price of a relative shortfall dt D / (m v): 7e-4 for 10 N at 1 m/s). As for the
@@ -42,6 +42,16 @@
 // w: a tool off the axle line (yt ≠ 0) turns the robot towards its side, one behind the axle (xt < 0)
 // damps the yaw. The sideways part is held by the wheels (no lateral slip, also on ice). Evaluated
 // once per step, as the rolling resistance.
+// Its magnitude follows the draft law of ASABE D497 (Agricultural Machinery Management Data, section 4.1;
+// Harrigan & Rotz, Applied Engineering in Agriculture 11(6), 1995), D = F_i (A + B S + C S²) W T, with F_i the
+// soil's texture factor, A, B, C the machine's constants, S the speed, W the width, T the depth. For one
+// opener of fixed width it is calibrated on traction/draft_force D0, the draft at the drill's nominal working
+// depth T0 (draft_depth) and speed S0 (draft_speed) on the field's soil:
+//   D(T, S) = D0 · F · (T / T0) · (1 + b S + c S²) / (1 + b S0 + c S0²),   b = B/A, c = C/A,
+// F the patch's draft_factor under the tool point (1 on the field's soil), S the tool point's speed. At T0 and
+// S0 it is D0 exactly, so a run that keeps the drill at its nominal depth (no depth control) has today's draft.
+// The speed terms default to 0: D497 lists seeding implements (planters, drills) with a per-row constant
+// (B = C = 0); a tine opener that tills its slot has speed terms (D497's tillage tines) to be set here.
 
 #pragma once
 
@@ -73,14 +83,26 @@ struct TractionParams {
   double slip_speed_floor;    ///< [m/s] smallest speed the slip ratio is divided by
   double caster_x;            ///< [m] caster contact ahead of the axle (URDF caster_joint x)
   int substeps;               ///< integration sub-steps per plant step
-  double draft_force;         ///< [N] the seed drill tool's draft while it is down (0: none)
+  double draft_force;  ///< [N] the seed drill tool's draft while it is down, at draft_depth and draft_speed (0: none)
+  double draft_depth;  ///< [m] the drill's nominal working depth (the depth draft_force is for)
+  double draft_speed;  ///< [m/s] the speed draft_force is for
+  double draft_speed_linear;     ///< [s/m] D497's B/A: the draft's linear rise with speed (0: none)
+  double draft_speed_quadratic;  ///< [s²/m²] D497's C/A: its quadratic rise with speed (0: none)
+  double tool_depth_min;         ///< [m] the drill's mechanical depth range: shallowest it can be set to
+  double tool_depth_max;         ///< [m] deepest it can be set to
 
-  /// checkRanges() plus the cross rules: mu_slide <= mu_peak, slip_stiffness >= mu_peak / slip_peak.
+  /// checkRanges() plus the cross rules: mu_slide <= mu_peak, slip_stiffness >= mu_peak / slip_peak,
+  /// tool_depth_min < tool_depth_max, draft_depth within [tool_depth_min, tool_depth_max].
   std::string validate() const;
 };
 /// traction/{enabled, mu_peak, mu_slide, slip_peak, slip_stiffness, rolling_resistance,
-/// slip_speed_floor, caster_x, substeps, draft_force}.
+/// slip_speed_floor, caster_x, substeps, draft_force, draft_depth, draft_speed, draft_speed_linear,
+/// draft_speed_quadratic, tool_depth_min, tool_depth_max}.
 const ParamTable<TractionParams>& tractionTable();
+
+/// The tool's draft [N] at `depth` [m] and the tool point's `speed` [m/s] on a soil of draft factor
+/// `soil_factor` (the file comment's law; draft_force exactly at draft_depth, draft_speed, factor 1).
+double toolDraft(const TractionParams& p, double depth, double speed, double soil_factor = 1.0);
 
 /// Friction coefficient μ(κ) of the curve (odd in κ): a rational rise μ_p g(|κ|/κ_p),
 /// g(x) = a x / ((1 − x)² + a x), a = K κ_p / μ_p (slope K at 0, peak μ_p with zero slope at κ_p), then
@@ -151,6 +173,25 @@ struct GripBudget {
 };
 GripBudget gripBudget(const RobotParams& robot, double mass_scale, const TractionParams& traction, double mu_peak,
                       double mu_slide, double rolling_resistance);
+/// The same with the tool's draft given [N] (gripBudget above takes traction.draft_force).
+GripBudget gripBudget(const RobotParams& robot, double mass_scale, const TractionParams& traction, double mu_peak,
+                      double mu_slide, double rolling_resistance, double draft);
+
+/// The field check before a run: whether a soil's grip budget carries the drill's draft at a given depth (the
+/// agronomic band's shallowest, the least a depth control can pull) and the nominal speed (draft_speed).
+struct DraftCheck {
+  int patch = -1;       ///< soil patch index; -1: the field's own soil
+  GripBudget budget;    ///< with `draft` in needed
+  double draft = 0.0;   ///< [N] the draft at `depth` and draft_speed on this soil
+  double depth = 0.0;   ///< [m] the depth checked (clamped to the mechanical range)
+  bool carried = true;  ///< budget.peak >= budget.needed: the wheels can pull the drill straight at the peak
+  std::string why;      ///< one line: the soil, its budget, the draft, the verdict
+};
+/// The field's soil first, then each patch in order. Nothing to check (draft_force 0): an empty list.
+std::vector<DraftCheck> checkFieldDraft(const RobotParams& robot, double mass_scale, const TractionParams& traction,
+                                        const std::vector<SoilPatch>& patches, double depth);
+/// One line per soil that cannot carry the drill (checkFieldDraft), or "" when every one can.
+std::string fieldDraftWarnings(const std::vector<DraftCheck>& checks);
 /// The grip budget of the soil at `where` (the patch there, else the field's soil) as one line: "soil patch 2 grip
 /// budget: peak traction 7.4 N (sliding 5.9 N) against 24.1 N needed". What a simulation adds to a no-traction
 /// report (the robot itself cannot know the soil's grip): the in-process loop's and plant_sim's.
@@ -203,6 +244,13 @@ class TractionPlant {
   /// Tool down: the draft acts from the next step on (the caller applies the seed drill's rule).
   void setToolDown(bool down) { tool_down_ = down; }
   bool toolDown() const { return tool_down_; }
+  /// The drill's working depth [m] from the next step on, clamped to the mechanical range
+  /// (tool_depth_min..tool_depth_max); a non-finite depth is refused (false, unchanged). reset() does not
+  /// change it; it starts at traction/draft_depth.
+  bool setToolDepth(double depth);
+  double toolDepth() const { return tool_depth_; }
+  /// Patch index (-1: default soil) under the tool point, as of the last step's start (draft_force > 0).
+  int patchUnderTool() const { return ground_tool_ - 1; }
   /// The draft's generalised force on v [N] and moment on w [N·m] of the last step (0 with the tool up).
   double draftForce() const { return draft_f_; }
   double draftMoment() const { return draft_m_; }
@@ -224,10 +272,13 @@ class TractionPlant {
   TractionParams traction_;
   std::vector<FrictionCurve> curves_;  // [0]: the traction parameters, [1 + i]: patch i
   std::vector<double> rr_;             // rolling resistance, indexed as curves_
+  std::vector<double> draft_factor_;   // the drill's draft factor, indexed as curves_ ([0]: 1)
   SoilMap soil_;
   int ground_[3] = {0, 0, 0};  // curves_ index under the right wheel, the left wheel, the caster
   Eigen::Vector2d tool_{-0.45, 0.0};
   bool tool_down_ = false;
+  double tool_depth_;
+  int ground_tool_ = 0;  // curves_ index under the tool point
   double draft_f_ = 0.0, draft_m_ = 0.0;
   double m_b_, i_b_, mcd_;
   double sqrt_m_, sqrt_i_, inv_sqrt_mi_, inv_sqrt_m_, inv_sqrt_i_;

@@ -14,7 +14,8 @@
 //   4. outer controller -> velocity command, inner controller -> wheel torques; at a stop hold (the
 //      reference's stop: the inner loop frozen) the standstill hold brakes on the fed twist instead; the traction
 //      control (if on) caps the torque of a slipping wheel, and tells the speed governor (if on) for the next period;
-//   5. with the traction plant and a draft: the tool rule on the true tool point lowers or lifts the tool;
+//   5. with the traction plant and a draft: the tool rule on the true tool point lowers or lifts the tool, the
+//      hitch control (if on) holds it up or, with depth control, sets the drill's depth for the step;
 //      With the traction control, its progress check (traction_monitor.h) may find the robot without
 //      traction: from the next period on the robot is held (a stop hold whatever the reference), and
 //      the run ends traction_control/no_traction_hold later;
@@ -62,6 +63,8 @@ struct NoSlipPlant {
     return w == RIGHT ? s[V] + L * s[OMEGA] : s[V] - L * s[OMEGA];
   }
   void setToolDown(bool) {}
+  void setToolDepth(double) {}
+  double toolDepth() const { return 0.0; }
   double L;  ///< the plant's half track [m]
 };
 
@@ -75,6 +78,8 @@ struct SlipPlant {
   double slip(Wheel w) const { return plant.slipRatio(w); }
   double wheelSpeed(Wheel w) const { return R * plant.wheelRate(w); }
   void setToolDown(bool down) { plant.setToolDown(down); }
+  void setToolDepth(double depth) { plant.setToolDepth(depth); }
+  double toolDepth() const { return plant.toolDepth(); }
   double R;  ///< the plant's wheel radius [m]
 };
 
@@ -98,7 +103,7 @@ struct LoopLayers {
   CommandLimiter* limiter = nullptr;            ///< between the outer and the inner loop
   TractionControl* traction_control = nullptr;  ///< between the inner loop and the motors
   GovernedReference* governor = nullptr;        ///< the reference the loop is given, governed
-  HitchControl* hitch = nullptr;                ///< raises the tool on the traction control's grip verdict
+  HitchControl* hitch = nullptr;                ///< raises the tool (or first runs it shallower) on the grip verdict
   TractionMonitor* monitor = nullptr;           ///< the traction control's progress check (needs it)
   /// With the governor: the run lasts until the governed time has run the scenario's duration, at most twice
   /// its duration (LoopConfig::governed_time_back).
@@ -121,14 +126,15 @@ bool wants(const std::function<void(const Sample&)>& trace) {
   return static_cast<bool>(trace);
 }
 inline void emit(const std::function<void(const LoopSample&)>& trace, const LoopSample& s, const Fed&, double, double,
-                 bool, const WheelTorques&, const LoopLayers&) {
+                 bool, double, const WheelTorques&, const LoopLayers&) {
   trace(s);
 }
 inline void emit(const std::function<void(const EstimatedSample&)>& trace, const LoopSample& s, const Fed& fed,
-                 double slip_r, double slip_l, bool tool_down, const WheelTorques& sent, const LoopLayers& layers) {
-  trace({&s, fed.pose, fed.v, fed.omega, slip_r, slip_l, tool_down, sent, &layers});
+                 double slip_r, double slip_l, bool tool_down, double tool_depth, const WheelTorques& sent,
+                 const LoopLayers& layers) {
+  trace({&s, fed.pose, fed.v, fed.omega, slip_r, slip_l, tool_down, sent, &layers, tool_depth});
 }
-inline void emit(RunTally& tally, const LoopSample& s, const Fed&, double, double, bool, const WheelTorques&,
+inline void emit(RunTally& tally, const LoopSample& s, const Fed&, double, double, bool, double, const WheelTorques&,
                  const LoopLayers&) {
   tally.add(s);
 }
@@ -213,12 +219,15 @@ LoopResult closedLoop(const Scenario& sc, PlantT& plant, Feed& feed, Outer& oute
       }
     }
     bool tool_down = false;
+    double tool_depth = 0.0;  // [m] 0 with the tool up
     if constexpr (PlantT::kTraction) {
       ToolRule* tool = layers.tool;
       if (tool != nullptr && tool->active && k < last) {
         tool_down = tool->update(s);
         if (HitchControl* hitch = layers.hitch) {
           const bool raised = hitch->update(layers.traction_control->limiting(), std::fabs(fed.v) * dt, dt);
+          // Depth control: the drill at the hitch's depth from this step on (without it, the plant's nominal).
+          if (hitch->controlsDepth()) plant.setToolDepth(hitch->depth());
           if (tool_down && raised) {
             tool_down = false;
             // Where the seed drill would sow (the reference's tool_down too), the row goes unsown.
@@ -226,12 +235,19 @@ LoopResult closedLoop(const Scenario& sc, PlantT& plant, Feed& feed, Outer& oute
           }
         }
         plant.setToolDown(tool_down);
-        if (tool_down) out.tool_down_time += dt;
+        if (tool_down) {
+          out.tool_down_time += dt;
+          tool_depth = plant.toolDepth();
+          if (ref.tool_down) {
+            out.sown_distance += tool->speed(s) * dt;
+            out.sown_depth_integral += tool_depth * tool->speed(s) * dt;
+          }
+        }
       }
     }
     if (loop_detail::wants(trace))
       loop_detail::emit(trace, {t, &s, &ref, &cmd, &u, inner.m0Hat(), inner.i0Hat(), ex, ey, eth}, fed,
-                        plant.slip(RIGHT), plant.slip(LEFT), tool_down, sent, layers);
+                        plant.slip(RIGHT), plant.slip(LEFT), tool_down, tool_depth, sent, layers);
     result.periods = k;
     if (no_traction && t >= end_at) break;  // held since the verdict: the run ends with its report
     if (stop && k % kStopCheckEvery == kStopCheckEvery - 1 && k < last && stop(metrics)) {

@@ -208,7 +208,8 @@ struct LoopConfig {
   /// The target slowed along its path while a wheel slips (needs traction_control; off: planned timing).
   SpeedGovernorParams speed_governor;
   /// The tool raised while the traction control holds the wheels at their grip limit (needs
-  /// traction_control; off: the seed drill's rule alone).
+  /// traction_control; off: the seed drill's rule alone); with depth_control the drill first runs shallower
+  /// within the agronomic band (seeding.depth_min..depth_max, which its depths must lie in).
   HitchControlParams hitch_control;
   /// With the speed governor: the run gets back the time the governor took from the path, i.e. it lasts
   /// until the governed path time has run the scenario's duration (at most twice the duration), so that a
@@ -233,6 +234,9 @@ struct EstimatedSample {
   WheelTorques sent;                         ///< the torques sent to the motors (after the layers) [N·m]
   /// The loop's layers this period (their state after it: ceilings, slip estimates, the governor's rate).
   const LoopLayers* layers = nullptr;
+  /// The seed drill's depth over the next step [m]: 0 with the tool up; with it down the depth control's
+  /// (hitch_control/depth_control), else the drill's nominal (traction/draft_depth).
+  double tool_depth = 0.0;
 };
 
 struct LoopResult {
@@ -255,6 +259,10 @@ struct LoopResult {
   /// held it up, i.e. the length of row left unsown [m]; and how often it raised the tool.
   double unsown_distance = 0.0;
   int hitch_raises = 0;
+  /// The tool point's travel with the tool down where the seed drill sows (the reference's tool_down) [m], and the
+  /// integral of the drill's depth over it [m²]: their ratio is the mean sowing depth (meanSowingDepth()).
+  double sown_distance = 0.0, sown_depth_integral = 0.0;
+  double meanSowingDepth() const { return sown_distance > 0.0 ? sown_depth_integral / sown_distance : 0.0; }
   /// With the traction control: the robot found without traction (the run then ended
   /// traction_control/no_traction_hold after the verdict, the robot held at rest).
   NoTractionReport no_traction;
