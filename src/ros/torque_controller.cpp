@@ -192,7 +192,11 @@ void TorqueController::compute() {
     if (out.holding) hold_->heldBack(sent);
     // As the in-process loop (closed_loop.h): this period's verdict and the fed speed's travel decide the
     // tool for the step this torque drives.
-    if (hitch_) torque_.tool_raised = hitch_->update(traction_control_->limiting(), std::fabs(v) * dt_, dt_);
+    if (hitch_) {
+      torque_.tool_raised = hitch_->update(traction_control_->limiting(), std::fabs(v) * dt_, dt_);
+      // Its depth for the same step (0: no depth control, the drill's nominal), applied by plant_sim.
+      torque_.tool_depth = hitch_->controlsDepth() ? hitch_->depth() : 0.0;
+    }
   }
   torque_.header.stamp = odom.header.stamp;
   torque_.right = sent.right;

@@ -40,6 +40,7 @@ void LockstepDriver::torqueCallback(const WheelTorque::ConstPtr& msg) {
   switch (protocol_.onTorque(stamp, {msg->right, msg->left})) {
     case Answer::kStep:
       plant_.setToolRaised(msg->tool_raised);  // the answer to this state: its torque and its hitch command
+      plant_.setToolDepth(msg->tool_depth);    // and its depth control's depth
       if (!plant_.step(protocol_.torque(), msg->header.stamp)) {
         protocol_.diverged();  // run() reports it; the bad state is never published
         return;

@@ -24,6 +24,12 @@ std::string loadToolSettings(const ros::NodeHandle& nh, const std::string& urdf,
   if (!(engage > 0.0) || !std::isfinite(engage))
     return "parameter " + nh.resolveName("seed_drill/engage_distance") + " must be finite and > 0 (the draft's tool)";
   out.seeding.engage_distance = engage;
+  // The agronomic depth band's shallowest depth: the depth the field check judges the drill at.
+  double depth_min = out.seeding.depth_min;
+  nh.param("seed_drill/depth_min", depth_min, depth_min);
+  if (!(depth_min > 0.0) || !std::isfinite(depth_min))
+    return "parameter " + nh.resolveName("seed_drill/depth_min") + " must be finite and > 0 (the drill's depth band)";
+  out.seeding.depth_min = depth_min;
   double x = 0.0, y = 0.0;
   const std::string e = linkPositionFromUrdf(urdf, link, x, y);
   if (!e.empty()) return "the draft's tool point (seed_drill/tool_link): " + e;

@@ -21,6 +21,7 @@ void RealtimeDriver::torqueCallback(const WheelTorque::ConstPtr& msg) {
   }
   torque_ = {msg->right, msg->left};
   tool_raised_ = msg->tool_raised;
+  tool_depth_ = msg->tool_depth;
   torque_stamp_ = msg->header.stamp;
   torque_valid_ = true;
 }
@@ -60,7 +61,8 @@ void RealtimeDriver::run() {
     core::WheelTorques u;
     const bool fresh = torque_valid_ && (stamp - torque_stamp_).toSec() <= cfg_.torque_timeout;
     if (fresh) u = torque_;
-    plant_.setToolRaised(fresh && tool_raised_);  // a silent controller raises nothing: the drill's rule
+    plant_.setToolRaised(fresh && tool_raised_);     // a silent controller raises nothing: the drill's rule
+    plant_.setToolDepth(fresh ? tool_depth_ : 0.0);  // nor sets a depth: the drill's nominal
     if (!fresh && torque_valid_) {
       ROS_WARN_THROTTLE(2.0, "plant_sim: no wheel_torque for %.3f s (timeout %.3f s): applying zero torque",
                         (stamp - torque_stamp_).toSec(), cfg_.torque_timeout);

@@ -43,7 +43,8 @@ std::string loadSoilPatches(ParamReader& p, const std::string& key, const core::
     std::string e =
         readMembers(item, name,
                     {polygon, numberMember("mu_peak", patch.mu_peak), numberMember("mu_slide", patch.mu_slide),
-                     numberMember("rolling_resistance", patch.rolling_resistance)});
+                     numberMember("rolling_resistance", patch.rolling_resistance),
+                     numberMember("draft_factor", patch.draft_factor)});
     if (e.empty()) e = patch.validate(name);
     if (!e.empty()) return e;
     // The patch's grip must fit the field's slip curve too (slip_stiffness >= mu_peak / slip_peak).
@@ -56,7 +57,7 @@ std::string loadSoilPatches(ParamReader& p, const std::string& key, const core::
     out.push_back(patch);
     return std::string();
   };
-  return forEachMap(p, key, "{polygon, mu_peak, mu_slide, rolling_resistance}", visit);
+  return forEachMap(p, key, "{polygon, mu_peak, mu_slide, rolling_resistance, draft_factor}", visit);
 }
 
 TractionModel::TractionModel(ros::NodeHandle nh, const core::RobotParams& robot,
@@ -71,6 +72,14 @@ TractionModel::TractionModel(ros::NodeHandle nh, const core::RobotParams& robot,
   plant_.setSoil(config.soil);
   plant_.setToolPoint(config.tool);
   plant_.reset(x0, 0.0);
+  // The field check before the run: can each soil pull the drill at the band's shallowest depth?
+  for (const core::DraftCheck& c : core::checkFieldDraft(robot, disturbance.mass_scale, config.traction,
+                                                         config.soil.patches(), config.seeding.depth_min)) {
+    if (c.carried)
+      ROS_INFO("plant_sim: field check: %s", c.why.c_str());
+    else
+      ROS_WARN("plant_sim: field check: %s", c.why.c_str());
+  }
   slip_pub_ = nh.advertise<std_msgs::Float64MultiArray>("wheel_slip", kLockstepQueue);
   soil_pub_ = nh.advertise<visualization_msgs::MarkerArray>("soil_markers", 1, true);
   publishSoil();
@@ -129,7 +138,10 @@ void TractionModel::step(double tau_right, double tau_left, double dt) {
   ++steps_;
   max_slip_ = std::max({max_slip_, std::fabs(plant_.slipRatio(core::RIGHT)), std::fabs(plant_.slipRatio(core::LEFT))});
   max_draft_ = std::max(max_draft_, std::fabs(plant_.draftForce()));
-  if (plant_.toolDown()) tool_down_time_ += dt;
+  if (plant_.toolDown()) {
+    tool_down_time_ += dt;
+    min_depth_ = min_depth_ > 0.0 ? std::min(min_depth_, plant_.toolDepth()) : plant_.toolDepth();
+  }
 }
 
 void TractionModel::publishVisuals(const ros::Time& stamp) {
@@ -153,12 +165,13 @@ void TractionModel::publishVisuals(const ros::Time& stamp) {
 }
 
 std::string TractionModel::report() const {
-  char text[360];
-  std::snprintf(text, sizeof text,
-                "traction: max |slip ratio| %.4f over %ld steps; %zu soil patch(es); tool down %.2f s, held up by "
-                "the hitch control %.2f s, max draft %.1f N (traction/draft_force %g N)",
-                max_slip_, static_cast<long>(steps_), cfg_.soil.patches().size(), tool_down_time_, tool_held_up_time_,
-                max_draft_, cfg_.traction.draft_force);
+  char text[420];
+  std::snprintf(
+      text, sizeof text,
+      "traction: max |slip ratio| %.4f over %ld steps; %zu soil patch(es); tool down %.2f s, held up by the hitch "
+      "control %.2f s, max draft %.1f N (traction/draft_force %g N at %.1f cm); shallowest depth down %.1f cm",
+      max_slip_, static_cast<long>(steps_), cfg_.soil.patches().size(), tool_down_time_, tool_held_up_time_, max_draft_,
+      cfg_.traction.draft_force, 100.0 * cfg_.traction.draft_depth, 100.0 * min_depth_);
   std::lock_guard<std::mutex> lock(mutex_);
   return no_traction_.empty() ? std::string(text) : std::string(text) + "; no traction: " + no_traction_;
 }

@@ -39,6 +39,8 @@ class PlantModel {
   /// The hitch control's command for the next step (WheelTorque/tool_raised): the tool held up whatever the
   /// seed drill's rule says. Only the traction plant has a tool.
   virtual void setToolRaised(bool /*raised*/) {}
+  /// The depth control's depth for the next step [m] (WheelTorque/tool_depth; 0: the drill's nominal depth).
+  virtual void setToolDepth(double /*depth*/) {}
   /// One line for the end-of-run report ("" for none).
   virtual std::string report() const { return ""; }
 };

@@ -40,6 +40,7 @@ class RealtimeDriver : public PlantSimDriver {
   ros::Time torque_stamp_;     // its stamp
   bool torque_valid_ = false;
   bool tool_raised_ = false;  // its hitch command (WheelTorque/tool_raised)
+  double tool_depth_ = 0.0;   // its depth control's depth (WheelTorque/tool_depth; 0: nominal)
   long rejected_ = 0;
 };
 

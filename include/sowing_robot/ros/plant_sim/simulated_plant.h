@@ -63,6 +63,8 @@ class SimulatedPlant {
   bool step(const core::WheelTorques& torque, const ros::Time& stamp);
   /// The hitch control's command (WheelTorque/tool_raised) for the steps from now on.
   void setToolRaised(bool raised) { model_->setToolRaised(raised); }
+  /// The depth control's depth (WheelTorque/tool_depth; 0: the drill's nominal) for the steps from now on.
+  void setToolDepth(double depth) { model_->setToolDepth(depth); }
   /// The state as step k (stamped stampOf(k)): ground_truth and the sensors' odom, imu and due fixes; tf
   /// (odom -> base_link from the encoders' odom), joint_states and the true path too with `visuals`;
   /// /clock every clock_rate, with visuals, or when `clock` is set.

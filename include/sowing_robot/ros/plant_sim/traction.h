@@ -18,6 +18,7 @@
 
 #include <ros/ros.h>
 
+#include <cmath>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -44,7 +45,7 @@ class TractionModel : public PlantModel {
     core::TractionParams traction;
     core::SoilMap soil;
     Eigen::Vector2d tool{-0.45, 0.0};  // tool point in base_link (URDF tool_link) [m]
-    core::SeedingParams seeding;       // engage_distance: the seed drill's
+    core::SeedingParams seeding;       // engage_distance and the depth band (depth_min): the seed drill's
     std::string odom_frame = "odom";
   };
   /// Throws std::invalid_argument when the parameters do not validate.
@@ -53,6 +54,11 @@ class TractionModel : public PlantModel {
 
   void step(double tau_right, double tau_left, double dt) override;
   void setToolRaised(bool raised) override { tool_raised_ = raised; }
+  /// As the in-process loop: a depth control's depth (> 0) from this step on, clamped to the mechanical range;
+  /// 0 (no depth control) or a non-finite one: the drill's nominal depth (traction/draft_depth).
+  void setToolDepth(double depth) override {
+    plant_.setToolDepth(depth > 0.0 && std::isfinite(depth) ? depth : cfg_.traction.draft_depth);
+  }
   const core::State& state() const override { return plant_.state(); }
   double time() const override { return plant_.time(); }
   void wheelRates(double& right, double& left) const override {
@@ -88,6 +94,7 @@ class TractionModel : public PlantModel {
   bool tool_raised_ = false;  // the hitch control's command for the next step
   double max_slip_ = 0.0, tool_down_time_ = 0.0, tool_held_up_time_ = 0.0;
   double max_draft_ = 0.0;
+  double min_depth_ = 0.0;  // the shallowest depth the tool was down at [m] (0: never down)
   std::int64_t steps_ = 0;
   std::string no_traction_;  // the grip diagnosis at the verdict, once it has come
   ros::Publisher slip_pub_, soil_pub_, diagnosis_pub_;
