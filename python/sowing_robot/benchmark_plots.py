@@ -41,7 +41,7 @@ def read_runs(path):
         rows = list(csv.DictReader(f))
     if not rows:
         raise ValueError(f"{path}: no runs")
-    text_cols = {"scenario", "controller", "failure"}
+    text_cols = {"scenario", "set", "controller", "failure"}
     for r in rows:
         for k, v in r.items():
             if k not in text_cols:

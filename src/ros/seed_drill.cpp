@@ -109,7 +109,7 @@ void SeedDrillNode::referenceCallback(const ReferenceState::ConstPtr& msg) {
 
 void SeedDrillNode::paired(const nav_msgs::Odometry& odom, bool tool_down) {
   if (!settings_.follow_hitch) {
-    update(odom, tool_down, false);
+    update(odom, {tool_down, false, seedDepth(0.0)});
     return;
   }
   if (hitch_inputs_.setFirst({odom.header, odom, tool_down})) updateHitchPair();
@@ -121,24 +121,24 @@ void SeedDrillNode::torqueCallback(const WheelTorque::ConstPtr& msg) {
 }
 
 void SeedDrillNode::updateHitchPair() {
-  update(hitch_inputs_.first().odom, hitch_inputs_.first().tool_down, hitch_inputs_.second().tool_raised);
+  const WheelTorque& torque = hitch_inputs_.second();
+  update(hitch_inputs_.first().odom,
+         {hitch_inputs_.first().tool_down, static_cast<bool>(torque.tool_raised), seedDepth(torque.tool_depth)});
 }
 
-void SeedDrillNode::update(const nav_msgs::Odometry& odom, bool tool_down, bool held_up) {
+void SeedDrillNode::update(const nav_msgs::Odometry& odom, const ToolState& tool) {
   if (believed_is_truth_) {
-    sow(odom, odom, tool_down, held_up);
+    sow(odom, odom, tool);
     return;
   }
-  if (believed_inputs_.setFirst({odom.header, odom, tool_down, held_up}))
-    sow(believed_inputs_.first().truth, believed_inputs_.second(), believed_inputs_.first().tool_down,
-        believed_inputs_.first().held_up);
+  if (believed_inputs_.setFirst({odom.header, odom, tool}))
+    sow(believed_inputs_.first().truth, believed_inputs_.second(), believed_inputs_.first().tool);
 }
 
 void SeedDrillNode::believedCallback(const nav_msgs::Odometry::ConstPtr& msg) {
   // Kept even before the plan: the state of the same stamp may come after it (another connection).
   if (believed_inputs_.setSecond(*msg))
-    sow(believed_inputs_.first().truth, believed_inputs_.second(), believed_inputs_.first().tool_down,
-        believed_inputs_.first().held_up);
+    sow(believed_inputs_.first().truth, believed_inputs_.second(), believed_inputs_.first().tool);
 }
 
 Eigen::Vector2d SeedDrillNode::toolPoint(const nav_msgs::Odometry& odom) const {
@@ -149,16 +149,16 @@ Eigen::Vector2d SeedDrillNode::toolPoint(const nav_msgs::Odometry& odom) const {
   return Eigen::Vector2d(pose.x + c * tool_x_ - s * tool_y_, pose.y + s * tool_x_ + c * tool_y_);
 }
 
-double SeedDrillNode::seedDepth(const ros::Time& /*stamp*/) const {
+double SeedDrillNode::seedDepth(double sent_depth) const {
+  if (sent_depth > 0.0) return sent_depth;
   const core::SeedingParams& p = settings_.seeding;
   return 0.5 * (p.depth_min + p.depth_max);
 }
 
-void SeedDrillNode::sow(const nav_msgs::Odometry& truth, const nav_msgs::Odometry& believed, bool tool_down,
-                        bool held_up) {
+void SeedDrillNode::sow(const nav_msgs::Odometry& truth, const nav_msgs::Odometry& believed, const ToolState& tool) {
   const ros::Time& stamp = truth.header.stamp;
   core::Seed seed;
-  if (drill_->drop(stamp.toSec(), toolPoint(truth), toolPoint(believed), tool_down, held_up, seedDepth(stamp), seed))
+  if (drill_->drop(stamp.toSec(), toolPoint(truth), toolPoint(believed), tool.down, tool.held_up, tool.depth, seed))
     addSeed(seed, stamp);
   if (!final_sent_ && end_ns_ >= 0 && static_cast<std::int64_t>(stamp.toNSec()) >= end_ns_) {
     final_sent_ = true;

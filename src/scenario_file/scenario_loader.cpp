@@ -30,6 +30,7 @@
 #include "sowing_robot/core/planning/field.h"
 #include "sowing_robot/core/settings/node_settings.h"
 #include "sowing_robot/core/simulation/runner.h"
+#include "sowing_robot/scenario_file/scenario_sets.h"
 #include "sowing_robot/scenario_file/yaml_reading.h"
 
 namespace sowing_robot {
@@ -277,8 +278,8 @@ core::BenchScenario loadScenarioFileImpl(const std::string& path, const std::str
   YAML::Node root = loadYaml(path);
   if (!profile.empty()) applyProfile(root, profile);
   std::set<std::string> known = {
-      "name", "description", "track", "duration", "control_rate", "start",           "line",
-      "sine", "field",       "plant", "draws",    "success",      "envelope_period", "requires"};
+      "name",  "description", "track", "duration", "control_rate",    "start",    "line", "sine",
+      "field", "plant",       "draws", "success",  "envelope_period", "requires", "set"};
   known.insert(std::begin(kLoopBlocks), std::end(kLoopBlocks));
   onlyKeys(root, known, path, "");
   core::BenchScenario b;
@@ -286,6 +287,16 @@ core::BenchScenario loadScenarioFileImpl(const std::string& path, const std::str
   b.name = required(root, "name", path, "").as<std::string>();
   if (b.name != stem(path)) fail(path, "name '" + b.name + "' must be the file's name ('" + stem(path) + "')");
   required(root, "description", path, "");
+  // The evaluation set (docs/evaluation.md). A file without the key is validation: it may have been looked at
+  // while designing; a scenario is test only when its file says so.
+  if (const YAML::Node set = root["set"]) {
+    if (!set.IsScalar()) fail(path, "set must be one of training, validation, test");
+    const std::string e = checkScenarioSet(set.Scalar());
+    if (!e.empty()) fail(path, e);
+    b.set = set.Scalar();
+  } else {
+    b.set = "validation";
+  }
 
   const std::string track = required(root, "track", path, "").as<std::string>();
   b.base.duration = toDouble(required(root, "duration", path, ""), path, "duration");
@@ -551,19 +562,6 @@ std::vector<TrainingRecord> trainingOf(const std::string& gains_path) {
       out.push_back({name, runs, seed});
   }
   return out;
-}
-
-std::string heldOutVerdict(const std::vector<TrainingRecord>& training, const std::string& scenario,
-                           unsigned long long base_seed, long long runs) {
-  bool trained_on = false;
-  for (const TrainingRecord& t : training) {
-    if (t.scenario != scenario) continue;
-    trained_on = true;
-    // Run i's draws depend on (base seed, i) only: the same base seed repeats the training's first runs.
-    if (t.base_seed == base_seed)
-      return "TRAINED ON: runs 0-" + std::to_string(std::min(t.runs, runs) - 1) + " are training runs";
-  }
-  return trained_on ? "held-out draws (the scenario was trained on with another base seed)" : "held out";
 }
 
 }  // namespace scenario_file

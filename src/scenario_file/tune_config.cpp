@@ -87,6 +87,9 @@ void loadRobust(const YAML::Node& r, const std::string& path, const std::string&
     } catch (const std::exception& e) {
       fail(path, at + ": " + e.what());
     }
+    // A test scenario is never looked at while designing (docs/evaluation.md): the tuner may not see it.
+    if (ts.bench.set == "test")
+      fail(path, at + " (" + ts.bench.name + "): a test scenario cannot be trained on (set: test; docs/evaluation.md)");
     ts.bench.spec.base_seed = static_cast<std::uint64_t>(seed);
     ts.runs = static_cast<std::int64_t>(runs);
     const std::string e = core::firstError({ts.bench.validate(), core::validateGainBounds(ts.bench.base, c.gains)});

@@ -39,6 +39,7 @@
 #include "sowing_robot/core/simulation/runner.h"
 #include "sowing_robot/farm/farm.h"
 #include "sowing_robot/scenario_file/scenario_loader.h"
+#include "sowing_robot/scenario_file/scenario_sets.h"
 
 using namespace sowing_robot::core;
 namespace scenario_file = sowing_robot::scenario_file;
@@ -46,6 +47,12 @@ namespace scenario_file = sowing_robot::scenario_file;
 #ifndef SOWING_SOURCE_DIR
 #define SOWING_SOURCE_DIR "."
 #endif
+
+namespace {
+/// The protocol's scenarios (every set): what a test scenario is compared with, and where a robust tuning's
+/// training scenarios are found by name.
+const char* const kCatalogDir = SOWING_SOURCE_DIR "/config/scenarios";
+}  // namespace
 
 namespace {
 const char* const kUsage =
@@ -112,7 +119,7 @@ const char* trackName(TrackKind t) { return t == TrackKind::line ? "line" : t ==
 /// One paragraph: what the scenario draws and how it is judged.
 std::string describe(const BenchScenario& b) {
   const MonteCarloSpec& s = b.spec;
-  std::string out = "- **" + b.name + "** (" + trackName(b.track) + ", " + num(b.base.duration) + " s" +
+  std::string out = "- **" + b.name + "** [" + b.set + "] (" + trackName(b.track) + ", " + num(b.base.duration) + " s" +
                     (b.track == TrackKind::field ? " + the approach's extra time" : "") + " at " +
                     num(1e9 / static_cast<double>(b.base.control_period_ns)) + " Hz, start (" + num(b.base.start.x) +
                     ", " + num(b.base.start.y) + ", " + num(b.base.start.theta) + ")";
@@ -257,6 +264,10 @@ bool parseOptions(int argc, char** argv, Options& o, int& exit_code) {
 /// The scenarios and controller pairs the options name, loaded and checked before the first run.
 struct Suite {
   std::vector<BenchScenario> scenarios;
+  /// The same scenarios read without the profile (the run's base seed in place): their content, which the
+  /// evaluation protocol compares (scenario_sets.h).
+  std::vector<BenchScenario> plain;
+  std::vector<scenario_file::CatalogEntry> catalog;  // the package's config/scenarios, every set
   std::vector<Scenario> pairs;
   std::vector<std::string> gains_source;  // per pair: the tuned file its gains come from, or why the defaults
 };
@@ -264,9 +275,24 @@ struct Suite {
 /// Throws on the first unknown name or bad file (scenarios first, then controllers, in the given order).
 Suite loadSuite(const Options& o) {
   Suite suite;
+  suite.catalog = scenario_file::scenarioCatalog(kCatalogDir);
   for (const auto& name : o.scenario_names) {
     suite.scenarios.push_back(scenario_file::loadScenario(name, o.scenario_dir, o.profile_files.file));
-    if (o.base_seed >= 0) suite.scenarios.back().spec.base_seed = static_cast<std::uint64_t>(o.base_seed);
+    suite.plain.push_back(scenario_file::loadScenario(name, o.scenario_dir));
+    if (o.base_seed >= 0)
+      for (auto* b : {&suite.scenarios.back(), &suite.plain.back()})
+        b->spec.base_seed = static_cast<std::uint64_t>(o.base_seed);
+    // A test scenario whose content a training or validation scenario holds would be reported as a blind test
+    // while it is not one: refused, naming what it shares (docs/evaluation.md).
+    const auto overlaps = scenario_file::testOverlaps(suite.plain.back(), suite.catalog);
+    if (!overlaps.empty()) {
+      std::string list;
+      for (const auto& l : overlaps) list += (list.empty() ? "" : "; ") + l;
+      throw std::invalid_argument("test scenario " + suite.plain.back().name +
+                                  " is not held out: its content overlaps " + list +
+                                  " (a test scenario needs a world, layout and soil, and draws of its own; "
+                                  "docs/evaluation.md)");
+    }
   }
   for (const auto& c : o.controllers) {
     Scenario sc;
@@ -320,6 +346,23 @@ std::string profileLine(const Options& o) {
   return line + ".\n\n";
 }
 
+/// The report's paragraph on the evaluation sets (docs/evaluation.md): which scenario is in which, and the content
+/// digest of each (equal digests: equal content).
+std::string setsParagraph(const Suite& suite) {
+  std::string out =
+      "Evaluation sets (docs/evaluation.md; test: reported, never looked at while designing; validation: "
+      "the profile's and the estimator's design choices were made on it; training: the tuner's):\n\n";
+  for (const std::string& set : scenario_file::scenarioSets()) {
+    std::string names;
+    for (const auto& b : suite.plain)
+      if (b.set == set)
+        names += std::string(names.empty() ? "" : ", ") + b.name + " (content " +
+                 scenario_file::fingerprintOf(b).digest() + ")";
+    if (!names.empty()) out += "- " + set + ": " + names + "\n";
+  }
+  return out;
+}
+
 /// report.md up to its overview: the profile, how many runs, where each pair's gains come from (with what a
 /// robust tuning never saw), and what each scenario draws.
 std::string reportHead(const Suite& suite, const Options& o) {
@@ -339,11 +382,14 @@ std::string reportHead(const Suite& suite, const Options& o) {
       held_out += " " + t.scenario + " (runs 0-" + std::to_string(t.runs - 1) + ", base seed " +
                   std::to_string(t.base_seed) + ")";
     held_out += ":";
-    for (const auto& b : suite.scenarios)
-      held_out += " " + b.name + " " + scenario_file::heldOutVerdict(training, b.name, b.spec.base_seed, seeds) + ";";
+    for (const auto& b : suite.plain)
+      held_out +=
+          " " + b.name + " " + scenario_file::heldOutVerdict(training, b, seeds, suite.catalog, kCatalogDir) + ";";
     held_out += "\n";
   }
-  if (!held_out.empty()) report += "\nTraining and held-out data (robust-tuned gains):\n\n" + held_out;
+  if (!held_out.empty())
+    report += "\nTraining and held-out data (robust-tuned gains; judged by content, not by name):\n\n" + held_out;
+  report += "\n" + setsParagraph(suite);
   report += "\nScenarios:\n\n";
   for (const auto& b : suite.scenarios) report += describe(b) + describeRealism(b);
   return report;
@@ -431,9 +477,10 @@ bool runAll(sowing_robot::farm::Farm& farm, const sowing_robot::farm::Compute& c
     }
     progress.batchDone();
     addLoads(batch_loads, out.loads);
-    out.csv += runsCsvLines(b.name, name, rows, realism);
+    out.csv += runsCsvLines(b.name, name, rows, realism, b.set);
     out.envelopes += envelopeCsvLines(b.name, name, crossTrackEnvelope(rows, b.envelope_period));
-    out.summary += summaryLine(b.name, name, rows);
+    out.summary +=
+        summaryLine(b.name + " [" + b.set + "]", name, rows);  // the set beside the name: test figures stand out
     out.sections += reportSection(b.name, name, rows);
   }
   return true;

@@ -136,3 +136,28 @@ TEST(BenchmarkCommand, AProfileIsChosenByNameAndBringsItsGains) {
   EXPECT_EQ(o.err.find('\n'), o.err.size() - 1) << "more than one line: " << o.err;
   EXPECT_FALSE(exists(out + "/runs.csv"));
 }
+
+// The evaluation protocol (docs/evaluation.md): every run carries its scenario's set in runs.csv and the report,
+// and a scenario labelled test whose content a validation scenario holds (the thesis line under another name,
+// shortened) is refused with one line naming what it shares, before any run.
+TEST(BenchmarkCommand, RunsCarryTheirSetAndAnOverlappingTestScenarioIsRefused) {
+  TempDir dir;
+  const std::string line = quickLine(dir);
+  ASSERT_EQ(run(dir, "--scenarios " + line + " --seeds 2 --threads 1 --output " + dir.path + "/val").status, 0);
+  const std::string csv = readFile(dir.path + "/val/runs.csv");
+  EXPECT_EQ(csv.rfind("scenario,set,controller,seed,", 0), 0u) << csv;
+  EXPECT_NE(csv.find("\nquick_line,validation,kanayama+atsmc,0,"), std::string::npos) << csv;
+  const std::string report = readFile(dir.path + "/val/report.md");
+  EXPECT_NE(report.find("- **quick_line** [validation]"), std::string::npos) << report;
+  EXPECT_NE(report.find("- validation: quick_line (content "), std::string::npos) << report;
+
+  std::string text = readFile(line);
+  text.replace(text.find("\nset: validation"), 16, "\nset: test");
+  std::ofstream(line) << text;
+  expectOneLineRefusal(dir, "--scenarios " + line + " --seeds 2",
+                       "thesis_line (validation): same layout, soil and draws");
+  expectOneLineRefusal(dir, "--scenarios " + line + " --seeds 2", "test scenario quick_line is not held out");
+  // Its own base seed makes the draws its own, but the world is still the thesis line's.
+  expectOneLineRefusal(dir, "--scenarios " + line + " --seeds 2 --base-seed 77",
+                       "thesis_line (validation): same layout and soil (other draws)");
+}

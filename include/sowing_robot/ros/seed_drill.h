@@ -34,6 +34,13 @@
 
 namespace sowing_robot {
 
+/// What the plan and the hitch say of the tool for one stamp.
+struct ToolState {
+  bool down = false;     ///< the reference asks for the tool (ReferenceState/tool_down)
+  bool held_up = false;  ///< the hitch holds it up (WheelTorque/tool_raised)
+  double depth = 0.0;    ///< the depth the drill runs at [m] (seedDepth)
+};
+
 class SeedDrillNode {
  public:
   SeedDrillNode(ros::NodeHandle nh, ros::NodeHandle pnh);
@@ -53,17 +60,18 @@ class SeedDrillNode {
   void planCallback(const FieldPlan::ConstPtr& msg);
   /// The state and whether the tool is down for the same time: sown now, or once the believed pose of
   /// its stamp is here (`feedback` other than ground_truth).
-  void update(const nav_msgs::Odometry& odom, bool tool_down, bool held_up);
+  void update(const nav_msgs::Odometry& odom, const ToolState& tool);
   /// The pose the controllers are fed (`feedback`), when it is not ground_truth itself.
   void believedCallback(const nav_msgs::Odometry::ConstPtr& msg);
   /// The true and the believed state of one stamp: move the tool, maybe drop a seed; the final report after
   /// the run's final state.
-  void sow(const nav_msgs::Odometry& truth, const nav_msgs::Odometry& believed, bool tool_down, bool held_up);
+  void sow(const nav_msgs::Odometry& truth, const nav_msgs::Odometry& believed, const ToolState& tool);
   /// The tool point (odom frame) on a state's pose.
   Eigen::Vector2d toolPoint(const nav_msgs::Odometry& odom) const;
-  /// The depth the seed falling at `stamp` is placed at [m]: the one place it comes from. Today the middle of
-  /// the agronomic band (seed_drill/depth_min..depth_max); a depth control will send it with the wheel torque.
-  double seedDepth(const ros::Time& stamp) const;
+  /// The depth a seed is placed at [m], the one place it comes from: the depth control's, sent with the wheel
+  /// torque (WheelTorque/tool_depth, follow_hitch), or without one the drill's nominal, the middle of the
+  /// agronomic band (seed_drill/depth_min..depth_max, as the in-process SeedRecorder).
+  double seedDepth(double sent_depth) const;
   /// A seed dropped by the state stamped `stamp`: recorded, shown, and every 50th reported.
   void addSeed(const core::Seed& seed, const ros::Time& stamp);
   void publishReport(const ros::Time& stamp);
@@ -85,8 +93,7 @@ class SeedDrillNode {
   struct Sowing {
     std_msgs::Header header;
     nav_msgs::Odometry truth;
-    bool tool_down = false;
-    bool held_up = false;  ///< the hitch holds the tool up
+    ToolState tool;
   };
   ListenerPair<Sowing, nav_msgs::Odometry> believed_inputs_;
   bool believed_is_truth_ = true;  ///< `feedback` is ground_truth (or not remapped): no second subscription

@@ -16,7 +16,8 @@
 namespace sowing_robot {
 namespace scenario_file {
 
-/// The scenario file at `path` (its `name` must equal the file's stem). A field scenario's `field/config`
+/// The scenario file at `path` (its `name` must equal the file's stem; its `set`, training | validation | test,
+/// defaults to validation: BenchScenario::set, docs/evaluation.md). A field scenario's `field/config`
 /// is read relative to the scenario file's directory (with its plant_sim/field/patches, used with traction on).
 /// Blocks traction:, sensors: (sensors/seed refused: drawn per run), estimator: and feedback: set
 /// BenchScenario::realism (docs/benchmark.md).
@@ -78,11 +79,8 @@ struct TrainingRecord {
 /// The training set a gains file records (its "# training: NAME runs N base_seed S" header lines, written by
 /// tune with a robust: block); empty for gains tuned on one run (or a file that cannot be read).
 std::vector<TrainingRecord> trainingOf(const std::string& gains_path);
-/// What the benchmark's report says of a scenario run with gains trained on `training`, for runs 0..runs-1
-/// of base seed `base_seed`: "held out" (not trained on), "held-out draws" (trained on, other draws), or
-/// "TRAINED ON: runs 0-K are training runs".
-std::string heldOutVerdict(const std::vector<TrainingRecord>& training, const std::string& scenario,
-                           unsigned long long base_seed, long long runs);
+/// What the benchmark's report says of a scenario and such a training set: scenario_sets.h's heldOutVerdict,
+/// which compares content, not names.
 
 }  // namespace scenario_file
 }  // namespace sowing_robot

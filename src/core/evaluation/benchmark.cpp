@@ -489,7 +489,7 @@ std::string csvField(const RunMetric& m, const RunRow& r) {
 // seed and the realism metrics (runsCsvIdentityColumns() lists the ones that are not metrics).
 std::string runsCsvHeader(bool realism) {
   std::string h =
-      "scenario,controller,seed,mass_scale,inertia_scale,amplitude,phase,noise_seed,start_x,start_y,start_theta";
+      "scenario,set,controller,seed,mass_scale,inertia_scale,amplitude,phase,noise_seed,start_x,start_y,start_theta";
   for (const RunMetric& m : runMetrics())
     if (m.group == MetricGroup::always) h += "," + m.name;
   h += ",failure";
@@ -502,12 +502,12 @@ std::string runsCsvHeader(bool realism) {
 }
 
 std::string runsCsvLines(const std::string& scenario, const std::string& controller, const std::vector<RunRow>& rows,
-                         bool realism) {
+                         bool realism, const std::string& set) {
   std::string out;
   for (const RunRow& r : rows) {
     const RunDraw& d = r.draw;
-    out += scenario + "," + controller + "," + std::to_string(d.index) + "," + csvNumber(d.mass_scale) + "," +
-           csvNumber(d.inertia_scale) + "," + csvNumber(d.amplitude) + "," + csvNumber(d.phase) + "," +
+    out += scenario + "," + set + "," + controller + "," + std::to_string(d.index) + "," + csvNumber(d.mass_scale) +
+           "," + csvNumber(d.inertia_scale) + "," + csvNumber(d.amplitude) + "," + csvNumber(d.phase) + "," +
            std::to_string(d.noise_seed) + "," + csvNumber(d.start_x) + "," + csvNumber(d.start_y) + "," +
            csvNumber(d.start_theta);
     for (const RunMetric& m : runMetrics())

@@ -238,8 +238,8 @@ const std::vector<RunMetric>& runMetrics() {
 
 const std::vector<std::string>& runsCsvIdentityColumns() {
   static const std::vector<std::string> columns{
-      "scenario",   "controller", "seed",    "mass_scale",  "inertia_scale", "amplitude",  "phase",
-      "noise_seed", "start_x",    "start_y", "start_theta", "failure",       "sensor_seed"};
+      "scenario", "set",        "controller", "seed",    "mass_scale",  "inertia_scale", "amplitude",
+      "phase",    "noise_seed", "start_x",    "start_y", "start_theta", "failure",       "sensor_seed"};
   return columns;
 }
 

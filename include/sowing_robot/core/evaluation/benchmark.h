@@ -160,6 +160,10 @@ enum class TrackKind { line, field, sine };
 /// period (ContactMonitor, as runField does) and any contact fails the run.
 struct BenchScenario {
   std::string name;
+  /// The evaluation set the scenario belongs to (docs/evaluation.md): "training" (the tuner sees it),
+  /// "validation" (design choices are made on it) or "test" (reported, never looked at while designing).
+  /// A scenario file's `set:` key; a scenario built in code is "validation" (it may have been looked at).
+  std::string set = "validation";
   TrackKind track = TrackKind::line;
   Scenario base;
   MonteCarloSpec spec;
@@ -241,12 +245,13 @@ Statistic statistic(std::vector<double> values);
 const std::vector<std::string>& metricColumns();
 std::vector<double> metricValues(const RunRow& row);
 
-/// Tidy CSV: header line, then one line per row: scenario, controller, seed, the draws, every metric of
-/// runMetrics() (run_metrics.h) of the group always, the failure. realism: then sensor_seed and the metrics of
-/// the group realism (scenarios with sensors or traction; NaN or empty on rows without them).
+/// Tidy CSV: header line, then one line per row: scenario, set (BenchScenario::set: training, validation or
+/// test; "" when the caller has none), controller, seed, the draws, every metric of runMetrics()
+/// (run_metrics.h) of the group always, the failure. realism: then sensor_seed and the metrics of the group
+/// realism (scenarios with sensors or traction; NaN or empty on rows without them).
 std::string runsCsvHeader(bool realism = false);
 std::string runsCsvLines(const std::string& scenario, const std::string& controller, const std::vector<RunRow>& rows,
-                         bool realism = false);
+                         bool realism = false, const std::string& set = "");
 /// Markdown section for one scenario and controller: success rate with failure reasons, then per metric
 /// (run_metrics.h: report_table) mean, std, p95 and worst.
 std::string reportSection(const std::string& scenario, const std::string& controller, const std::vector<RunRow>& rows);

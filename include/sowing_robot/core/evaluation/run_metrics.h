@@ -58,8 +58,8 @@ struct RunMetric {
 /// Every per-run metric, in runs.csv order within its group.
 const std::vector<RunMetric>& runMetrics();
 
-/// runs.csv's columns that are not metrics: who ran (scenario, controller), what was drawn (seed and draws,
-/// sensor_seed in the realism block), and why a run failed (failure, text).
+/// runs.csv's columns that are not metrics: who ran (scenario, its evaluation set, controller), what was drawn (seed
+/// and draws, sensor_seed in the realism block), and why a run failed (failure, text).
 const std::vector<std::string>& runsCsvIdentityColumns();
 
 /// The registry as JSON (a list of objects, one per metric: name, unit, label, meaning, format, group,

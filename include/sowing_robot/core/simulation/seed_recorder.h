@@ -2,7 +2,8 @@
 // (SeedDrill::drop) on the tool point of the TRUE pose (where the seed really falls), with the tool point of the
 // FED pose as where the robot believed it fell. The drill sows where the reference asks for the tool and the
 // hitch does not hold it up -- what the node pipeline's seed_drill does with follow_hitch -- at the depth the
-// drill runs at (the middle of the agronomic band while no depth control sets it).
+// drill runs at (the traction plant's tool depth, set by the depth control; without a tool in the plant the drill's
+// nominal, the middle of the agronomic band).
 // Used by the benchmark's rows (RowMeter), hence the tuner, and by the Python module: one record, one rule.
 #pragma once
 
@@ -30,7 +31,7 @@ class SeedRecorder {
   void add(const LoopSample& s) {
     const State& x = *s.state;
     drop(s.t, toolPoint(x[X], x[Y], x[THETA]), toolPoint(x[X], x[Y], yawThroughQuaternion(x[THETA])),
-         s.reference->tool_down, false);
+         s.reference->tool_down, false, depth_);
   }
   /// A period of a loop with a feedback source and layers: the believed point from the fed pose, the tool held up
   /// by the hitch control sows nothing.
@@ -38,7 +39,7 @@ class SeedRecorder {
     const State& x = *s.loop->state;
     const bool raised = s.layers != nullptr && s.layers->hitch != nullptr && s.layers->hitch->raised();
     drop(s.loop->t, toolPoint(x[X], x[Y], x[THETA]), toolPoint(s.fed.x, s.fed.y, s.fed.theta),
-         s.loop->reference->tool_down, raised);
+         s.loop->reference->tool_down, raised, s.tool_depth > 0.0 ? s.tool_depth : depth_);
   }
 
   const std::vector<Seed>& seeds() const { return seeds_; }
@@ -50,9 +51,10 @@ class SeedRecorder {
     const double sn = std::sin(theta), c = std::cos(theta);
     return {x + c * tool_.x() - sn * tool_.y(), y + sn * tool_.x() + c * tool_.y()};
   }
-  void drop(double t, const Eigen::Vector2d& truth, const Eigen::Vector2d& believed, bool tool_down, bool held_up) {
+  void drop(double t, const Eigen::Vector2d& truth, const Eigen::Vector2d& believed, bool tool_down, bool held_up,
+            double depth) {
     Seed seed;
-    if (drill_.drop(t, truth, believed, tool_down, held_up, depth_, seed)) seeds_.push_back(seed);
+    if (drill_.drop(t, truth, believed, tool_down, held_up, depth, seed)) seeds_.push_back(seed);
   }
 
   SeedDrill drill_;
