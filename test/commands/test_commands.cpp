@@ -45,7 +45,9 @@ const std::vector<std::string> kScripts{"run",
                                         "dev/field_evidence_figure",
                                         "dev/reproduce",
                                         "dev/benchmark_report",
-                                        "dev/path_evidence"};
+                                        "dev/path_evidence",
+                                        "dev/seed_evidence",
+                                        "dev/seed_evidence_table"};
 
 struct Outcome {
   int status = -1;
