@@ -107,17 +107,12 @@ class RowMeter {
   RunTally& tally() { return tally_; }
 
   void add(const LoopSample& s) {
-    tally_.add(s);
-    if (extras_.contacts) extras_.contacts->update(s.t, {(*s.state)[X], (*s.state)[Y], (*s.state)[THETA]});
-    if (extras_.last_reference) *extras_.last_reference = s.reference->pose;
+    addPeriod(s);
     if (seeds_) seeds_->add(s);
   }
   /// A period of the loop with a feedback source and layers: the seeds from the fed pose and the hitch.
   void add(const EstimatedSample& s) {
-    const LoopSample& l = *s.loop;
-    tally_.add(l);
-    if (extras_.contacts) extras_.contacts->update(l.t, {(*l.state)[X], (*l.state)[Y], (*l.state)[THETA]});
-    if (extras_.last_reference) *extras_.last_reference = l.reference->pose;
+    addPeriod(*s.loop);
     if (seeds_) seeds_->add(s);
   }
 
@@ -162,6 +157,12 @@ class RowMeter {
   }
 
  private:
+  void addPeriod(const LoopSample& s) {
+    tally_.add(s);
+    if (extras_.contacts) extras_.contacts->update(s.t, {(*s.state)[X], (*s.state)[Y], (*s.state)[THETA]});
+    if (extras_.last_reference) *extras_.last_reference = s.reference->pose;
+  }
+
   RunRow& row_;
   const MonteCarloSpec& spec_;
   const RunExtras& extras_;
