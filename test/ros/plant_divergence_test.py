@@ -15,6 +15,7 @@ the wait for its exit times out and both process cases fail (and odom carries |v
 the nodelet ending the process on the failure (as plant_sim did with _Exit before), the nodelet case
 fails: the manager is gone."""
 import math
+import re
 import subprocess
 import tempfile
 import time
@@ -104,8 +105,9 @@ class PlantDivergence(unittest.TestCase):
             node_process.set_private_params(ns + "/run", RUN)
         node_process.set_private_params(diverging + "/plant_sim", dict(COMMON, max_speed=2.0))
         node_process.set_private_params(healthy + "/plant_sim", COMMON)  # no torque: it runs at rest
-        seen = {diverging: [], healthy: []}  # odom |v| received, per plant
-        subs = [rospy.Subscriber(ns + "/ground_truth", Odometry, lambda m, ns=ns: seen[ns].append(abs(m.twist.twist.linear.x)),
+        seen = {diverging: [], healthy: []}  # (stamp [s sim], |v|) received, per plant
+        subs = [rospy.Subscriber(ns + "/ground_truth", Odometry,
+                                 lambda m, ns=ns: seen[ns].append((m.header.stamp.to_sec(), abs(m.twist.twist.linear.x))),
                                  queue_size=1000) for ns in seen]
         pub = rospy.Publisher(diverging + "/wheel_torque", WheelTorque, queue_size=10)
         stamp = {"last": None}
@@ -140,10 +142,12 @@ class PlantDivergence(unittest.TestCase):
                 self.assertIn(diverging + "/plant_sim: state diverged", fatal[0])
                 self.assertIn("max_speed 2 m/s", fatal[0])
                 # The diverged run publishes nothing more; the healthy plant in the same manager goes on.
-                # (A realtime plant at 200 Hz publishes a state every 5 ms: 40 would come in this window.)
-                stopped_at, healthy_at = len(seen[diverging]), len(seen[healthy])
+                # Judged by stamp, not by arrival: a state published just before the FATAL line may still be in
+                # transit when the line is read. Every state published before the diverging step is stamped
+                # before its time; a run that went on would publish later stamps (40 in the 0.2 s below).
+                diverged_at = float(re.search(r"state diverged at t=([0-9.]+) s", fatal[0]).group(1))
+                healthy_at = len(seen[healthy])
                 time.sleep(0.2)
-                self.assertEqual(len(seen[diverging]), stopped_at, "states published after the divergence")
                 try:
                     listed = rospy.ServiceProxy(manager_ns + "/manager/list", NodeletList)().nodelets
                 except rospy.ServiceException as e:
@@ -151,7 +155,9 @@ class PlantDivergence(unittest.TestCase):
                 self.assertIn(healthy + "/plant_sim", listed)
                 self.wait_for_more(seen[healthy], healthy_at + 20, "states from the healthy plant")
                 self.assertIsNone(manager.poll(), "the manager ended (exit %s)" % manager.returncode)
-                self.assertLessEqual(max(seen[diverging]), 2.0, "a diverged state was published")
+                late = [t for t, _ in seen[diverging] if t >= diverged_at - 1e-9]
+                self.assertEqual(late, [], "states published after the divergence at t=%.6f s" % diverged_at)
+                self.assertLessEqual(max(v for _, v in seen[diverging]), 2.0, "a diverged state was published")
             finally:
                 node_process.stop(manager)
                 for sub in subs:
