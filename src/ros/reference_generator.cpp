@@ -56,6 +56,11 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
       error = "parameter robot_description (the URDF) is not set";
     if (error.empty()) error = footprintFromUrdf(xml, footprint);
     field.avoidance.footprint_radius = footprint.circumscribedRadius();
+    // The last row is driven until the seed drill's tool point (seed_drill/tool_link, where sim.launch loads
+    // config/seed_drill.yaml, as plant_sim reads it) reaches its end, so the row is sown to it.
+    std::string tool_link = "tool_link";
+    nh.param<std::string>("seed_drill/tool_link", tool_link, tool_link);
+    if (error.empty()) error = toolRunOutFromUrdf(xml, tool_link, field.run_out);
     // The reference starts where the robot does (run/start) and joins the first row on a bounded approach.
     field.start_pose = run.start();
     if (error.empty() && p.error().empty()) error = field.validate();

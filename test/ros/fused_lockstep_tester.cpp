@@ -125,6 +125,9 @@ TEST(FusedLockstep, NodePipelineEqualsTheInProcessEstimatedLoop) {
                   {fieldp.error(), loadObstacles(fieldp, "obstacles", obstacles), footprintFromUrdf(xml, footprint)}),
               "");
     field.avoidance.footprint_radius = footprint.circumscribedRadius();
+    std::string tool_link = "tool_link";
+    ros::param::get("seed_drill/tool_link", tool_link);
+    ASSERT_EQ(toolRunOutFromUrdf(xml, tool_link, field.run_out), "");
     field.start_pose = sc.start;
     std::unique_ptr<core::FieldSource> f = core::makeFieldSource(field, obstacles);
     field_source = f.get();

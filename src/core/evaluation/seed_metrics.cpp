@@ -43,8 +43,8 @@ double overlap(const std::vector<Interval>& a, const std::vector<Interval>& b) {
   return sum;
 }
 
-/// The stretches of row r (along-row coordinate in [0, length]) inside an obstacle's detour zone.
-std::vector<Interval> detourStretches(const RowSegment& r, const SeedDrill& plan) {
+/// The stretches of row r (along-row coordinate in [0, length]) that an obstacle blocks (SeedDrill::blockedRadius).
+std::vector<Interval> obstacleStretches(const RowSegment& r, const SeedDrill& plan) {
   const Eigen::Vector2d d = r.b - r.a;
   const double length = d.norm();
   std::vector<Interval> out;
@@ -54,7 +54,7 @@ std::vector<Interval> detourStretches(const RowSegment& r, const SeedDrill& plan
     const Eigen::Vector2d c(o.x, o.y);
     const double along = (c - r.a).dot(u);
     const double across = (c - r.a - along * u).norm();
-    const double radius = plan.detourRadius(o);
+    const double radius = plan.blockedRadius(o);
     if (across >= radius) continue;
     const double half = std::sqrt(radius * radius - across * across);
     out.push_back({along - half, along + half});
@@ -131,7 +131,7 @@ SeedFigures seedFigures(const std::vector<Seed>& seeds, const SeedDrill& plan) {
       if (k + 1 < s.size() && s[k + 1] - s[k] <= kSownGap * spacing) covered.push_back({s[k], s[k + 1]});
     }
     covered = mergeIntervals(std::move(covered), row_length);
-    const std::vector<Interval> detours = detourStretches(rows[i], plan);
+    const std::vector<Interval> detours = obstacleStretches(rows[i], plan);
     RowSowing rs;
     rs.detour_length = totalLength(detours);
     rs.length = row_length - rs.detour_length;
@@ -142,7 +142,7 @@ SeedFigures seedFigures(const std::vector<Seed>& seeds, const SeedDrill& plan) {
     sown += rs.sown;
     detour_length += rs.detour_length;
     detour_sown += rs.detour_sown;
-    // ISO 7256-1 on the spacings clear of the detour stretches (one across them is the obstacle, not the meter).
+    // ISO 7256-1 on the spacings clear of the obstacle stretches (one across them is the obstacle, not the meter).
     for (std::size_t k = 0; k + 1 < s.size(); ++k) {
       if (meets(detours, s[k], s[k + 1])) continue;
       const double x = s[k + 1] - s[k];

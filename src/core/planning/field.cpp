@@ -75,6 +75,8 @@ std::string FieldParams::validate() const {
   std::string e = firstError({fieldTable().checkRanges(*this), avoidance.validate()});
   if (!e.empty()) return e;
   if (start_pose && !allFinite(start_pose->x, start_pose->y, start_pose->theta)) return "start pose must be finite";
+  if (!(run_out >= 0.0) || !std::isfinite(run_out))
+    return "the tool's run-out past the last row's end = " + formatNumber(run_out) + " m must be finite and >= 0";
   if (turn_speed > row_speed)
     return "field/turn_speed = " + formatNumber(turn_speed) +
            " m/s must be <= field/row_speed = " + formatNumber(row_speed) + " m/s";
@@ -276,6 +278,7 @@ FieldPath::FieldPath(const FieldParams& params, const std::vector<Obstacle>& obs
 
   // Geometry.
   double s = 0.0;
+  bool cut = false;
   for (int i = 0; i < n; ++i) {
     const double h = params_.heading + (i % 2 == 1 ? M_PI : 0.0);
     Element row;
@@ -292,8 +295,11 @@ FieldPath::FieldPath(const FieldParams& params, const std::vector<Obstacle>& obs
       if (rp.cut) {  // the path ends here, at rest
         row.length = rp.stop;
         n = i + 1;
+        cut = true;
       }
     }
+    // The tool point reaches the last row's end (a planned field's; the thesis path, without a plan, is the thesis's).
+    if (i == n - 1 && !cut && params_.avoidance.plan_detours) row.length += params_.run_out;
     if (i == 0 && params_.approach && params_.avoidance.plan_detours && params_.start_pose) {
       planApproach(row, n == 1 ? 0.0 : params_.turn_speed, obstacles);
       if (has_approach_) {

@@ -141,9 +141,11 @@ bool SeedDrill::update(const Eigen::Vector2d& p, bool tool_down, Eigen::Vector2d
   const Eigen::Vector2d last = last_;
   has_last_ = true;
   last_ = p;
-  // After the plan's request has ended the drill stays down only while the tool point is still on the row's
-  // stretch and on its line (within tolerance): a path that rounds its corner before the row's end leaves it there.
-  if (held_up || (!tool_down && !(withinRowSpan(p) && crossTrack(p) <= params_.tolerance))) lowered_ = false;
+  // A seed falls only on a row's stretch: the drill is lifted once the tool point passes a row's end, whatever the
+  // plan asks (a robot that overshoots its last stop would sow the headland). After the plan's request has ended it
+  // stays down only while the tool point is also on the row's line (within tolerance): a path that rounds its corner
+  // before the row's end leaves it there.
+  if (held_up || !withinRowSpan(p) || (!tool_down && crossTrack(p) > params_.tolerance)) lowered_ = false;
   if (tool_down && !held_up && !lowered_ && onRowSegment(p)) {
     lowered_ = true;
     travelled_ = 0.0;

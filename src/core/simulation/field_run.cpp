@@ -27,6 +27,7 @@ FieldRunSetup::FieldRunSetup() {
   scenario.disturbance.mass_scale = scenario.disturbance.inertia_scale = 1.2;
   seeding.detour_margin = 4.0;
   field.avoidance.footprint_radius = footprint.circumscribedRadius();
+  field.run_out = std::max(0.0, -tool.x());
 }
 
 FieldRunReport runField(const FieldRunSetup& setup) {

@@ -3,6 +3,7 @@
 #include "sowing_robot/core/common/validation.h"
 
 #include <urdf_parser/urdf_parser.h>
+#include <algorithm>
 
 #include <Eigen/Geometry>
 #include <cmath>
@@ -258,6 +259,14 @@ std::string robotParamsFromUrdf(const std::string& urdf_xml, core::RobotParams& 
 }  // namespace sowing_robot
 
 namespace sowing_robot {
+
+std::string toolRunOutFromUrdf(const std::string& urdf_xml, const std::string& tool_link, double& run_out) {
+  double x = 0.0, y = 0.0;
+  const std::string e = linkPositionFromUrdf(urdf_xml, tool_link, x, y);
+  if (!e.empty()) return "the seed drill's tool point (seed_drill/tool_link): " + e;
+  run_out = std::max(0.0, -x);
+  return "";
+}
 
 std::string linkPositionFromUrdf(const std::string& urdf_xml, const std::string& link, double& x, double& y) {
   urdf::ModelInterfaceSharedPtr model;

@@ -111,21 +111,31 @@ TEST(SeedMetrics, DoublesAreMultiplesAndSpreadIsPrecision) {
   EXPECT_NEAR(f.precision, 20.0, 0.3);  // sample std of alternating +-0.02 around 0.1
 }
 
-TEST(SeedMetrics, DetourStretchesAreReportedApart) {
-  // An obstacle of 0.3 m on the row at x = 5: detour radius 0.3 + 0.5 + 0.5 = 1.3 m, i.e. [3.7, 6.3].
+TEST(SeedMetrics, ObstacleStretchesAreWhereTheRowIsBlocked) {
+  // An obstacle of 0.3 m on the row at x = 5 blocks it within 0.3 + 0.5 (influence) = 0.8 m: [4.2, 5.8]. The
+  // robot leaves the row before it and rejoins after: the seeds it places there, 0.3 m off the line, sow the row.
   const SeedDrill d = plan({{5.0, 3.0, 0.3}});
   std::vector<Seed> seeds;
-  sow(seeds, d, 0.1, 3.65, 0.1);  // up to 3.6
-  sow(seeds, d, 6.4, 10.0, 0.1);  // from 6.4: the robot went round, sowing nothing on the line
-  const SeedFigures f = seedFigures(seeds, d);
+  sow(seeds, d, 0.1, 3.65, 0.1);       // on the line up to 3.6
+  sow(seeds, d, 3.7, 4.15, 0.1, 0.3);  // leaving it: 3.7 .. 4.1
+  sow(seeds, d, 5.9, 6.35, 0.1, 0.3);  // rejoining: 5.9 .. 6.3
+  sow(seeds, d, 6.4, 10.0, 0.1);       // on the line again
+  SeedFigures f = seedFigures(seeds, d);
   ASSERT_EQ(f.rows.size(), 1u);
-  EXPECT_NEAR(f.rows[0].detour_length, 2.6, 1e-9);
-  EXPECT_NEAR(f.rows[0].length, 7.4, 1e-9);
-  // Sown [0.05, 3.65] and [6.35, 9.95] less the detour part [6.3, 6.35] = 0: 3.6 + 3.6 = 7.2 of 7.4.
-  EXPECT_NEAR(f.sown_share, 7.2 / 7.4, 1e-9);
+  EXPECT_NEAR(f.rows[0].detour_length, 1.6, 1e-9);
+  EXPECT_NEAR(f.rows[0].length, 8.4, 1e-9);
+  // Sown [0.05, 4.15] and [5.85, 9.95]: 4.1 + 4.1 = 8.2 of 8.4; nothing of the blocked stretch.
+  EXPECT_NEAR(f.sown_share, 8.2 / 8.4, 1e-9);
   EXPECT_NEAR(f.detour_sown_share, 0.0, 1e-9);
-  // The gap across the detour stretch is not an ISO miss (its seeds border the obstacle, not a fault).
+  // The gap across the blocked stretch is not an ISO miss (its seeds border the obstacle, not a fault).
   EXPECT_NEAR(f.misses, 0.0, 1e-12);
+
+  // A drill lifted for the whole detour leaves the row unsown where it could have been sown: counted.
+  seeds.clear();
+  sow(seeds, d, 0.1, 3.65, 0.1);
+  sow(seeds, d, 6.4, 10.0, 0.1);
+  f = seedFigures(seeds, d);
+  EXPECT_NEAR(f.sown_share, 7.2 / 8.4, 1e-9);
 }
 
 TEST(SeedMetrics, LateralDepthAndMapError) {
@@ -159,14 +169,16 @@ TEST(SeedMetrics, SeedsFromTheDrillItselfSowTheRow) {
   SeedDrill d = plan();
   std::vector<Seed> seeds;
   Seed s;
-  for (int i = 0; i <= 10050; ++i) {  // to 10.05 m: the 100th seed clear of rounding at 10 m
-    const Eigen::Vector2d p(i * 1e-3, 3.0);
+  for (int i = 0; i <= 10050; ++i) {  // from 0.5 mm to 10.0505 m, clear of rounding at the row's ends
+    const Eigen::Vector2d p(i * 1e-3 + 5e-4, 3.0);
     if (d.drop(i * 1e-3, p, p, true, false, 0.04, s)) seeds.push_back(s);
   }
   const SeedFigures f = seedFigures(seeds, d);
-  EXPECT_EQ(f.seeds, 100u);
-  EXPECT_NEAR(f.sown_share, 0.995, 1e-9);  // [0.05, 10]: the last seed at 10.0, the row's end
+  // Every 0.1 m from 0.1005 to 9.9005; the 100th would fall 0.5 mm past the row's end, where the drill is lifted
+  // (a seed falls only on a row's stretch, whatever the plan asks).
+  EXPECT_EQ(f.seeds, 99u);
+  EXPECT_NEAR(f.sown_share, 0.99, 1e-9);  // [0.0505, 9.9505]
   EXPECT_NEAR(f.quality_of_feed, 100.0, 1e-9);
   EXPECT_EQ(seeds.front().row, 0);
-  EXPECT_DOUBLE_EQ(seeds.back().t, seeds.back().truth.x());
+  EXPECT_DOUBLE_EQ(seeds.back().t + 5e-4, seeds.back().truth.x());
 }

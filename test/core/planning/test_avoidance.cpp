@@ -56,7 +56,7 @@ TEST(Avoidance, ThesisFieldClearsEveryObstacleWithinTheBoundsAndKeepsTheRowSeeds
   expectBodyClearAndBounded(r, s.field);
   EXPECT_EQ(r.status.code, AvoidanceStatus::Code::kOk);
   EXPECT_EQ(r.status.detours, 3u);
-  EXPECT_NEAR(r.end.x(), 100.0, 0.15);
+  EXPECT_NEAR(r.end.x(), 100.0 + s.field.run_out, 0.15);  // the tool point at the row end
   EXPECT_NEAR(r.end.y(), 3.0, 0.05);
   // On-row seeds no worse than with the thesis potential field (max 7.8 mm, RMS 1.6 mm).
   FieldRunSetup before = s;
@@ -94,7 +94,7 @@ TEST(Avoidance, ObstacleOffTheRowIsPassedOnItsFarSide) {
     min_y = std::min(min_y, q.pose.y);
   }
   EXPECT_GE(min_y, 3.0 - 1e-9);
-  EXPECT_NEAR(r.end.x(), 60.0, 0.15);
+  EXPECT_NEAR(r.end.x(), 60.0 + s.field.run_out, 0.15);
   EXPECT_NEAR(r.end.y(), 3.0, 0.05);
 }
 
@@ -114,7 +114,7 @@ TEST(Avoidance, NarrowGateIsNeverEnteredAndAWideOneIs) {
     if (std::fabs(q.pose.x - 30.0) < 0.3 && std::fabs(q.pose.y - 3.0) < 0.6) entered = true;
   }
   EXPECT_FALSE(entered);
-  EXPECT_NEAR(r.end.x(), 60.0, 0.15);
+  EXPECT_NEAR(r.end.x(), 60.0 + s.field.run_out, 0.15);
 
   // 2.4 m between the centres: the inflated discs leave the row free, and the robot drives straight through.
   const FieldRunSetup w = row60({{30.0, 4.2, 0.3}, {30.0, 1.8, 0.3}});
@@ -132,7 +132,7 @@ TEST(Avoidance, LargeObstacleIsGoneAround) {
   std::printf("large obstacle: %s\n", r.summary().c_str());
   expectBodyClearAndBounded(r, s.field);
   EXPECT_EQ(r.status.code, AvoidanceStatus::Code::kOk);
-  EXPECT_NEAR(r.end.x(), 60.0, 0.15);
+  EXPECT_NEAR(r.end.x(), 60.0 + s.field.run_out, 0.15);
   EXPECT_NEAR(r.end.y(), 3.0, 0.05);
 }
 
@@ -183,7 +183,7 @@ TEST(Avoidance, ObstacleAddedAtRunTimeAheadOfTheRobotIsAvoided) {
   expectBodyClearAndBounded(r, s.field);
   EXPECT_EQ(r.status.detours, 1u);
   EXPECT_LT(r.min_clearance, 1.0);  // it did meet the obstacle
-  EXPECT_NEAR(r.end.x(), 60.0, 0.15);
+  EXPECT_NEAR(r.end.x(), 60.0 + s.field.run_out, 0.15);
   EXPECT_LT(r.rows.max, 0.02);
 }
 

@@ -53,7 +53,8 @@ TEST(CoveragePath, RowsAreSingleSegmentsWithTheToolDownAndTurnsAreEvenlySampledW
     EXPECT_NEAR(a.y(), 3.0 + i, 1e-9);
     EXPECT_NEAR(b.y(), 3.0 + i, 1e-9);
     // The tool's changes are found on the 1 ms sampling: within 1 mm at 1 m/s at either end.
-    EXPECT_NEAR(std::fabs(b.x() - a.x()), 30.0, 2e-3) << "row " << i;
+    // The last row runs on until the tool point, which trails the axle by run_out, is at its end.
+    EXPECT_NEAR(std::fabs(b.x() - a.x()), 30.0 + (i == 2 ? f.run_out : 0.0), 2e-3) << "row " << i;
   }
   // The turns: points every 5 cm (to the sampling's 1 ms), all within the headland beyond the rows.
   for (std::size_t k = 0; k < c.tool_down.size(); ++k) {
@@ -81,14 +82,14 @@ TEST(FieldPathReference, PlansNoTurnInPlaceKeepsTheFieldsBoundsAndStopsAtTheLast
     peak_v = std::max(peak_v, r.v);
     if (r.tool_down) down_time += dt;
     // Tool down only on the rows (|y - row| within the detour's offset near the obstacle).
-    if (r.tool_down) EXPECT_TRUE(r.pose.x > -1e-6 && r.pose.x < 30.0 + 1e-6) << t;
+    if (r.tool_down) EXPECT_TRUE(r.pose.x > -1e-6 && r.pose.x < 30.0 + s.field.run_out + 1e-6) << t;
   }
   EXPECT_LE(peak_lateral, lateral * (1.0 + 1e-6));
   EXPECT_NEAR(peak_v, s.field.row_speed, 1e-6);
   EXPECT_GT(down_time, 80.0);  // 90 m of rows (less the settle and the detour's slower stretch) at <= 1 m/s
   EXPECT_TRUE(r.stop);
   EXPECT_TRUE(ref.finished(ref.duration()));
-  EXPECT_NEAR(r.pose.x, 30.0, 1e-6);
+  EXPECT_NEAR(r.pose.x, 30.0 + s.field.run_out, 1e-6);  // the tool point at the row end
   EXPECT_NEAR(r.pose.y, 5.0, 1e-6);
   // A clone starts over and repeats the references bit for bit.
   auto copy = ref.clone();
@@ -110,7 +111,7 @@ TEST(FieldPathReference, ThreeRowFieldIsSownClearOfTheObstacleToTheLastRowsEnd) 
   EXPECT_GT(r.min_clearance, 0.1);
   EXPECT_GT(r.rows.count, 400u);
   EXPECT_LT(r.rows.max, 0.02);
-  EXPECT_NEAR(r.end.x(), 30.0, 0.15);
+  EXPECT_NEAR(r.end.x(), 30.0 + s.field.run_out, 0.15);  // the tool point at the row end
   EXPECT_NEAR(r.end.y(), 5.0, 0.05);
 }
 
@@ -126,8 +127,8 @@ TEST(FieldPathReference, ObstacleAddedAtRunTimeIsPlannedRoundFromTheRobotsProgre
   ASSERT_TRUE(set);
   EXPECT_EQ(r.status.detours, 1u);
   EXPECT_EQ(r.contacts, 0u);
-  EXPECT_LT(r.min_clearance, 1.0);  // it did meet the obstacle
-  EXPECT_NEAR(r.end.x(), 100.0, 0.15);
+  EXPECT_LT(r.min_clearance, 1.0);                        // it did meet the obstacle
+  EXPECT_NEAR(r.end.x(), 100.0 + s.field.run_out, 0.15);  // the tool point at the row end
   EXPECT_LT(r.rows.max, 0.02);
 }
 

@@ -142,7 +142,7 @@ TEST(StopHold, TheEndOfThePathIsAStopThatHoldsForEveryPair) {
     expectStandsStill(f, run, std::string(pair) + ", end of the path");
     // Where the reference's stop found it: the pure pursuits (no along-track feedback) and ATSMC (its
     // speed swings +-0.3 m/s under this disturbance) may be up to 0.19 m off the end.
-    EXPECT_NEAR(f.end.x(), kRow, 0.2) << pair;
+    EXPECT_NEAR(f.end.x(), kRow + run.field.run_out, 0.2) << pair;  // the tool point at the row end
     EXPECT_NEAR(f.end.y(), 3.0, 0.02) << pair;
   }
 }
@@ -195,7 +195,7 @@ TEST(StopHold, WhenThePlanResumesTheRobotDrivesOnToTheNewEnd) {
     ASSERT_NE(seen, nullptr);
     ASSERT_GE(removed, 0.0) << pair;
     EXPECT_TRUE(moved_again) << pair;
-    EXPECT_NEAR(f.end.x(), kRow + 1.0, 0.15) << pair << " ended at " << f.end.x();
+    EXPECT_NEAR(f.end.x(), kRow + 1.0 + run.field.run_out, 0.15) << pair << " ended at " << f.end.x();
     EXPECT_NEAR(f.end.y(), 3.0, 0.02) << pair;
   }
 }

@@ -5,10 +5,11 @@
 //  - Sown share, on the row's geometry: the seeds of a row projected on it; a stretch between two consecutive
 //    seeds at most sown_gap x spacing apart is sown, and each seed sows half a spacing either side of it (so a
 //    row sown end to end at the spacing is 100 % less the half spacing before its first seed and after its last).
-//    The stretches inside an obstacle's detour zone (SeedDrill::detourRadius) are reported apart: there the
-//    robot goes round, and the row cannot be sown on its line.
+//    The obstacle stretches, where an obstacle blocks the row (SeedDrill::blockedRadius: its radius + the plan's
+//    clearance), are reported apart: the row cannot be sown on its line there. The rest of a detour, where the
+//    robot leaves and rejoins the row, is row to sow (its seeds lie off the line, and are counted).
 //  - ISO 7256-1 (single-seed drills; Kachman & Smith 1995 for the indices' definitions) on the spacings between
-//    consecutive seeds along each row outside the detour stretches, x_ref = the drill's spacing: multiples index
+//    consecutive seeds along each row outside the obstacle stretches, x_ref = the drill's spacing: multiples index
 //    D = share of spacings <= 0.5 x_ref, miss index M = share > 1.5 x_ref, quality of feed A = 100 - D - M, and
 //    precision C = the standard deviation of the accepted spacings (0.5, 1.5] x_ref over x_ref. A long unsown
 //    stretch is a single miss among hundreds of spacings: the sown share, not A, shows it.
@@ -26,9 +27,9 @@ namespace core {
 
 /// One row's sowing [m].
 struct RowSowing {
-  double length = 0.0;         ///< the row's length outside detour stretches
+  double length = 0.0;         ///< the row's length outside obstacle stretches
   double sown = 0.0;           ///< of which sown
-  double detour_length = 0.0;  ///< the row's length inside detour stretches
+  double detour_length = 0.0;  ///< the row's length inside obstacle stretches
   double detour_sown = 0.0;    ///< of which sown (by seeds projected onto it)
   double share() const { return length > 0.0 ? sown / length : 1.0; }
 };
@@ -37,9 +38,9 @@ struct RowSowing {
 struct SeedFigures {
   std::size_t seeds = 0;
   std::vector<RowSowing> rows;  ///< per row of the plan, in its order
-  double sown_share;            ///< sown length / length over every row, outside detour stretches
+  double sown_share;            ///< sown length / length over every row, outside obstacle stretches
   double worst_row_share;       ///< the least-sown row's share
-  double detour_sown_share;     ///< sown share of the detour stretches (NaN without any)
+  double detour_sown_share;     ///< sown share of the obstacle stretches (NaN without any)
   double multiples, misses, quality_of_feed, precision;  ///< ISO 7256-1 D, M, A, C [%]
   double lateral_rms, lateral_p95, lateral_max;          ///< seeds outside detour zones, from their row's line [m]
   double depth_outside;                                  ///< share of the seeds outside [depth_min, depth_max]

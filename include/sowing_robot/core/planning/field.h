@@ -61,6 +61,11 @@ struct FieldParams {
   /// The robot's start pose [m, m, rad]. Not a parameter: the caller sets it (the node from plant_sim's
   /// start/{x, y, theta}, as avoidance.footprint_radius from the URDF). Unset: no approach.
   std::optional<Pose2D> start_pose;
+  /// How far the seed drill's tool point trails the axle [m] (>= 0): the last row is driven this much past its end,
+  /// so the tool reaches the row's end and sows it (the axle stopping at the end leaves that stretch unsown). Not a
+  /// parameter: the caller sets it from the URDF's tool_link (0.45 m). 0, or without avoidance.plan_detours (the
+  /// thesis path): the axle stops at the row's end.
+  double run_out = 0.0;
   PotentialFieldParams potential;  ///< alpha, beta, repulsion (see PotentialField)
   AvoidanceParams avoidance;       ///< planned detours around the inflated obstacles (detour.h)
   std::string validate() const;

@@ -95,8 +95,13 @@ class SeedDrill {
   bool inDetour(const Eigen::Vector2d& p) const;
   /// Index of the row nearest p (-1 without rows).
   int nearestRow(const Eigen::Vector2d& p) const;
-  /// Radius of an obstacle's detour zone: radius + influence + detour_margin [m].
+  /// Radius of an obstacle's detour zone: radius + influence + detour_margin [m]. Seeds inside it are detour seeds,
+  /// whose offset from the row line is reported apart (the robot is going round there).
   double detourRadius(const Obstacle& o) const { return o.radius + influence_ + params_.detour_margin; }
+  /// Radius about an obstacle inside which its row is blocked: radius + influence [m]. The plan keeps the axle at
+  /// least the influence distance from the obstacle's surface (AvoidanceParams::pathClearance), so no seed can
+  /// fall on the row line there; the rest of a detour, where the robot leaves and rejoins the row, is row to sow.
+  double blockedRadius(const Obstacle& o) const { return o.radius + influence_; }
 
   const std::vector<RowSegment>& rows() const { return rows_; }
   const std::vector<Obstacle>& obstacles() const { return obstacles_; }

@@ -26,6 +26,10 @@ std::string robotParamsFromUrdf(const std::string& urdf_xml, core::RobotParams& 
 /// the seed-drop point). Returns "" or one line naming what is missing.
 std::string linkPositionFromUrdf(const std::string& urdf_xml, const std::string& link, double& x, double& y);
 
+/// How far the seed drill's tool point (`tool_link`) trails the axle [m] (>= 0): a planned field's
+/// FieldParams::run_out, so its last row is driven until the tool point is at the row's end. "" or one line.
+std::string toolRunOutFromUrdf(const std::string& urdf_xml, const std::string& tool_link, double& run_out);
+
 /// The robot's footprint in base_link: every link's collision geometry (box, cylinder, sphere) projected
 /// onto base_link's ground plane, through the joints at zero position (the drive wheels' continuous
 /// joints included: their collision cylinders are about the axle, so the projection does not depend on
