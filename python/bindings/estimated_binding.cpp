@@ -147,7 +147,7 @@ py::dict seedsDict(const std::vector<Seed>& seeds) {
 /// The seed figures under the metric registry's names (run_metrics.h: its seed_figure entries), as runs.csv has them.
 py::dict seedFiguresDict(const SeedFigures& f) {
   RunRow row;
-  storeSeedFigures(row, f);
+  row.seed_figures = f;
   py::dict d;
   for (const RunMetric& m : runMetrics())
     if (m.seed_figure) d[m.name.c_str()] = m.get(row);

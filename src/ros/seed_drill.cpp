@@ -9,6 +9,7 @@
 #include "sowing_robot/core/simulation/lockstep.h"
 #include "sowing_robot/ros/common/component_params.h"
 #include "sowing_robot/ros/common/msg_checks.h"
+#include "sowing_robot/ros/common/seed_message.h"
 #include "sowing_robot/ros/common/urdf_params.h"
 
 namespace sowing_robot {
@@ -167,17 +168,7 @@ void SeedDrillNode::sow(const nav_msgs::Odometry& truth, const nav_msgs::Odometr
 }
 
 void SeedDrillNode::addSeed(const core::Seed& seed, const ros::Time& stamp) {
-  Seed record;
-  record.header.stamp = stamp;
-  record.header.frame_id = odom_frame_;
-  record.position.x = seed.truth.x();
-  record.position.y = seed.truth.y();
-  record.believed.x = seed.believed.x();
-  record.believed.y = seed.believed.y();
-  record.row = seed.row;
-  record.depth = seed.depth;
-  record.detour = seed.detour;
-  record_pub_.publish(record);
+  record_pub_.publish(seedMessage(seed, stamp, odom_frame_));
   if (chunk_.points.size() >= kChunk) {
     chunk_.points.clear();
     ++chunk_id_;

@@ -7,33 +7,10 @@
 #include <exception>
 #include <set>
 
+#include "sowing_robot/ros/common/seed_message.h"
+
 namespace sowing_robot {
 namespace seed_map {
-
-core::Seed fromMessage(const sowing_robot::Seed& msg) {
-  core::Seed s;
-  s.t = msg.header.stamp.toSec();
-  s.truth = {msg.position.x, msg.position.y};
-  s.believed = {msg.believed.x, msg.believed.y};
-  s.row = msg.row;
-  s.depth = msg.depth;
-  s.detour = msg.detour;
-  return s;
-}
-
-sowing_robot::Seed toMessage(const core::Seed& seed, const std::string& frame) {
-  sowing_robot::Seed m;
-  m.header.stamp.fromSec(seed.t);
-  m.header.frame_id = frame;
-  m.position.x = seed.truth.x();
-  m.position.y = seed.truth.y();
-  m.believed.x = seed.believed.x();
-  m.believed.y = seed.believed.y();
-  m.row = seed.row;
-  m.depth = seed.depth;
-  m.detour = seed.detour;
-  return m;
-}
 
 std::string readBagSeeds(const std::string& path, const std::string& topic, std::vector<core::Seed>& seeds,
                          std::string& used_topic) {
@@ -69,7 +46,7 @@ std::string readBagSeeds(const std::string& path, const std::string& topic, std:
       const sowing_robot::Seed::ConstPtr msg = m.instantiate<sowing_robot::Seed>();
       if (!msg)
         return chosen + " in " + path + " holds another definition of " + type + " (md5sum " + m.getMD5Sum() + ")";
-      out.push_back(fromMessage(*msg));
+      out.push_back(seedOf(*msg));
     }
     if (out.empty()) return "no seeds in " + path + " on " + chosen;
     seeds = std::move(out);

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "../common/hold_meter.h"
 #include "sowing_robot/core/simulation/field_run.h"
 #include "sowing_robot/core/simulation/runner.h"
 #include "sowing_robot/scenario_file/scenario_loader.h"
@@ -74,10 +75,11 @@ TEST(ProfileEdges, TheProfileIsWhatTheToolsRun) {
   EXPECT_TRUE(run.config.estimator.slip.detect);
 }
 
-struct StopFigures {
+/// HoldMeter's figures over the hold from kSettle after the stop.
+struct StopFigures : test::HoldMeter {
   double t_stop = -1.0;
   bool flagged = false;
-  double max_v = 0.0, max_omega = 0.0, drift = 0.0, max_wheel_rate = 0.0, max_torque = 0.0;
+  double max_torque = 0.0;
   double clearance = 1e9;  ///< the axle's least distance to the obstacle's surface after the stop [m]
   Eigen::Vector2d end = Eigen::Vector2d::Zero();
   AvoidanceStatus status;
@@ -92,9 +94,6 @@ StopFigures runStop(const std::string& pair) {
   run.scenario.duration = FieldPath(run.field, obstacles).duration() + 15.0 + kSettle + kHold;
   FieldReference reference(run.field, obstacles);
   StopFigures f;
-  Eigen::Vector2d settled(0.0, 0.0);
-  bool has_settled = false, has_prev = false;
-  double prev_t = 0.0, prev_phi[2] = {0.0, 0.0};
   const LoopResult r = runClosedLoop(run.scenario, run.config, reference, false, [&](const EstimatedSample& es) {
     const LoopSample& s = *es.loop;
     const State& x = *s.state;
@@ -109,18 +108,7 @@ StopFigures runStop(const std::string& pair) {
     f.clearance = std::min(f.clearance, (p - Eigen::Vector2d(60.0, 3.0)).norm() - 0.3);
     if (s.t < f.t_stop + kSettle) return;
     f.max_torque = std::max({f.max_torque, std::fabs(es.sent.right), std::fabs(es.sent.left)});
-    if (!has_settled) settled = p;
-    has_settled = true;
-    f.max_v = std::max(f.max_v, std::fabs(x[V]));
-    f.max_omega = std::max(f.max_omega, std::fabs(x[OMEGA]));
-    f.drift = std::max(f.drift, (p - settled).norm());
-    if (has_prev)
-      for (int w = 0; w < 2; ++w)
-        f.max_wheel_rate = std::max(f.max_wheel_rate, std::fabs(x[PHI_R + w] - prev_phi[w]) / (s.t - prev_t));
-    has_prev = true;
-    prev_t = s.t;
-    prev_phi[0] = x[PHI_R];
-    prev_phi[1] = x[PHI_L];
+    f.sample(s.t, x);
   });
   f.end = Eigen::Vector2d(r.run.final_state[X], r.run.final_state[Y]);
   f.status = reference.status();

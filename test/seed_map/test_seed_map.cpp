@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "sowing_robot/ros/common/seed_message.h"
 #include "sowing_robot/seed_map/bag_seeds.h"
 #include "sowing_robot/seed_map/seed_map.h"
 
@@ -214,7 +215,8 @@ void writeBag(const std::string& path, const std::vector<std::pair<std::string, 
     s.data = "not a seed";
     bag.write("/chatter", ros::Time(1.0), s);
   }
-  for (const auto& [topic, seed] : seeds) bag.write(topic, ros::Time(seed.t), sm::toMessage(seed, "odom"));
+  for (const auto& [topic, seed] : seeds)
+    bag.write(topic, ros::Time(seed.t), sowing_robot::seedMessage(seed, ros::Time(seed.t), "odom"));
 }
 
 TEST_F(SeedMap, BagSeedsReadBack) {

@@ -1,19 +1,14 @@
 // The seed record of a bag: the seed drill's sowing_robot/Seed messages (`seeds/record`, recorded by sim.launch
-// record:=true) read back as core::Seed, and the conversion both ways.
+// record:=true) read back as core::Seed (the conversion: ros/common/seed_message.h).
 #pragma once
 
 #include <string>
 #include <vector>
 
-#include "sowing_robot/Seed.h"
 #include "sowing_robot/core/planning/seeding.h"
 
 namespace sowing_robot {
 namespace seed_map {
-
-core::Seed fromMessage(const sowing_robot::Seed& msg);
-/// The message of a seed (its stamp from seed.t), in `frame`.
-sowing_robot::Seed toMessage(const core::Seed& seed, const std::string& frame);
 
 /// The seeds of `path` in bag order (time order), from `topic` or ("") from the bag's one topic of type
 /// sowing_robot/Seed; `used_topic` names it. "" or the one line why not: the bag cannot be read (missing, corrupt,

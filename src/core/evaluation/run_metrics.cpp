@@ -19,6 +19,14 @@ void access(RunMetric& m, T RunRow::*field) {
     m.set = [field](RunRow& r, double v) { r.*field = static_cast<T>(v); };
 }
 
+/// A member of RunRow's seed figures as a metric's get/set: a figure of the seed record (seed_figure).
+template <typename T>
+void access(RunMetric& m, T SeedFigures::*field) {
+  m.get = [field](const RunRow& r) { return static_cast<double>(r.seed_figures.*field); };
+  m.set = [field](RunRow& r, double v) { r.seed_figures.*field = static_cast<T>(v); };
+  m.seed_figure = true;
+}
+
 /// The glyph of an axis in labels (the column suffix is axisName()).
 const char* axisGlyph(int axis) {
   static const char* const glyphs[AXIS_COUNT] = {"x", "y", "θ"};
@@ -99,51 +107,50 @@ std::vector<RunMetric> buildMetrics() {
   m->format = MetricFormat::flag;
   m->aggregation = Aggregation::share;
   // The seed record (seed_metrics.h): tracks with rows to sow (NaN on the sine track).
-  const std::size_t first_seed_figure = out.size();
-  m = add("seeds", "seeds", "seeds", "seeds the drill placed", &RunRow::seeds);
+  m = add("seeds", "seeds", "seeds", "seeds the drill placed", &SeedFigures::seeds);
   m->format = MetricFormat::count;
   m->aggregation = Aggregation::mean;
   m->better = Better::none;
   m = add("sown_share", "1", "sown share",
           "share of the rows sown outside obstacle stretches (consecutive seeds at most 1.5 spacings apart)",
-          &RunRow::sown_share);
+          &SeedFigures::sown_share);
   m->report_table = m->compared = true;
   m->better = Better::higher;
   m->overview_column = 6;
   m->plots = kBoxPlot;
-  m = add("worst_row_share", "1", "worst row sown", "sown share of the least-sown row", &RunRow::worst_row_share);
+  m = add("worst_row_share", "1", "worst row sown", "sown share of the least-sown row", &SeedFigures::worst_row_share);
   m->better = Better::higher;
   m = add("detour_sown_share", "1", "detour sown", "sown share of the rows' obstacle stretches (NaN without)",
-          &RunRow::detour_sown_share);
+          &SeedFigures::detour_sown_share);
   m->better = Better::none;
   m = add("multiples_index", "%", "multiples D", "ISO 7256-1: share of seed spacings <= 0.5 x the set spacing",
-          &RunRow::multiples_index);
+          &SeedFigures::multiples);
   m = add("miss_index", "%", "misses M", "ISO 7256-1: share of seed spacings > 1.5 x the set spacing",
-          &RunRow::miss_index);
-  m = add("quality_of_feed", "%", "quality of feed", "ISO 7256-1: A = 100 - D - M", &RunRow::quality_of_feed);
+          &SeedFigures::misses);
+  m = add("quality_of_feed", "%", "quality of feed", "ISO 7256-1: A = 100 - D - M", &SeedFigures::quality_of_feed);
   m->report_table = m->compared = true;
   m->better = Better::higher;
   m->overview_column = 7;
   m->plots = kBoxPlot;
   m = add("precision", "%", "precision C",
-          "ISO 7256-1: standard deviation of the accepted spacings over the set spacing", &RunRow::precision);
+          "ISO 7256-1: standard deviation of the accepted spacings over the set spacing", &SeedFigures::precision);
   m->report_table = true;
   m = add("seed_lateral_rms", "m", "seed offset RMS", "RMS of the seeds' offset from their row's line (not in detours)",
-          &RunRow::seed_lateral_rms);
+          &SeedFigures::lateral_rms);
   m = add("seed_lateral_p95", "m", "seed offset p95", "p95 of the seeds' offset from their row's line (not in detours)",
-          &RunRow::seed_lateral_p95);
+          &SeedFigures::lateral_p95);
   m->report_table = m->compared = true;
   m->plots = kBoxPlot;
   m = add("seed_lateral_max", "m", "seed offset max", "largest offset of a seed from its row's line (not in detours)",
-          &RunRow::seed_lateral_max);
+          &SeedFigures::lateral_max);
   m = add("depth_outside_share", "1", "depth outside band",
-          "share of the seeds placed outside the agronomic depth band", &RunRow::depth_outside_share);
+          "share of the seeds placed outside the agronomic depth band", &SeedFigures::depth_outside);
   m = add("map_error_rms", "m", "seed-map error RMS",
           "RMS of |believed - true seed position|: the fed pose's tool point against where the seed fell",
-          &RunRow::map_error_rms);
+          &SeedFigures::map_error_rms);
   m->report_table = m->compared = true;
-  m = add("map_error_p95", "m", "seed-map error p95", "p95 of |believed - true seed position|", &RunRow::map_error_p95);
-  for (std::size_t i = first_seed_figure; i < out.size(); ++i) out[i].seed_figure = true;
+  m = add("map_error_p95", "m", "seed-map error p95", "p95 of |believed - true seed position|",
+          &SeedFigures::map_error_p95);
   m = add("success", "bool", "success",
           "not diverged, no contact, finished, and the scenario's rule: sown (the seed record's figures within the "
           "scenario's bounds) or tracking (|cross-track| below the threshold from settle_time on)",

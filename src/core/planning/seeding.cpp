@@ -121,13 +121,13 @@ bool SeedDrill::drop(double t, const Eigen::Vector2d& truth, const Eigen::Vector
   return true;
 }
 
-bool SeedDrill::withinRowSpan(const Eigen::Vector2d& p) const {
+bool SeedDrill::withinRowSpan(const Eigen::Vector2d& p, bool open_ended) const {
   for (const RowSegment& r : rows_) {
     const Eigen::Vector2d ab = r.b - r.a;
     const double len2 = ab.squaredNorm();
     if (!(len2 > 0.0)) continue;
     const double u = (p - r.a).dot(ab) / len2;
-    if (u > 0.0 && u < 1.0) return true;
+    if (u > 0.0 && (u < 1.0 || open_ended)) return true;
   }
   return false;
 }

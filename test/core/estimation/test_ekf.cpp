@@ -9,19 +9,16 @@
 #include <random>
 #include <vector>
 
+#include "nees_bounds.h"
 #include "sowing_robot/core/estimation/ekf.h"
 #include "sowing_robot/core/model/sensors.h"
 
 using namespace sowing_robot::core;
+using sowing_robot::test::neesBounds;
+using sowing_robot::test::NeesBounds;
 using Vector6 = Eigen::Matrix<double, 6, 1>;
 
 namespace {
-
-/// Quantile of chi-square with k dof (Wilson-Hilferty; within 0.1 % for k >= 50).
-double chi2Quantile(double k, double z) {
-  const double a = 2.0 / (9.0 * k);
-  return k * std::pow(1.0 - a + z * std::sqrt(a), 3.0);
-}
 
 EkfStepInput straight(double distance, double var_distance) {
   EkfStepInput in;
@@ -227,15 +224,6 @@ NeesRun runNees(std::uint64_t seed, const EkfParams& filter_params, const EkfPar
   }
   EXPECT_EQ(ekf.counts().refused(), 0) << "seed " << seed << ": " << ekf.counts().gated << " gated";
   return out;
-}
-
-/// The 95 % interval of the mean NEES over M independent runs at one time: chi2(4 M) / M.
-struct NeesBounds {
-  double lo, hi;
-};
-NeesBounds neesBounds(std::size_t runs, double z = 1.96) {
-  const double k = 4.0 * runs;
-  return {chi2Quantile(k, -z) / runs, chi2Quantile(k, z) / runs};
 }
 
 /// Counts the checkpoints whose mean NEES over the runs is outside the two-sided 99 % interval of

@@ -13,21 +13,18 @@
 #include <utility>
 #include <vector>
 
+#include "nees_bounds.h"
 #include "sowing_robot/core/estimation/ekf.h"
 #include "sowing_robot/core/model/sensors.h"
 
 using namespace sowing_robot::core;
+using sowing_robot::test::neesBounds;
+using sowing_robot::test::NeesBounds;
 using Vector10 = Eigen::Matrix<double, 10, 1>;
 
 namespace {
 
 constexpr double kR = 0.095, kL = 0.24, kDt = 1e-3;
-
-/// Quantile of chi-square with k dof (Wilson-Hilferty).
-double chi2Quantile(double k, double z) {
-  const double a = 2.0 / (9.0 * k);
-  return k * std::pow(1.0 - a + z * std::sqrt(a), 3.0);
-}
 
 /// What the truth does at time t: the body's twist and each wheel's spin, the surface speed R W of the
 /// wheel beyond the ground speed of its contact point [m/s].
@@ -191,15 +188,6 @@ Motion stalled(double t) {
   }
   m.spin_right = m.spin_left = wheel - m.v;
   return m;
-}
-
-/// The 95 % interval of the mean NEES over M runs at one time: chi2(4 M) / M.
-struct NeesBounds {
-  double lo, hi;
-};
-NeesBounds neesBounds(std::size_t runs, double z = 1.96) {
-  const double k = 4.0 * runs;
-  return {chi2Quantile(k, -z) / runs, chi2Quantile(k, z) / runs};
 }
 
 /// Mean NEES over the runs and their checkpoints; `outside` the checkpoints whose mean over the runs is

@@ -70,7 +70,8 @@ TEST(Avoidance, ThesisFieldClearsEveryObstacleWithinTheBoundsAndKeepsTheRowSeeds
 }
 
 TEST(Avoidance, ThesisPotentialFieldAloneRunsTheBodyIntoTheObstacles) {
-  // What the issue measured (the check above fails this way without the plan).
+  // Why the detours are planned: the thesis's potential field alone drives the body into the obstacles (the
+  // check above fails this way without the plan).
   FieldRunSetup s = thesisField();
   s.field.avoidance.plan_detours = false;
   const FieldRunReport r = runField(s);

@@ -385,14 +385,15 @@ TEST(EstimatedRun, AGovernedRunGetsTheTimeTheGovernorTookBack) {
   EXPECT_GE(back_ref.lastTime(), sc.duration - 0.01);  // the path has run its duration (to within a period)
 }
 
-// Slip-limit hitch control in the loop (FIELD.md's grip budget): on a patch where the wheels' peak grip
-// cannot pull the tool's draft (mu 0.2 at mass 1.3: 38.7 N against 18.4 N of rolling resistance plus a 25 N
-// draft) the robot with the tool kept down stalls behind its target; with the hitch the traction control's
-// grip verdict raises the tool, the robot crosses, and the row it left unsown is counted. The hitch needs
-// the traction control.
-TEST(EstimatedRun, TheHitchControlLiftsTheToolThroughAPatchTheDraftCannotBePulledAcross) {
+// The hitch tests' line (kanayama+pid, 14 s): a 25 N draft on an open-ended row along it, a wet patch from x = 4 to
+// 9 m (mu 0.2, rolling resistance 0.08), the motors and the traction control on (raising the tool at 10 /s).
+Scenario hitchLine() {
   Scenario sc = line(OuterKind::kanayama, InnerKind::pid);
   sc.duration = 14.0;
+  return sc;
+}
+
+LoopConfig hitchPatch() {
   LoopConfig cfg;
   TractionParams t;
   t.draft_force = 25.0;
@@ -408,6 +409,17 @@ TEST(EstimatedRun, TheHitchControlLiftsTheToolThroughAPatchTheDraftCannotBePulle
   cfg.motor.enabled = true;
   cfg.traction_control.enabled = true;
   cfg.traction_control.raise_rate = 10.0;
+  return cfg;
+}
+
+// Slip-limit hitch control in the loop (FIELD.md's grip budget): on a patch where the wheels' peak grip
+// cannot pull the tool's draft (mu 0.2 at mass 1.3: 38.7 N against 18.4 N of rolling resistance plus a 25 N
+// draft) the robot with the tool kept down stalls behind its target; with the hitch the traction control's
+// grip verdict raises the tool, the robot crosses, and the row it left unsown is counted. The hitch needs
+// the traction control.
+TEST(EstimatedRun, TheHitchControlLiftsTheToolThroughAPatchTheDraftCannotBePulledAcross) {
+  const Scenario sc = hitchLine();
+  LoopConfig cfg = hitchPatch();
   LineReference ref;
   const LoopResult down = runClosedLoop(sc, cfg, ref, false);
   cfg.hitch_control.enabled = true;
@@ -433,23 +445,8 @@ TEST(EstimatedRun, TheHitchControlLiftsTheToolThroughAPatchTheDraftCannotBePulle
 // row unsown than the hitch alone. The trace's tool_depth is 0 with the tool up and the nominal depth without
 // depth control.
 TEST(EstimatedRun, DepthControlRunsTheDrillShallowerBeforeLiftingIt) {
-  Scenario sc = line(OuterKind::kanayama, InnerKind::pid);
-  sc.duration = 14.0;
-  LoopConfig cfg;
-  TractionParams t;
-  t.draft_force = 25.0;
-  cfg.traction = t;
-  SoilPatch wet;
-  wet.polygon = {{4.0, 0.0}, {9.0, 0.0}, {9.0, 6.0}, {4.0, 6.0}};
-  wet.mu_peak = 0.2;
-  wet.mu_slide = 0.15;
-  wet.rolling_resistance = 0.08;
-  cfg.patches = {wet};
-  cfg.tool_rows = {RowSegment{Eigen::Vector2d(0.0, 3.0), Eigen::Vector2d(100.0, 3.0)}};
-  cfg.tool_rows_open_ended = true;
-  cfg.motor.enabled = true;
-  cfg.traction_control.enabled = true;
-  cfg.traction_control.raise_rate = 10.0;
+  const Scenario sc = hitchLine();
+  LoopConfig cfg = hitchPatch();
   cfg.hitch_control.enabled = true;
   struct Depths {
     double min_down = 1.0, max_down = 0.0;
@@ -477,8 +474,8 @@ TEST(EstimatedRun, DepthControlRunsTheDrillShallowerBeforeLiftingIt) {
       "mean sowing depth %.4f m, end x %.2f m\n",
       hitch.unsown_distance, hitch.hitch_raises, depth.unsown_distance, depth.hitch_raises, depth_depths.min_down,
       depth_depths.max_down, depth.meanSowingDepth(), depth.run.final_state[X]);
-  EXPECT_EQ(hitch_depths.min_down, t.draft_depth);  // no depth control: the nominal depth throughout
-  EXPECT_EQ(hitch_depths.max_down, t.draft_depth);
+  EXPECT_EQ(hitch_depths.min_down, cfg.traction->draft_depth);  // no depth control: the nominal depth throughout
+  EXPECT_EQ(hitch_depths.max_down, cfg.traction->draft_depth);
   EXPECT_TRUE(hitch_depths.up_is_zero);
   EXPECT_TRUE(depth_depths.up_is_zero);
   EXPECT_NEAR(depth_depths.min_down, 0.02, 1e-4);  // down to the band's shallowest (deepening from there)
@@ -498,12 +495,7 @@ TEST(EstimatedRun, DepthControlRunsTheDrillShallowerBeforeLiftingIt) {
 // hold while a torque is held back), without it the run is the one of today's layers bit for bit.
 TEST(EstimatedRun, TheTractionControlsAntiWindupReachesTheInnerLoop) {
   Scenario sc = line(OuterKind::kanayama, InnerKind::pid);
-  LoopConfig cfg;
-  TractionParams wet;
-  wet.mu_peak = 0.2;
-  wet.mu_slide = 0.15;
-  cfg.traction = wet;
-  cfg.motor.enabled = true;
+  LoopConfig cfg = wetLineWithMotors();
   cfg.traction_control.enabled = true;
   LineReference ref;
   const LoopResult plain = runClosedLoop(sc, cfg, ref, false);

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "../../common/hold_meter.h"
 #include "sowing_robot/core/simulation/field_run.h"
 #include "sowing_robot/core/simulation/runner.h"
 
@@ -49,12 +50,10 @@ struct StopRun {
   }
 };
 
-struct HoldFigures {
-  double t_stop = -1.0;                 ///< the path's end: the plan stops the robot here [s]
-  bool flagged = false;                 ///< the reference said so (Reference::stop) from then on
-  double max_v = 0.0, max_omega = 0.0;  ///< over [t_stop + kSettle, end]
-  double drift = 0.0;                   ///< largest distance from the pose at t_stop + kSettle [m]
-  double max_wheel_rate = 0.0;          ///< largest |wheel spin| over the hold, either wheel [rad/s]
+/// HoldMeter's figures over [t_stop + kSettle, end] (drift: from the pose at t_stop + kSettle).
+struct HoldFigures : sowing_robot::test::HoldMeter {
+  double t_stop = -1.0;  ///< the path's end: the plan stops the robot here [s]
+  bool flagged = false;  ///< the reference said so (Reference::stop) from then on
   Eigen::Vector2d end = Eigen::Vector2d::Zero();
   AvoidanceStatus status;
   bool diverged = false;
@@ -64,13 +63,8 @@ HoldFigures runStop(const StopRun& run, const LoopConfig& config = {},
                     const std::function<void(double, FieldReference&)>& on_step = {}) {
   FieldReference reference(run.field, run.obstacles);
   HoldFigures f;
-  Eigen::Vector2d settled(0.0, 0.0);
-  bool has_settled = false;
-  bool has_prev = false;  // the hold's previous sample: its time and wheel angles
-  double prev_t = 0.0, prev_phi[2] = {0.0, 0.0};
   const LoopResult r = runClosedLoop(run.scenario, config, reference, false, [&](const EstimatedSample& es) {
     const LoopSample& s = *es.loop;
-    const State& x = *s.state;
     if (on_step) on_step(s.t, reference);
     if (f.t_stop < 0.0 && reference.finished(s.t)) {
       f.t_stop = s.t;
@@ -78,20 +72,7 @@ HoldFigures runStop(const StopRun& run, const LoopConfig& config = {},
     }
     if (f.t_stop >= 0.0 && !s.reference->stop) f.flagged = false;
     if (f.t_stop < 0.0 || s.t < f.t_stop + kSettle) return;
-    const Eigen::Vector2d p(x[X], x[Y]);
-    if (!has_settled) settled = p;
-    has_settled = true;
-    f.max_v = std::max(f.max_v, std::fabs(x[V]));
-    f.max_omega = std::max(f.max_omega, std::fabs(x[OMEGA]));
-    f.drift = std::max(f.drift, (p - settled).norm());
-    // The wheels' spin over each period of the hold, from their angles (what an encoder counts).
-    if (has_prev)
-      for (int w = 0; w < 2; ++w)
-        f.max_wheel_rate = std::max(f.max_wheel_rate, std::fabs(x[PHI_R + w] - prev_phi[w]) / (s.t - prev_t));
-    has_prev = true;
-    prev_t = s.t;
-    prev_phi[0] = x[PHI_R];
-    prev_phi[1] = x[PHI_L];
+    f.sample(s.t, *s.state);
   });
   f.end = Eigen::Vector2d(r.run.final_state[X], r.run.final_state[Y]);
   f.status = reference.status();
@@ -162,7 +143,8 @@ TEST(StopHold, FedTheEstimateItHoldsToTheEncodersResolution) {
   // The hold works on the fed twist (here the EKF's: the encoders' windowed speed, the gyro's rate), not
   // on the hidden truth. The encoders resolve the speed to one tick per window, 2 pi R / 2048 / 0.01 s =
   // 0.029 m/s (config/sensors.yaml), and the hold cannot damp finer than that: |v| stays below it, and
-  // the robot does not creep (drift < 1 cm).
+  // the robot does not creep (drift < 1 cm). Without the traction control this is the hold on the EKF's twist;
+  // with it (the field profile) the hold closes on the wheels' encoder rates instead: test_profile_edges.
   const double quantum = 2.0 * M_PI * Scenario().robot.R / 2048 / 0.01;
   for (const char* pair : {"kanayama+atsmc", "rpp+pid"}) {
     const StopRun run(pair, {{kRow, 3.0, 0.3}});

@@ -53,30 +53,12 @@ inline bool performanceFailure(const std::string& failure) {
          failure == "seed map" || failure == "slip";
 }
 
-/// The seed figures into the row.
-inline void storeSeedFigures(RunRow& row, const SeedFigures& f) {
-  row.seeds = static_cast<long>(f.seeds);
-  row.sown_share = f.sown_share;
-  row.worst_row_share = f.worst_row_share;
-  row.detour_sown_share = f.detour_sown_share;
-  row.multiples_index = f.multiples;
-  row.miss_index = f.misses;
-  row.quality_of_feed = f.quality_of_feed;
-  row.precision = f.precision;
-  row.seed_lateral_rms = f.lateral_rms;
-  row.seed_lateral_p95 = f.lateral_p95;
-  row.seed_lateral_max = f.lateral_max;
-  row.depth_outside_share = f.depth_outside;
-  row.map_error_rms = f.map_error_rms;
-  row.map_error_p95 = f.map_error_p95;
-}
-
 /// The sown rule's verdict on the seed figures ("" when they pass; the slip is judged where it is known).
 inline std::string seedFailure(const RunRow& row, const MonteCarloSpec& spec) {
-  if (!(row.worst_row_share >= spec.min_sown_share)) return "row unsown";
-  if (!(row.quality_of_feed >= spec.min_quality_of_feed)) return "seed spacing";
-  if (!(row.seed_lateral_p95 <= spec.max_seed_lateral_p95)) return "off the row";
-  if (!(row.map_error_rms <= spec.max_map_error_rms)) return "seed map";
+  if (!(row.seed_figures.worst_row_share >= spec.min_sown_share)) return "row unsown";
+  if (!(row.seed_figures.quality_of_feed >= spec.min_quality_of_feed)) return "seed spacing";
+  if (!(row.seed_figures.lateral_p95 <= spec.max_seed_lateral_p95)) return "off the row";
+  if (!(row.seed_figures.map_error_rms <= spec.max_map_error_rms)) return "seed map";
   return "";
 }
 
@@ -143,7 +125,7 @@ class RowMeter {
       row_.failure = "contact";
     }
     if (seeds_) {
-      storeSeedFigures(row_, seedFigures(seeds_->seeds(), seeds_->drill()));
+      row_.seed_figures = seedFigures(seeds_->seeds(), seeds_->drill());
       if (extras_.keep_seeds) row_.seed_record = seeds_->takeSeeds();
     }
     if (row_.failure.empty()) {

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "sowing_robot/core/common/reference.h"
+#include "sowing_robot/core/evaluation/seed_metrics.h"
 #include "sowing_robot/core/planning/sine_reference.h"
 #include "sowing_robot/core/simulation/field_run.h"
 #include "sowing_robot/core/simulation/metrics.h"
@@ -114,21 +115,9 @@ struct RunRow {
   /// fallen there (that length over the seed drill's spacing). 0 without the hitch control.
   double unsown_distance = std::numeric_limits<double>::quiet_NaN();
   double seeds_unsown = std::numeric_limits<double>::quiet_NaN();
-  /// The seed record's figures (seed_metrics.h: SeedFigures): tracks with rows to sow; NaN (count 0) without.
-  long seeds = 0;
-  double sown_share = std::numeric_limits<double>::quiet_NaN();
-  double worst_row_share = std::numeric_limits<double>::quiet_NaN();
-  double detour_sown_share = std::numeric_limits<double>::quiet_NaN();
-  double multiples_index = std::numeric_limits<double>::quiet_NaN();
-  double miss_index = std::numeric_limits<double>::quiet_NaN();
-  double quality_of_feed = std::numeric_limits<double>::quiet_NaN();
-  double precision = std::numeric_limits<double>::quiet_NaN();
-  double seed_lateral_rms = std::numeric_limits<double>::quiet_NaN();
-  double seed_lateral_p95 = std::numeric_limits<double>::quiet_NaN();
-  double seed_lateral_max = std::numeric_limits<double>::quiet_NaN();
-  double depth_outside_share = std::numeric_limits<double>::quiet_NaN();
-  double map_error_rms = std::numeric_limits<double>::quiet_NaN();
-  double map_error_p95 = std::numeric_limits<double>::quiet_NaN();
+  /// The seed record's figures (seed_metrics.h): tracks with rows to sow; NaN (count 0) without. The registry's
+  /// seed_figure entries read them (run_metrics.cpp).
+  SeedFigures seed_figures;
   /// The seeds themselves, when the caller asked for them (RunExtras::keep_seeds; empty otherwise).
   std::vector<Seed> seed_record;
 };

@@ -89,8 +89,9 @@ class SeedDrill {
   /// True when p is within engage_distance of a row and between its ends (not beyond them, as in a
   /// headland turn): where the tool may be lowered.
   bool onRowSegment(const Eigen::Vector2d& p) const;
-  /// True when p's projection lies strictly between the ends of some row (at any distance from it).
-  bool withinRowSpan(const Eigen::Vector2d& p) const;
+  /// True when p's projection lies strictly between the ends of some row (at any distance from it); past the far
+  /// end too when open_ended (the rows go on past their ends: the tool rule's open-ended plan, tool_engagement.h).
+  bool withinRowSpan(const Eigen::Vector2d& p, bool open_ended = false) const;
   /// True when p lies in an obstacle's detour zone.
   bool inDetour(const Eigen::Vector2d& p) const;
   /// Index of the row nearest p (-1 without rows).

@@ -30,12 +30,11 @@ class ToolEngagement {
   bool update(const Eigen::Vector2d& p);
   bool down() const { return down_; }
   /// True when p lies between the ends of some row (its projection strictly inside; past the end too
-  /// for an open-ended plan).
+  /// for an open-ended plan): SeedDrill::withinRowSpan.
   bool withinRows(const Eigen::Vector2d& p) const;
 
  private:
-  SeedDrill geometry_;  // only its onRowSegment: the seed drill's own rule
-  std::vector<RowSegment> rows_;
+  SeedDrill geometry_;  // the plan's rows and the seed drill's own rules (onRowSegment, withinRowSpan)
   bool open_ended_ = false;
   bool down_ = false;
 };
