@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "sowing_robot/core/model/traction.h"
 #include "sowing_robot/scenario_file/scenario_loader.h"
 #include "sowing_robot/scenario_file/scenario_sets.h"
 #include "sowing_robot/scenario_file/tune_config.h"
@@ -183,7 +184,7 @@ TEST(ScenarioSets, TheTunerRefusesATestScenario) {
       dir.write("tune.yaml",
                 "pso_tuner: {particles: 2, iterations: 0, controller: kanayama+atsmc}\nrobust:\n  training:\n"
                 "    - {scenario: " +
-                    kSuite + "/test/test_silt_rut.yaml, runs: 1, base_seed: 1}\n");
+                    kSuite + "/test/test_peat_band.yaml, runs: 1, base_seed: 1}\n");
   try {
     scenario_file::loadTuneConfig(config, "", kSource);
     ADD_FAILURE() << "a test scenario was accepted for training";
@@ -243,4 +244,22 @@ TEST(ScenarioSets, NoTestScenarioSharesContentWithATrainingOrValidationOne) {
   EXPECT_GE(wet, 3);
   EXPECT_GE(dry, 1);
   EXPECT_EQ(tests, wet + dry);
+}
+
+// No test soil is unsowable by design: the field check (checkFieldDraft, in the benchmark's report header) finds
+// that each soil of each test field, wet patches included, carries the drill at the agronomic band's shallowest
+// depth and the nominal mass. A test field is read, never run, to check this.
+TEST(ScenarioSets, EveryTestSoilCarriesTheDrillAtItsShallowestDepth) {
+  int tests = 0;
+  for (const auto& t : scenario_file::scenarioCatalog(kSuite)) {
+    if (t.scenario.set != "test") continue;
+    SCOPED_TRACE(t.path);
+    ++tests;
+    ASSERT_TRUE(t.scenario.realism && t.scenario.realism->traction);
+    const core::LoopConfig& c = *t.scenario.realism;
+    const auto checks = core::checkFieldDraft(t.scenario.base.robot, 1.0, *c.traction, c.patches, c.seeding.depth_min);
+    EXPECT_EQ(checks.size(), c.patches.size() + 1);  // the field's soil, then each patch
+    EXPECT_EQ(core::fieldDraftWarnings(checks), "");
+  }
+  EXPECT_GE(tests, 4);
 }
