@@ -36,6 +36,7 @@
 
 #include "sowing_robot/DesiredVelocity.h"
 #include "sowing_robot/ReferenceState.h"
+#include "sowing_robot/Seed.h"
 #include "sowing_robot/TorqueControllerState.h"
 #include "sowing_robot/TrackingError.h"
 #include "sowing_robot/WheelTorque.h"
@@ -126,6 +127,21 @@ Extractor<sowing_robot::ReferenceState> referenceState() {
             R(m.v_dot);
             R(m.omega_dot);
             c.bools[0].push_back(m.tool_down);
+          }};
+}
+Extractor<sowing_robot::Seed> seed() {
+  return {{"position.x", "position.y", "believed.x", "believed.y", "row", "depth"},
+          {"detour"},
+          {},
+          [](const sowing_robot::Seed& m, Columns& c) {
+            std::size_t i = 0;
+            R(m.position.x);
+            R(m.position.y);
+            R(m.believed.x);
+            R(m.believed.y);
+            R(m.row);
+            R(m.depth);
+            c.bools[0].push_back(m.detour);
           }};
 }
 Extractor<sowing_robot::DesiredVelocity> desiredVelocity() {
@@ -304,6 +320,7 @@ std::unique_ptr<TopicReader> readerFor(const std::string& type) {
   if (type == "nav_msgs/Odometry") return std::make_unique<TypedReader<nav_msgs::Odometry>>(odometry());
   if (type == "sowing_robot/ReferenceState")
     return std::make_unique<TypedReader<sowing_robot::ReferenceState>>(referenceState());
+  if (type == "sowing_robot/Seed") return std::make_unique<TypedReader<sowing_robot::Seed>>(seed());
   if (type == "sowing_robot/DesiredVelocity")
     return std::make_unique<TypedReader<sowing_robot::DesiredVelocity>>(desiredVelocity());
   if (type == "sowing_robot/WheelTorque")
@@ -468,7 +485,7 @@ PYBIND11_MODULE(_bag, m) {
   m.attr("KNOWN_TYPES") =
       py::make_tuple("sowing_robot/TrackingError", "nav_msgs/Odometry", "sowing_robot/ReferenceState",
                      "sowing_robot/DesiredVelocity", "sowing_robot/WheelTorque", "sowing_robot/TorqueControllerState",
-                     "visualization_msgs/MarkerArray", "visualization_msgs/Marker");
+                     "visualization_msgs/MarkerArray", "visualization_msgs/Marker", "sowing_robot/Seed");
   static py::exception<rosbag::BagException> bag_error(m, "BagError");
   static py::exception<rosbag::BagUnindexedException> unindexed(m, "BagUnindexed", bag_error.ptr());
   static py::exception<rosbag::BagFormatException> format_error(m, "BagFormatError", bag_error.ptr());

@@ -23,7 +23,7 @@ const char* const kUsage =
     "usage: rosrun sowing_robot seed_map BAG [--csv FILE] [--geojson FILE --origin LAT,LON[,ALT]] [--topic NAME]\n"
     "       rosrun sowing_robot seed_map --help\n\n"
     "Writes the seeds a run recorded (the seed drill's sowing_robot/Seed messages, `seeds/record` in a bag of\n"
-    "sim.launch record:=true) as a seed map:\n"
+    "sim.launch record:=lean or full) as a seed map:\n"
     "  --csv FILE       one line per seed: t,x,y,believed_x,believed_y,row,depth,detour (odom frame [m], s)\n"
     "  --geojson FILE   an RFC 7946 FeatureCollection of Point features in WGS84 longitude/latitude\n"
     "  --origin LAT,LON[,ALT]  the WGS84 position [deg, deg, m] of the odom frame's origin (x east, y north);\n"

@@ -14,11 +14,18 @@
 // ~deterministic (the fleet's bags): each message is recorded at the stamp it carries (message_stamp.h)
 // instead of its receive time, held for ~reorder_window of simulated time behind ~recorded_until and written
 // in stamp order (stamp_order_writer.h), so two lockstep runs with the same seed give the same file bit for
-// bit. What is held is written at the close; a crash loses it. Usage: kUsage below (--help).
+// bit. What is held is written at the close; a crash loses it.
+//
+// A lean recording (sim.launch record:=lean, docs/recording.md) keeps only what a whole field's run needs:
+// ~throttle_topics are written at most once per ~throttle_period of their header stamps (the first message
+// of each period: the same messages in every run, whatever the machine's speed, which a wall-clock throttle
+// would not give), rosgraph_msgs/Log messages below ~min_log_level are left out, and ~compression packs the
+// bag's chunks (lz4: fast enough for a 1 kHz loop). Usage: kUsage below (--help).
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
 #include <ros/serialization.h>
 #include <rosbag/bag.h>
+#include <rosgraph_msgs/Log.h>
 #include <std_msgs/Time.h>
 #include <topic_tools/shape_shifter.h>
 
@@ -42,10 +49,12 @@
 namespace {
 const char* const kUsage = SOWING_NODE_USAGE(
     "bag_recorder",
-    "Records the named topics into a bag without losing messages in lockstep runs (sim.launch record:=true):\n"
+    "Records the named topics into a bag without losing messages in lockstep runs (sim.launch record:=):\n"
     "  rosrun sowing_robot bag_recorder _output:=run.bag _topics:=\"/odom /reference ...\" [_queue:=200000]\n"
     "    [_period_topics:=\"/odom ...\"] [_deterministic:=false [_reorder_window:=5]] [_receive_delay:=0 (s per\n"
-    "    message, tests: a recorder starved of CPU)]\n"
+    "    message, tests: a recorder starved of CPU)] [_throttle_topics:=\"/odom ...\" _throttle_period:=0.1 (s of\n"
+    "    their stamps)] [_min_log_level:=0 (rosgraph_msgs/Log below it left out: 4 warnings and above)]\n"
+    "    [_compression:=none|lz4|bz2]\n"
     "On SIGINT it drains what it has received, then closes the bag; ~recorded_until says how far it got.\n"
     "_deterministic:=true records each message at its own stamp and writes the bag in stamp order (held for\n"
     "_reorder_window seconds of simulated time): two lockstep runs with the same seed give the same file.\n");
@@ -119,8 +128,11 @@ class RecordedUntil {
 
 struct Options {
   std::string output;
-  std::vector<std::string> topics, period_topics;
+  std::vector<std::string> topics, period_topics, throttle_topics;
   int queue = 200000;
+  double throttle_period = 0.1;  // [s] of the throttled topics' stamps
+  int min_log_level = 0;         // rosgraph_msgs/Log levels: 1 debug, 2 info, 4 warn, 8 error, 16 fatal
+  std::string compression = "none";
   double receive_delay = 0.0;
   bool deterministic = false;
   double reorder_window = 5.0;  // [s] simulated
@@ -134,12 +146,16 @@ Options readOptions(const ros::NodeHandle& pnh) {
   // Resolved in the node's namespace (a fleet's robot_<i>/ records its own topics), and kept so in the bag.
   o.topics = words(p.get("topics", ""));
   o.period_topics = words(p.get("period_topics", ""));
-  for (auto* list : {&o.topics, &o.period_topics})
+  o.throttle_topics = words(p.get("throttle_topics", ""));
+  for (auto* list : {&o.topics, &o.period_topics, &o.throttle_topics})
     for (std::string& t : *list) t = ros::names::resolve(t);
   o.queue = p.get("queue", o.queue);
   o.receive_delay = p.get("receive_delay", o.receive_delay);
   o.deterministic = p.get("deterministic", o.deterministic);
   o.reorder_window = p.get("reorder_window", o.reorder_window);
+  o.throttle_period = p.get("throttle_period", o.throttle_period);
+  o.min_log_level = p.get("min_log_level", o.min_log_level);
+  o.compression = p.get("compression", o.compression);
   if (!p.error().empty()) sowing_robot::refuseToStart(p.error());
   const std::string unknown = p.unknownKeys();
   if (!unknown.empty()) sowing_robot::refuseToStart(unknown);
@@ -155,58 +171,116 @@ Options readOptions(const ros::NodeHandle& pnh) {
   for (const std::string& t : o.period_topics)
     if (std::find(o.topics.begin(), o.topics.end(), t) == o.topics.end())
       sowing_robot::refuseToStart("~period_topics: " + t + " is not among ~topics");
+  for (const std::string& t : o.throttle_topics)
+    if (std::find(o.topics.begin(), o.topics.end(), t) == o.topics.end())
+      sowing_robot::refuseToStart("~throttle_topics: " + t + " is not among ~topics");
+  if (!(o.throttle_period >= 1e-6 && o.throttle_period <= 3600.0))
+    sowing_robot::refuseToStart("~throttle_period = " + std::to_string(o.throttle_period) +
+                                " must be in [1e-6, 3600] s");
+  if (o.min_log_level < 0 || o.min_log_level > 16)
+    sowing_robot::refuseToStart("~min_log_level = " + std::to_string(o.min_log_level) + " must be in [0, 16]");
+  if (o.compression != "none" && o.compression != "lz4" && o.compression != "bz2")
+    sowing_robot::refuseToStart("~compression = '" + o.compression + "' must be none, lz4 or bz2");
   return o;
 }
 
 using MessageEvent = ros::MessageEvent<topic_tools::ShapeShifter const>;
 
+/// One recorded topic: whether it is a period topic (number `period_index`) and, if throttled, the period of
+/// stamps whose first message was written last.
+struct TopicState {
+  std::string topic;
+  bool is_period = false;
+  std::size_t period_index = 0;
+  bool throttled = false;
+  std::int64_t last_bucket = -1;
+};
+
 /// What every topic's callback writes to and counts: the bag directly, or (~deterministic) the stamp-order
 /// writer, which holds each message ~reorder_window behind ~recorded_until.
 struct Recording {
   Recording(rosbag::Bag& bag, const Options& o, RecordedUntil& recorded)
-      : bag(bag), o(o), recorded(recorded), ordered(bag, o.topics), window(o.reorder_window) {}
+      : bag(bag),
+        o(o),
+        recorded(recorded),
+        ordered(bag, o.topics),
+        window(o.reorder_window),
+        throttle_ns(std::max<std::int64_t>(1, std::llround(o.throttle_period * 1e9))) {}
   rosbag::Bag& bag;
   const Options& o;
   RecordedUntil& recorded;
   std::size_t received = 0;
+  std::size_t written = 0;                 // written to the bag (the stamp-order writer counts its own)
   sowing_robot::StampOrderWriter ordered;  // ~deterministic only
   const ros::Duration window;
-  std::unordered_set<std::string> warned;  // topics already warned of (deterministic mode)
+  std::unordered_set<std::string> warned;  // topics already warned of
+  const std::int64_t throttle_ns;
+  std::vector<TopicState> states;  // one per ~topics entry, filled before any subscription
 };
 
-/// A message of `topic` received (period topic number `index` if `is_period`): written or held.
-void recordMessage(Recording& rec, const std::string& topic, std::size_t index, bool is_period,
-                   const MessageEvent& event) {
+/// False when the lean recording leaves `msg` out: a throttled topic's message whose stamp lies in the period
+/// already written, or a log line below ~min_log_level. `stamp`/`stamped`: the message's, if read.
+bool keep(Recording& rec, TopicState& state, const topic_tools::ShapeShifter& msg, bool stamped,
+          const ros::Time& stamp) {
+  if (rec.o.min_log_level > 0 && msg.getDataType() == "rosgraph_msgs/Log")
+    return msg.instantiate<rosgraph_msgs::Log>()->level >= rec.o.min_log_level;
+  if (!state.throttled) return true;
+  if (!stamped) {
+    if (rec.warned.insert(state.topic + " unthrottled").second)
+      ROS_WARN("bag_recorder: %s (%s) carries no stamp: recorded unthrottled", state.topic.c_str(),
+               msg.getDataType().c_str());
+    return true;
+  }
+  const std::int64_t bucket = static_cast<std::int64_t>(stamp.toNSec()) / rec.throttle_ns;
+  if (bucket <= state.last_bucket) return false;  // repeats and late ones of a written period too
+  state.last_bucket = bucket;
+  return true;
+}
+
+/// Deterministic mode: `bytes` of `msg` (stamped `stamp` if `stamped`) to the stamp-order writer.
+void addInStampOrder(Recording& rec, const std::string& topic, const topic_tools::ShapeShifter& msg, bool stamped,
+                     const ros::Time& stamp, std::vector<std::uint8_t>&& bytes, const MessageEvent& event) {
+  ros::Time t = stamped ? stamp : ros::Time::now();
+  if (t < ros::TIME_MIN) t = ros::TIME_MIN;  // a stamp of 0
+  if (!stamped && rec.warned.insert(topic).second)
+    ROS_WARN(
+        "bag_recorder: %s (%s) carries no stamp: recorded at its receive time, so the bag will not "
+        "repeat bit for bit",
+        topic.c_str(), msg.getDataType().c_str());
+  const ros::Time written_up_to = rec.ordered.writtenUpTo();
+  if (!rec.ordered.add(topic, t, std::move(bytes), event.getConnectionHeaderPtr()) &&
+      rec.warned.insert(topic + " late").second)
+    ROS_WARN(
+        "bag_recorder: %s stamped %.3f s came after the bag was written to %.3f s (~reorder_window "
+        "%.1f s): written out of order, so the bag will not repeat bit for bit",
+        topic.c_str(), t.toSec(), written_up_to.toSec(), rec.window.toSec());
+}
+
+/// A message of `state.topic` received: written, held, or (lean recording) left out.
+void recordMessage(Recording& rec, TopicState& state, const MessageEvent& event) {
+  const std::string& topic = state.topic;
+  const bool is_period = state.is_period;
   const topic_tools::ShapeShifter& msg = *event.getMessage();
   ros::Time stamp;
   bool stamped = false;
   ++rec.received;
   if (!rec.o.deterministic) {
-    stamped = is_period && sowing_robot::messageStamp(msg, stamp);
-    ros::Time t = ros::Time::now();
-    if (t < ros::TIME_MIN) t = ros::TIME_MIN;  // before the first /clock
-    rec.bag.write(topic, t, event.getMessage(), event.getConnectionHeaderPtr());
+    stamped = (is_period || state.throttled) && sowing_robot::messageStamp(msg, stamp);
+    if (keep(rec, state, msg, stamped, stamp)) {
+      ros::Time t = ros::Time::now();
+      if (t < ros::TIME_MIN) t = ros::TIME_MIN;  // before the first /clock
+      rec.bag.write(topic, t, event.getMessage(), event.getConnectionHeaderPtr());
+      ++rec.written;
+    }
   } else {
     std::vector<std::uint8_t> bytes(msg.size());  // held by the writer; the stamp is read from them
     ros::serialization::OStream to(bytes.data(), static_cast<std::uint32_t>(bytes.size()));
     msg.write(to);
     stamped = sowing_robot::messageStamp(msg, bytes, stamp);
-    ros::Time t = stamped ? stamp : ros::Time::now();
-    if (t < ros::TIME_MIN) t = ros::TIME_MIN;  // a stamp of 0
-    if (!stamped && rec.warned.insert(topic).second)
-      ROS_WARN(
-          "bag_recorder: %s (%s) carries no stamp: recorded at its receive time, so the bag will not "
-          "repeat bit for bit",
-          topic.c_str(), msg.getDataType().c_str());
-    const ros::Time written_up_to = rec.ordered.writtenUpTo();
-    if (!rec.ordered.add(topic, t, std::move(bytes), event.getConnectionHeaderPtr()) &&
-        rec.warned.insert(topic + " late").second)
-      ROS_WARN(
-          "bag_recorder: %s stamped %.3f s came after the bag was written to %.3f s (~reorder_window "
-          "%.1f s): written out of order, so the bag will not repeat bit for bit",
-          topic.c_str(), t.toSec(), written_up_to.toSec(), rec.window.toSec());
+    if (keep(rec, state, msg, stamped, stamp))
+      addInStampOrder(rec, topic, msg, stamped, stamp, std::move(bytes), event);
   }
-  if (is_period) rec.recorded.received(index, topic, msg, stamped, stamp);
+  if (is_period) rec.recorded.received(state.period_index, topic, msg, stamped, stamp);
   if (rec.o.deterministic && rec.recorded.until() > ros::TIME_MIN + rec.window)
     rec.ordered.writeBefore(rec.recorded.until() - rec.window);
 }
@@ -217,12 +291,18 @@ std::vector<ros::Subscriber> subscribeAll(ros::NodeHandle& nh, Recording& rec, D
                                           std::vector<ros::Subscriber>& period_subs) {
   const Options& o = rec.o;
   std::vector<ros::Subscriber> subs;
-  for (const std::string& topic : o.topics) {
+  rec.states.resize(o.topics.size());  // not resized again: the callbacks hold references
+  for (std::size_t i = 0; i < o.topics.size(); ++i) {
+    const std::string& topic = o.topics[i];
     const auto period = std::find(o.period_topics.begin(), o.period_topics.end(), topic);
-    const std::size_t index = static_cast<std::size_t>(period - o.period_topics.begin());
-    const bool is_period = period != o.period_topics.end();
-    boost::function<void(const MessageEvent&)> cb = [&rec, topic, index, is_period](const MessageEvent& event) {
-      recordMessage(rec, topic, index, is_period, event);
+    TopicState& state = rec.states[i];
+    state.topic = topic;
+    state.period_index = static_cast<std::size_t>(period - o.period_topics.begin());
+    state.is_period = period != o.period_topics.end();
+    state.throttled = std::find(o.throttle_topics.begin(), o.throttle_topics.end(), topic) != o.throttle_topics.end();
+    const bool is_period = state.is_period;
+    boost::function<void(const MessageEvent&)> cb = [&rec, &state](const MessageEvent& event) {
+      recordMessage(rec, state, event);
     };
     ros::SubscribeOptions so;
     so.initByFullCallbackType<const MessageEvent&>(topic, static_cast<std::uint32_t>(o.queue), cb);
@@ -252,13 +332,14 @@ int closeBag(Recording& rec, const std::string& active) {
     const sowing_robot::StampOrderWriter::Counts& c = rec.ordered.counts();
     order = " in stamp order (" + std::to_string(c.repeats) + " resent kept once, " + std::to_string(c.late) + " late)";
   }
+  if (!o.throttle_topics.empty() || o.min_log_level > 0) order += " of " + std::to_string(rec.received) + " received";
   rec.bag.close();
   if (std::rename(active.c_str(), o.output.c_str()) != 0) {
     ROS_ERROR("bag_recorder: could not rename %s to %s", active.c_str(), o.output.c_str());
     return 1;
   }
   std::printf("bag_recorder: %zu messages written to %s%s\n",
-              o.deterministic ? rec.ordered.counts().written : rec.received, o.output.c_str(), order.c_str());
+              o.deterministic ? rec.ordered.counts().written : rec.written, o.output.c_str(), order.c_str());
   std::fflush(stdout);
   return 0;
 }
@@ -268,6 +349,8 @@ int record(ros::NodeHandle& nh, ros::NodeHandle& pnh, const Options& o) {
   const std::string active = o.output + ".active";
   try {
     bag.open(active, rosbag::bagmode::Write);
+    if (o.compression != "none")
+      bag.setCompression(o.compression == "lz4" ? rosbag::compression::LZ4 : rosbag::compression::BZ2);
   } catch (const rosbag::BagException& e) {
     throw sowing_robot::badParameter("cannot open " + active + ": " + e.what());
   }
@@ -281,7 +364,8 @@ int record(ros::NodeHandle& nh, ros::NodeHandle& pnh, const Options& o) {
   // their first messages is lost
   const sowing_robot::ReadyAnnouncer ready(nh, pnh, true, period_subs);
   ROS_INFO(
-      "bag_recorder: recording %zu topics to %s%s", o.topics.size(), o.output.c_str(),
+      "bag_recorder: recording %zu topics (%zu of them one message per %.3f s of stamps, compression %s) to %s%s",
+      o.topics.size(), o.throttle_topics.size(), o.throttle_period, o.compression.c_str(), o.output.c_str(),
       o.receive_delay > 0.0 ? (" (receive_delay " + std::to_string(o.receive_delay) + " s per message)").c_str() : "");
   while (!g_stop && ros::ok()) q->callAvailable(ros::WallDuration(0.1));
   // Drain: keep writing until nothing has arrived for a second, then close.

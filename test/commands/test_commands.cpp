@@ -47,7 +47,8 @@ const std::vector<std::string> kScripts{"run",
                                         "dev/benchmark_report",
                                         "dev/path_evidence",
                                         "dev/seed_evidence",
-                                        "dev/seed_evidence_table"};
+                                        "dev/seed_evidence_table",
+                                        "dev/recording_sizes"};
 
 struct Outcome {
   int status = -1;

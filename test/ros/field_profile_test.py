@@ -61,7 +61,7 @@ class FieldProfile(unittest.TestCase):
 
     def test_field_run_applies_less_torque_than_commanded_and_ends(self):
         bag = os.path.join(tempfile.mkdtemp(prefix="sowing_field_profile_"), "run.bag")
-        code, out, _ = node_process.sim(11685, ["profile:=field", "field:=line", "duration:=3.0", "record:=true",
+        code, out, _ = node_process.sim(11685, ["profile:=field", "field:=line", "duration:=3.0", "record:=full",
                                                 "bag:=" + bag], timeout=300)
         self.assertEqual(code, 0, out[-4000:])
         self.assertEqual(out.rstrip().splitlines()[-1], "sim: the run ended normally")

@@ -1,11 +1,11 @@
 #!/usr/bin/env python3
 """rostest of the sowing fleet (fleet.launch headless:=true robots:=2, lockstep, 15 s), each run on a ROS master of
 its own at a free port:
-  * run A (safety_distance 0.8 m, record:=true): ends by itself (exit 0) once both robots' run_monitors have printed;
+  * run A (safety_distance 0.8 m, record:=full): ends by itself (exit 0) once both robots' run_monitors have printed;
     each robot wrote its metrics (robot_0.yaml, robot_1.yaml, labelled by robot) and its bag; fleet_monitor's
     summary compares every period of both (15001 stamps), with the closest approach the robots' lane spacing
     (1 m, at the start) and no encounter;
-  * run B (safety_distance 1.2 m, record:=true): the same metrics bit for bit; the same messages in each robot's
+  * run B (safety_distance 1.2 m, record:=full): the same metrics bit for bit; the same messages in each robot's
     bag on every period topic, bit for bit and in the same order, and the same bag files byte for byte, seed record
     (`seeds/record`) included (the fleet's recorders write in stamp order: bag_recorder ~deterministic); fleet_monitor warns of the robots closer
     than 1.2 m and counts the encounters;
@@ -82,7 +82,7 @@ class Fleet(unittest.TestCase):
         for name, safety in (("a", 0.8), ("b", 1.2)):
             d = os.path.join(cls.tmp, name)
             os.makedirs(d)
-            cls.runs[name] = (d,) + fleet(d, "safety_distance:=%g" % safety, "record:=true", "bag_dir:=" + d)
+            cls.runs[name] = (d,) + fleet(d, "safety_distance:=%g" % safety, "record:=full", "bag_dir:=" + d)
 
     def test_a_run_ends_with_both_robots_metrics_and_the_fleet_summary(self):
         d, code, out, _ = self.runs["a"]

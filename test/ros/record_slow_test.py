@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """rostest: a recorded run ends only when the recorder has every period. `rosrun sowing_robot sim
-headless:=true record:=true field:=line duration:=5` with the recorder slowed down on its receiving side
+headless:=true record:=full field:=line duration:=5` with the recorder slowed down on its receiving side
 (bag_recorder ~receive_delay: it reads its connections slowly, so the backlog stays with the publishers, as
 on a machine that starves it of CPU). (1) The run waits for it (run_monitor says so) and the bag holds
 every period: 5001 /ground_truth messages (duration * rate + 1), the last stamped 5.0, and as many of every other
@@ -29,7 +29,7 @@ def run_sim(port, tmp, overlay, *args):
     with open(config, "w") as f:
         f.write(overlay)
     env = dict(os.environ, ROS_MASTER_URI="http://localhost:%d" % port)
-    cmd = [roslib.packages.find_node("sowing_robot", "sim")[0], "headless:=true", "record:=true", "field:=line",
+    cmd = [roslib.packages.find_node("sowing_robot", "sim")[0], "headless:=true", "record:=full", "field:=line",
            "duration:=%g" % DURATION, "config:=" + config] + list(args)
     # A session of its own: if the run hangs, the whole launch is killed, not only the runner.
     proc = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True,

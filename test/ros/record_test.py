@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""rostest: recording. (1) `sim.launch headless:=true record:=true field:=line duration:=10` leaves a bag
+"""rostest: recording. (1) `sim.launch headless:=true record:=full field:=line duration:=10` leaves a bag
 whose analyze_bag metrics (full precision, --yaml) equal run_monitor's metrics_output and the in-process
 runner's (run_scenario --yaml) exactly, with no missing period, and whose seed record (`seeds/record`) seed_map
 reads into a CSV of seeds on the line. (2) SIGINT in the middle of a recorded
@@ -23,7 +23,7 @@ def node(name):
 def launch(port, *args):
     env = dict(os.environ, ROS_MASTER_URI="http://localhost:%d" % port)
     return subprocess.Popen(["roslaunch", "-p", str(port), "sowing_robot", "sim.launch", "headless:=true",
-                             "record:=true", "field:=line"] + list(args), env=env, stdout=subprocess.PIPE,
+                             "record:=full", "field:=line"] + list(args), env=env, stdout=subprocess.PIPE,
                             stderr=subprocess.STDOUT, universal_newlines=True)
 
 

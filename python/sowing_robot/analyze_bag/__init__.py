@@ -2,8 +2,10 @@
 
   rosrun sowing_robot analyze_bag run.bag [more.bag ...] [options]   (--help: the options, from cli.py)
 
-Reads bags recorded by `roslaunch sowing_robot sim.launch record:=true bag:=NAME`, prints one Markdown table
-(core::metricsTable) with one column per bag, a short per-bag summary, and writes PNG figures.
+Reads bags recorded by `roslaunch sowing_robot sim.launch record:=full bag:=NAME`, prints one Markdown table
+(core::metricsTable) with one column per bag, a short per-bag summary, and writes PNG figures. A lean bag
+(record:=lean, docs/recording.md) gives what it can: metrics from its 10 Hz /tracking_error (approximate), the
+seed figures of /seeds/record, the path and tracking figures; a note line on stderr names what it lacks.
 
 Every metric is computed by the C++ core (core::MetricsAccumulator through the sowing_robot.core module), the
 code run_monitor and the in-process runner use, so the three agree to the bit. The samples are

@@ -20,6 +20,14 @@ TOPICS = {
     "/desired_velocity": "sowing_robot/DesiredVelocity",
     "/wheel_torque": "sowing_robot/WheelTorque",
     "/torque_controller/state": "sowing_robot/TorqueControllerState",
+    "/seeds/record": "sowing_robot/Seed",  # one message per seed (seed_drill)
+}
+# What a lean recording (sim.launch record:=lean, docs/recording.md) leaves out of TOPICS, and what of the report
+# goes with it.
+LEAN_LACKS = {
+    "/wheel_torque": "torque",
+    "/torque_controller/state": "saturation and adaptive-estimate",
+    "/desired_velocity": "desired-velocity",
 }
 OPTIONAL_TOPICS = {"/field_markers": ("visualization_msgs/MarkerArray", "visualization_msgs/Marker")}
 
@@ -116,14 +124,22 @@ class Series(object):
 
 
 def _select_topics(types, path):
-    """{our topic name: topic in the bag} by name (with the expected type), else by a unique type match.
+    """{our topic name: topic in the bag} by name (with the expected type), or the one namespaced so, else by a
+    unique type match.
     types: {topic in the bag: message type}."""
     chosen = {}
     for topic, msg_type in TOPICS.items():
         if types.get(topic) == msg_type:
             chosen[topic] = topic
             continue
-        candidates = [name for name, t in types.items() if t == msg_type]
+        candidates = [name for name, t in types.items() if t == msg_type and name not in TOPICS]
+        named = [name for name in candidates if name.endswith(topic)]  # a fleet robot's /robot_<i>/ground_truth
+        if len(named) == 1:
+            chosen[topic] = named[0]
+            continue
+        # none named as another of ours: a lean bag's (/robot_<i>)/ground_truth is no /odom (the encoders' odometry
+        # is not recorded when it is not fed back)
+        candidates = [name for name in candidates if not any(name.endswith(t) for t in TOPICS)]
         if len(candidates) == 1 and candidates[0] not in chosen.values():
             chosen[topic] = candidates[0]
     for topic, msg_types in OPTIONAL_TOPICS.items():
@@ -179,6 +195,34 @@ class BagData(object):
     def truth_from_odom(self):
         """True when truth() is /odom (an old bag): the caller warns, as /odom is the encoders' now."""
         return not len(self.get("/ground_truth")) and len(self.get("/odom")) > 0
+
+    def is_lean(self):
+        """True for a lean recording (sim.launch record:=lean): no /wheel_torque, and /tracking_error at a display
+        rate (its stamps 5 ms or more apart; the control loop's are 1 ms)."""
+        rate = self.sample_rate("/tracking_error")
+        return not len(self.get("/wheel_torque")) and 0.0 < rate <= 200.0
+
+    def lean_notes(self):
+        """One line per thing a lean bag lacks, what analyze_bag skips or approximates for it; [] for a full bag."""
+        if not self.is_lean():
+            return []
+        lacking = [topic for topic in LEAN_LACKS if not len(self.get(topic))]
+        notes = []
+        if lacking:
+            notes.append("%s not recorded (lean bag): %s figures skipped"
+                         % (", ".join(lacking), ", ".join(LEAN_LACKS[t] for t in lacking)))
+        rate = self.sample_rate("/tracking_error")
+        notes.append("/tracking_error at %.3g Hz (lean bag): the metrics are approximate, from its samples; "
+                     "run_monitor's (metrics_output:=FILE) are exact" % rate)
+        return notes
+
+    def sample_rate(self, topic):
+        """Samples per second of `topic` from its median stamp step (0 when under 2 samples)."""
+        stamps = self.get(topic).stamps
+        if len(stamps) < 2:
+            return 0.0
+        step = float(np.median(np.diff(stamps)))
+        return 1.0 / step if step > 0.0 else 0.0
 
     def mode(self):
         """Controller mode from /torque_controller/state (the most frequent), or None."""

@@ -29,7 +29,8 @@ class _Parser(Parser):
 
 def parse_args(argv):
     p = _Parser("Tracking metrics (thesis Tables 5.5/5.6) and figures of sowing_robot bags.", prog=PROG)
-    p.add_argument("bags", nargs="+", metavar="BAG", help="bag files recorded by sim.launch record:=true")
+    p.add_argument("bags", nargs="+", metavar="BAG",
+                   help="bag files recorded by sim.launch record:=full (or lean: what it can)")
     p.add_argument("--labels", help="comma-separated column labels, one per bag (default: controller mode)")
     p.add_argument("--plots", metavar="DIR", help="directory for the PNG figures (default: next to the first bag)")
     p.add_argument("--no-plots", action="store_true", help="skip the figures")
@@ -100,6 +101,8 @@ def run(argv):
         if d.truth_from_odom():
             sys.stderr.write("%s: warning: %s: no /ground_truth (a bag recorded before the sensors were modelled): the robot's path "
                              "and velocities are read from /odom, which was the true state then\n" % (PROG, d.path))
+        for note in d.lean_notes():
+            sys.stderr.write("%s: note: %s: %s\n" % (PROG, d.path, note))
         missing, ngaps = gaps(d.get("/tracking_error").stamps)
         if ngaps:
             sys.stderr.write("%s: warning: %s: %d /tracking_error samples missing in %d gap(s): the recorder dropped "

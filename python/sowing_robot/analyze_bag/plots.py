@@ -116,6 +116,9 @@ def write_plots(datas, out_dir, prefix):
             ax.add_patch(plt.Circle((x, y), max(sx, sy) / 2.0, color="0.5", alpha=0.5, label=lab))
         else:
             ax.add_patch(plt.Rectangle((x - sx / 2.0, y - sy / 2.0), sx, sy, color="0.5", alpha=0.5, label=lab))
+    seeds = datas[0].get("/seeds/record")
+    if len(seeds):
+        ax.plot(seeds["position.x"], seeds["position.y"], ".", color="tab:green", ms=2, label="seeds")
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
     if obstacles:
@@ -186,6 +189,10 @@ def write_plots(datas, out_dir, prefix):
     for ax in axs[1]:
         ax.set_xlabel("time [s]")
     finish(fig, "velocity", "Body velocities vs desired (Kanayama outer loop output)")
+
+    # 5.-7. need the full recording's torque and controller state (a lean bag has neither): skipped without them
+    if not any(len(d.get("/wheel_torque")) or len(d.get("/torque_controller/state")) for d in datas):
+        return written
 
     # 5. torques
     fig, axs = plt.subplots(2, 1, figsize=(10, 7), sharex=True)

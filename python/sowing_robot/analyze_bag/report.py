@@ -49,6 +49,13 @@ def summary(data, until=None):
         lines.append("- saturated: %d control periods (%d episodes)" % (int(sat.sum()), runs))
         lines.append("- final m0_hat %.5g kg, i0_hat %.5g kg·m²  (mode %s)"
                      % (state["m0_hat"][-1], state["i0_hat"][-1], state["mode"][-1]))
+    seeds = data.get("/seeds/record")
+    if len(seeds):
+        off = np.hypot(seeds["position.x"] - seeds["believed.x"], seeds["position.y"] - seeds["believed.y"])
+        detour = np.asarray(seeds["detour"], dtype=bool)
+        lines.append("- seeds: %d (%d in detours), depth mean %.4g m; fell from where the robot believed its tool: "
+                     "max %.4g m, RMS %.4g m" % (len(seeds), int(detour.sum()), float(np.mean(seeds["depth"])),
+                                                 float(off.max()), float(np.sqrt(np.mean(off ** 2)))))
     others = ["%s %d" % (topic, len(data.get(topic))) for topic in TOPICS if topic != "/tracking_error"]
     lines.append("- other topics (unique stamps): " + ", ".join(others))
     return "\n".join(lines)
