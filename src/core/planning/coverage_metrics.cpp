@@ -41,9 +41,12 @@ CoverageFigures coverageFigures(const FieldBoundary& field, const CoveragePlan& 
   double summed = 0.0;
   for (const geo::Line& l : sown) summed += bg::area(geo::strip(l, w));
   const double union_area = bg::area(all);
-  geo::MultiPolygon inside;
-  bg::intersection(all, workable, inside);
-  f.covered_area = bg::area(inside);
+  // Covered = workable minus what the strips leave of it: Boost's union of strips that touch side by side (one
+  // width apart) can come out with self-intersections, on which an intersection loses whole strips (13 % on the
+  // 10 ha field) while the difference stays within the union's area.
+  geo::MultiPolygon left;
+  bg::difference(workable, all, left);
+  f.covered_area = std::max(0.0, f.workable_area - bg::area(left));
   f.covered_share = f.workable_area > 0.0 ? f.covered_area / f.workable_area : 0.0;
   f.missed_share = f.workable_area > 0.0 ? std::max(0.0, f.workable_area - f.covered_area) / f.workable_area : 0.0;
   f.overlap_share = union_area > 0.0 ? std::max(0.0, summed - union_area) / union_area : 0.0;
@@ -65,9 +68,9 @@ CoverageFigures coverageFigures(const FieldBoundary& field, const CoveragePlan& 
     bg::difference(outers, holes, inner_field);
   }
   f.inner_area = bg::area(inner_field);
-  geo::MultiPolygon swath_inner;
-  bg::intersection(geo::strip(swaths, w), inner_field, swath_inner);
-  f.covered_inner_share = f.inner_area > 0.0 ? bg::area(swath_inner) / f.inner_area : 0.0;
+  geo::MultiPolygon inner_left;
+  bg::difference(inner_field, geo::strip(swaths, w), inner_left);
+  f.covered_inner_share = f.inner_area > 0.0 ? std::max(0.0, f.inner_area - bg::area(inner_left)) / f.inner_area : 0.0;
 
   f.swaths = static_cast<int>(plan.swaths.size());
   f.path_length = plan.path_length;
