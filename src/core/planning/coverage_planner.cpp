@@ -780,5 +780,24 @@ CoveragePlan planCoverage(const FieldBoundary& field, const CoverageParams& para
   return plan;
 }
 
+CoveragePath coverageFrom(const CoveragePlan& plan, const Pose2D& start, const CoverageParams& params) {
+  const std::string e = params.validate();
+  if (!e.empty()) throw std::invalid_argument(e);
+  if (!std::isfinite(start.x) || !std::isfinite(start.y) || !std::isfinite(start.theta))
+    throw std::invalid_argument("coverageFrom: the start pose must be finite");
+  if (plan.route.points.size() < 2 || plan.swaths.empty())
+    throw std::invalid_argument("coverageFrom: the plan has no route");
+  const Swath& first = plan.swaths.front();
+  RouteBuilder approach(params);
+  approach.start({start.x, start.y});
+  approach.connect({{start.x, start.y}, start.theta},
+                   {first.a, std::atan2(first.b.y() - first.a.y(), first.b.x() - first.a.x())});
+  CoveragePath out = std::move(approach.path);
+  out.points.back() = plan.route.points.front();
+  out.points.insert(out.points.end(), plan.route.points.begin() + 1, plan.route.points.end());
+  out.tool_down.insert(out.tool_down.end(), plan.route.tool_down.begin(), plan.route.tool_down.end());
+  return out;
+}
+
 }  // namespace core
 }  // namespace sowing_robot

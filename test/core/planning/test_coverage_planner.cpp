@@ -242,6 +242,25 @@ TEST(CoveragePlanner, ThePathFollowerTakesTheRoute) {
   EXPECT_GT(follower.duration(), 0.0);
 }
 
+// From the robot's start pose (behind the field, facing away): a tool-up approach within the turn bounds, then
+// the route unchanged.
+TEST(CoveragePlanner, TheRouteStartsFromTheRobotsPose) {
+  FieldBoundary f;
+  f.outer = rectangle(0, 0, 40, 20);
+  const CoverageParams p = fieldYamlParams();
+  const CoveragePlan plan = planCoverage(f, p);
+  const CoveragePath path = coverageFrom(plan, Pose2D{-5.0, -3.0, M_PI}, p);
+  ASSERT_EQ(path.tool_down.size() + 1, path.points.size());
+  EXPECT_LT((path.points.front() - Eigen::Vector2d(-5.0, -3.0)).norm(), 1e-12);
+  const std::size_t lead = path.points.size() - plan.route.points.size();
+  ASSERT_GT(lead, 2u);
+  for (std::size_t i = 0; i < lead; ++i) EXPECT_FALSE(path.tool_down[i]) << i;
+  for (std::size_t i = 0; i < plan.route.points.size(); ++i) EXPECT_EQ(path.points[lead + i], plan.route.points[i]);
+  EXPECT_LE(peakPointCurvature(std::vector<Eigen::Vector2d>(path.points.begin(), path.points.begin() + lead + 2)),
+            1.02 / p.min_turn_radius);
+  EXPECT_THROW(coverageFrom(plan, Pose2D{NAN, 0.0, 0.0}, p), std::invalid_argument);
+}
+
 TEST(CoverageMetrics, AreaSownFollowsTheSeedRuns) {
   // Two rows of 11 seeds 0.1 m apart (1 m each) and a lone seed: 2 x 1 m x 0.5 m.
   std::vector<Seed> seeds;

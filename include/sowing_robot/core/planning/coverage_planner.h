@@ -26,6 +26,7 @@
 #include <Eigen/Dense>
 
 #include "sowing_robot/core/common/param_table.h"
+#include "sowing_robot/core/common/types.h"
 #include "sowing_robot/core/planning/field_boundary.h"
 #include "sowing_robot/core/planning/field_path_follower.h"
 #include "sowing_robot/core/planning/seeding.h"
@@ -95,6 +96,11 @@ std::string checkBoundary(const FieldBoundary& field);
 /// The plan over `field`. Throws std::invalid_argument with one line (checkBoundary, params.validate(), or a
 /// field narrower than one swath plus its headlands).
 CoveragePlan planCoverage(const FieldBoundary& field, const CoverageParams& params);
+
+/// The plan's route from a start pose [m, m, rad]: a tool-up approach (a turn-straight-turn with the route's
+/// turn bounds) from the pose onto the first swath, heading along it, then the route. A pure function of its
+/// arguments; throws std::invalid_argument on invalid params, a non-finite pose or a plan without a route.
+CoveragePath coverageFrom(const CoveragePlan& plan, const Pose2D& start, const CoverageParams& params);
 
 }  // namespace core
 }  // namespace sowing_robot
