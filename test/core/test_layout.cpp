@@ -4,7 +4,7 @@
 // direction fails here before it can knot the rooms together. The package's own headers are included as
 // "sowing_robot/core/<room>/<file>.h" only: an angle-bracket form (<sowing_robot/...>) or a relative one
 // ("../x.h", "sensors.h") would hide the room it reaches, so each is refused too; and the core's only
-// other includes are the C++17 standard library and Eigen (it has no catkin include path).
+// other includes are the C++17 standard library, Eigen and Boost.Geometry (header-only; no catkin include path).
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -73,6 +73,8 @@ std::vector<std::string> layoutViolations(const fs::path& path, const std::strin
   // <vector>, <cmath>, ...: the standard library's headers have neither a directory nor an extension.
   static const std::regex standard_header(R"re([a-z_]+)re");
   static const std::regex eigen_header(R"re((Eigen|unsupported/Eigen)/[A-Za-z0-9_/]+)re");
+  // Boost.Geometry (header-only): the polygon checks of common/polygon.cpp.
+  static const std::regex boost_geometry_header(R"re(boost/geometry(/[A-Za-z0-9_/]+)?\.hpp)re");
   std::vector<std::string> out;
   std::istringstream in(text);
   std::string line;
@@ -90,9 +92,10 @@ std::vector<std::string> layoutViolations(const fs::path& path, const std::strin
       if (!angle)
         out.push_back(where + "relative include \"" + target +
                       "\": the package's headers are included as \"sowing_robot/core/<room>/<file>.h\"");
-      else if (!std::regex_match(target, standard_header) && !std::regex_match(target, eigen_header))
+      else if (!std::regex_match(target, standard_header) && !std::regex_match(target, eigen_header) &&
+               !std::regex_match(target, boost_geometry_header))
         out.push_back(where + "the core includes <" + target +
-                      ">, outside its dependencies (the C++17 standard library and Eigen)");
+                      ">, outside its dependencies (the C++17 standard library, Eigen and Boost.Geometry)");
       continue;
     }
     if (angle) out.push_back(where + "<" + target + "> in angle brackets: the package's own headers go in quotes");
@@ -190,6 +193,7 @@ TEST(Layout, TheCheckerReportsRelativeIncludes) {
 TEST(Layout, TheCheckerReportsIncludesFromOutsideTheCore) {
   expectOneViolation("#include <ros/ros.h>\n", 1, "<ros/ros.h>, outside its dependencies");
   expectOneViolation("#include <nav_msgs/Odometry.h>\n", 1, "outside its dependencies");
+  expectOneViolation("#include <boost/asio.hpp>\n", 1, "outside its dependencies");  // only Boost.Geometry
   expectOneViolation("#include \"sowing_robot/ros/seed_drill.h\"\n", 1, "outside the core's rooms");
   expectOneViolation("#include \"sowing_robot/WheelTorque.h\"\n", 1, "outside the core's rooms");
 }
