@@ -27,7 +27,8 @@ const std::vector<std::string> kPrograms{
     "benchmark",   "run_scenario",         "param_docs",        "bag_recorder",
     "plant_sim",   "kinematic_controller", "torque_controller", "reference_generator",
     "run_monitor", "seed_drill",           "state_estimator",   "pso_tuner",
-    "tune",        "cmd_vel_limiter",      "fleet_monitor",     "seed_map"};
+    "tune",        "cmd_vel_limiter",      "fleet_monitor",     "seed_map",
+    "field_info"};
 const std::vector<std::string> kScripts{"run",
                                         "test",
                                         "sim",

@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "sowing_robot/core/evaluation/bench_row.h"
+#include "sowing_robot/core/planning/field_soil.h"
 #include "sowing_robot/core/planning/seeding.h"
 
 namespace sowing_robot {
@@ -173,6 +174,12 @@ std::string describeRealism(const BenchScenario& b) {
     // can ask), at the nominal speed? One that cannot is where the tool must be lifted.
     for (const DraftCheck& d : checkFieldDraft(b.base.robot, 1.0, *c.traction, c.patches, c.seeding.depth_min))
       out += "; field check: " + d.why;
+    const std::string overlap = patchOverlapNote(c.patches);
+    if (!overlap.empty()) out += "; field check: " + overlap;
+    if (b.track == TrackKind::field) {
+      const std::string outside = patchesOutsideField(b.field, c.patches);
+      if (!outside.empty()) out += "; field check: WARNING " + outside;
+    }
   } else {
     out += "no slip";
   }

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "sowing_robot/core/common/polygon.h"
 #include "sowing_robot/core/common/validation.h"
 
 namespace sowing_robot {
@@ -13,6 +14,9 @@ std::string SoilPatch::validate(const std::string& key) const {
     return key + "/polygon has " + std::to_string(polygon.size()) + " vertices; a patch needs at least 3";
   for (std::size_t i = 0; i < polygon.size(); ++i)
     if (!polygon[i].allFinite()) return key + "/polygon[" + std::to_string(i) + "] must be finite";
+  // A bow-tie or a patch drawn as a line: the even-odd lookup would give it a shape nobody meant.
+  const std::string shape = ringProblem(polygon);
+  if (!shape.empty()) return key + "/polygon " + shape + "; a patch must be a simple polygon";
   const struct {
     const char* name;
     double value;
@@ -52,6 +56,16 @@ SoilMap::SoilMap(std::vector<SoilPatch> patches) : patches_(std::move(patches)) 
     }
     boxes_.push_back(b);
   }
+}
+
+std::string patchOverlapNote(const std::vector<SoilPatch>& patches, const std::string& key) {
+  std::string pairs;
+  for (std::size_t i = 0; i < patches.size(); ++i)
+    for (std::size_t j = i + 1; j < patches.size(); ++j)
+      if (ringsOverlap(patches[i].polygon, patches[j].polygon))
+        pairs += (pairs.empty() ? "" : ", ") + key + "[" + std::to_string(i) + "] and [" + std::to_string(j) + "]";
+  if (pairs.empty()) return "";
+  return "soil patches overlap (" + pairs + "): where they do, the one listed last holds";
 }
 
 int SoilMap::patchAt(const Eigen::Vector2d& p) const {

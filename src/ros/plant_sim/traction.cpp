@@ -80,6 +80,8 @@ TractionModel::TractionModel(ros::NodeHandle nh, const core::RobotParams& robot,
     else
       ROS_WARN("plant_sim: field check: %s", c.why.c_str());
   }
+  const std::string overlap = core::patchOverlapNote(config.soil.patches());
+  if (!overlap.empty()) ROS_INFO("plant_sim: field check: %s", overlap.c_str());
   slip_pub_ = nh.advertise<std_msgs::Float64MultiArray>("wheel_slip", kLockstepQueue);
   soil_pub_ = nh.advertise<visualization_msgs::MarkerArray>("soil_markers", 1, true);
   publishSoil();

@@ -74,6 +74,40 @@ TEST(SoilMap, BadPatchesAreRefusedNamingTheKey) {
   refused(p, "field/patches[0]/rolling_resistance");
 }
 
+// A patch's edges: a bow-tie (its edges cross, and its two lobes cancel in the signed area) and a patch drawn as
+// a line are refused naming the patch; overlapping patches are allowed (the last listed holds) and noted once.
+TEST(SoilMap, CrossingOrZeroAreaPatchesAreRefusedNamingThePatch) {
+  SoilPatch bow = box(0, 0, 1, 1, 0.2);
+  bow.polygon = {{0, 0}, {1, 1}, {1, 0}, {0, 1}};
+  std::string e = bow.validate("field/patches[1]");
+  EXPECT_EQ(e.rfind("field/patches[1]/polygon crosses itself", 0), 0u) << e;
+  EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+  EXPECT_THROW(SoilMap({box(0, 0, 1, 1, 0.2), bow}), std::invalid_argument);
+  SoilPatch flat = box(0, 0, 1, 1, 0.2);
+  flat.polygon = {{0, 0}, {1, 1}, {2, 2}};
+  e = flat.validate("field/patches[0]");
+  EXPECT_EQ(e.rfind("field/patches[0]/polygon has zero area", 0), 0u) << e;
+  flat.polygon = {{3, 3}, {3, 3}, {3, 3}, {3, 3}};
+  e = flat.validate("field/patches[0]");
+  EXPECT_EQ(e.rfind("field/patches[0]/polygon has zero area", 0), 0u) << e;
+  // Either sense and a non-convex shape are fine.
+  SoilPatch l = box(0, 0, 1, 1, 0.2);
+  l.polygon = {{0, 4}, {2, 4}, {2, 2}, {4, 2}, {4, 0}, {0, 0}};
+  EXPECT_EQ(l.validate("k"), "");
+}
+
+TEST(SoilMap, OverlappingPatchesAreNotedOnceLastListedHolds) {
+  EXPECT_EQ(patchOverlapNote({box(0, 0, 1, 1, 0.2), box(1, 0, 2, 1, 0.3)}), "");  // sharing an edge only
+  EXPECT_EQ(patchOverlapNote({}), "");
+  const std::string note = patchOverlapNote(
+      {box(0, 0, 10, 10, 0.2), box(20, 0, 30, 10, 0.3), box(5, 5, 25, 8, 0.25), box(40, 0, 41, 1, 0.3)});
+  EXPECT_EQ(note,
+            "soil patches overlap (field/patches[0] and [2], field/patches[1] and [2]): where they do, the one listed "
+            "last holds");
+  // Also a patch wholly inside another (a wet strip drawn over a larger patch).
+  EXPECT_NE(patchOverlapNote({box(0, 0, 10, 10, 0.2), box(2, 2, 3, 3, 0.3)}), "");
+}
+
 // A patch's grip beyond the field's slip curve (slip_stiffness 8 x slip_peak 0.15 = 1.2 < mu_peak) is
 // refused by the plant naming the patch.
 TEST(SoilMap, PlantRefusesAPatchTheSlipCurveCannotCarry) {

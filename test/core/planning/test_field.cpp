@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "sowing_robot/core/planning/field.h"
+#include "sowing_robot/core/planning/field_soil.h"
 
 using sowing_robot::core::FieldParams;
 using sowing_robot::core::FieldPath;
@@ -294,4 +295,36 @@ TEST(FieldReference, CloneAndDeterminism) {
     ASSERT_TRUE(sameReference(ra, b.next(t))) << t;
     ASSERT_TRUE(sameReference(ra, rc)) << t;
   }
+}
+
+// A soil patch wholly outside the rows and their headlands is a warning naming it (not an error: the map describes
+// the ground, and one map may serve a smaller field); one on the rows or on a headland is not.
+TEST(FieldSoil, PatchesWhollyOutsideTheFieldAreNamed) {
+  namespace core = sowing_robot::core;
+  FieldParams f;
+  f.rows = 3;
+  f.row_length = 20.0;
+  f.row_spacing = 1.0;
+  f.start_x = 0.0;
+  f.start_y = 3.0;
+  f.heading = 0.0;
+  f.rows_to_left = true;
+  f.min_turn_radius = 1.0;  // margin max(1, 2) = 2 m
+  const auto patch = [](double x0, double y0, double x1, double y1) {
+    core::SoilPatch p;
+    p.polygon = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
+    return p;
+  };
+  EXPECT_EQ(core::patchesOutsideField(f, {patch(5, 2, 8, 6)}), "");  // on the rows
+  EXPECT_EQ(core::patchesOutsideField(f, {patch(20.5, 0, 21.5, 8)}),
+            "");  // on the headland past the rows' ends
+  const std::string w =
+      core::patchesOutsideField(f, {patch(5, 2, 8, 6), patch(100, 100, 110, 110), patch(-5, -5, -3, -3)});
+  EXPECT_EQ(w.rfind("field/patches[1], field/patches[2] lie(s) wholly outside the field's rows", 0), 0u) << w;
+  const std::vector<Eigen::Vector2d> ground = core::fieldGround(f);
+  ASSERT_EQ(ground.size(), 4u);
+  EXPECT_NEAR(ground[0].x(), -2.0, 1e-12);
+  EXPECT_NEAR(ground[0].y(), 1.0, 1e-12);
+  EXPECT_NEAR(ground[2].x(), 22.0, 1e-12);
+  EXPECT_NEAR(ground[2].y(), 7.0, 1e-12);
 }

@@ -25,12 +25,17 @@ struct SoilPatch {
   double draft_factor = 1.0;
 
   /// "" or one line naming `key` (e.g. "field/patches[1]") and what is wrong: fewer than 3 vertices, a
-  /// non-finite vertex, a negative or non-finite coefficient (draft_factor included), mu_slide > mu_peak,
-  /// rolling_resistance > 1.
+  /// non-finite vertex, a polygon that is not simple (crosses itself, zero area: common/polygon.h), a negative or
+  /// non-finite coefficient (draft_factor included), mu_slide > mu_peak, rolling_resistance > 1.
   std::string validate(const std::string& key) const;
 };
 
-/// The patches of a field. Where patches overlap, the one listed last wins.
+/// One line for the field check when some patches overlap, naming the pairs (`key` "field/patches":
+/// "soil patches overlap (field/patches[0] and [2]): where they do, the one listed last holds"), or "". Overlap is
+/// allowed, as layers: a wet strip drawn over a larger patch lists it after that patch.
+std::string patchOverlapNote(const std::vector<SoilPatch>& patches, const std::string& key = "field/patches");
+
+/// The patches of a field. Where patches overlap, the one listed last wins (patchOverlapNote says where).
 class SoilMap {
  public:
   SoilMap() = default;
