@@ -2,27 +2,16 @@
 
 #include <cmath>
 
-// Boost 1.74's Boost.Math includes a header of its own it marks deprecated: a note on every build, not ours to fix.
-#define BOOST_ALLOW_DEPRECATED_HEADERS
-#include <boost/geometry.hpp>
-#include <boost/geometry/geometries/point_xy.hpp>
-#include <boost/geometry/geometries/polygon.hpp>
+#include "sowing_robot/core/common/boost_geometry.h"
 
 namespace sowing_robot {
 namespace core {
+
 namespace {
-
-namespace bg = boost::geometry;
-using Point = bg::model::d2::point_xy<double>;
-using Polygon = bg::model::polygon<Point>;  // clockwise, closed: bg::correct puts a ring in that order
-
-Polygon toPolygon(const std::vector<Eigen::Vector2d>& ring) {
-  Polygon p;
-  for (const Eigen::Vector2d& v : ring) bg::append(p.outer(), Point(v.x(), v.y()));
-  bg::correct(p);  // closes the ring and turns it clockwise (either sense is allowed)
-  return p;
-}
-
+namespace bg = geo::bg;
+using geo::Point;
+using geo::Polygon;
+using geo::toPolygon;
 }  // namespace
 
 double ringArea(const std::vector<Eigen::Vector2d>& ring) {
@@ -69,7 +58,7 @@ bool circleCoveredBy(const Eigen::Vector2d& centre, double radius, const std::ve
 
 bool circleOverlapsRing(const Eigen::Vector2d& centre, double radius, const std::vector<Eigen::Vector2d>& ring) {
   const Polygon p = toPolygon(ring);
-  return bg::distance(Point(centre.x(), centre.y()), p) < radius;
+  return bg::distance(geo::toPoint(centre), p) < radius;
 }
 
 }  // namespace core

@@ -1,24 +1,17 @@
-// The Boost.Geometry types the coverage planner and its metrics share, and their conversions from and to the
-// interface's Eigen rings. For the planning room's .cpp files only: the other headers keep to Eigen, so nothing
+// The Boost.Geometry operations the coverage planner and its metrics share (the types and conversions are
+// common/boost_geometry.h's). For the planning room's .cpp files only: the other headers keep to Eigen, so nothing
 // outside the coverage code compiles Boost.Geometry.
 #pragma once
 
 #include <vector>
 
-// Boost 1.74's geometry reaches deprecated headers of other Boost parts; their notes are not ours to act on.
-#define BOOST_ALLOW_DEPRECATED_HEADERS
-#include <boost/geometry.hpp>
-#include <boost/geometry/geometries/point_xy.hpp>
-
+#include "sowing_robot/core/common/boost_geometry.h"
 #include "sowing_robot/core/planning/field_boundary.h"
 
 namespace sowing_robot {
 namespace core {
 namespace geo {
 
-namespace bg = boost::geometry;
-using Point = bg::model::d2::point_xy<double>;
-using Polygon = bg::model::polygon<Point>;  // clockwise, closed
 using MultiPolygon = bg::model::multi_polygon<Polygon>;
 using Line = bg::model::linestring<Point>;
 using MultiLine = bg::model::multi_linestring<Line>;
@@ -26,17 +19,6 @@ using MultiLine = bg::model::multi_linestring<Line>;
 /// Points on a full circle of the round joins and ends: a 0.55 m radius is then drawn with 9.6 cm chords, a 3 m
 /// circle with 1.1 cm between its chords and the arc. More points cost time in every buffer.
 constexpr int kPointsPerCircle = 36;
-
-inline Point toPoint(const Eigen::Vector2d& p) { return Point(p.x(), p.y()); }
-inline Eigen::Vector2d toVector(const Point& p) { return {p.x(), p.y()}; }
-
-/// A polygon from a ring in either orientation, closed and oriented as Boost expects.
-inline Polygon toPolygon(const Ring& ring) {
-  Polygon poly;
-  for (const Eigen::Vector2d& p : ring) poly.outer().push_back(toPoint(p));
-  bg::correct(poly);
-  return poly;
-}
 
 /// A ring's points without the closing repeat.
 template <typename R>
