@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "sowing_robot/core/planning/coverage_follower.h"
 #include "sowing_robot/core/planning/coverage_metrics.h"
 #include "sowing_robot/core/planning/coverage_planner.h"
 #include "sowing_robot/core/planning/field.h"
@@ -233,13 +234,18 @@ TEST(CoveragePlanner, ThePathFollowerTakesTheRoute) {
   FieldBoundary f;
   f.outer = rectangle(0, 0, 40, 20);
   f.circles = {Obstacle{20.0, 10.0, 2.0}};
-  const CoveragePlan plan = planCoverage(f, fieldYamlParams());
-  PathParams pp;
-  pp.max_curvature = 2.5 / 0.5;  // as fieldFollowerParams: room for the fillets of a sampled turn
-  PathStart start;
-  start.pose = {plan.route.points[0].x(), plan.route.points[0].y(), 0.0};
-  const PathPlan follower(plan.route.points, start, pp, plan.route.tool_down);
-  EXPECT_GT(follower.duration(), 0.0);
+  const CoverageParams p = fieldYamlParams();
+  const CoveragePlan plan = planCoverage(f, p);
+  FieldParams field;
+  EXPECT_EQ(coverageFollowerParams(field, p).max_curvature, 2.5 / p.min_turn_radius);
+  EXPECT_EQ(coverageFollowerParams(field, p).v_max, field.row_speed);
+  // From behind the field: the follower reaches the route's end, the tool down on the way and up on the approach.
+  PathReference follower = coverageReference(plan, Pose2D{-5.0, -3.0, 0.0}, field, p);
+  const double end = follower.planStart() + follower.plan().duration();
+  EXPECT_GT(end, plan.path_length / field.row_speed);
+  EXPECT_FALSE(follower.plan().at(0.0).tool_down);
+  const Reference last = follower.plan().at(end + 1.0);
+  EXPECT_LT((Eigen::Vector2d(last.pose.x, last.pose.y) - plan.route.points.back()).norm(), 1e-6);
 }
 
 // From the robot's start pose (behind the field, facing away): a tool-up approach within the turn bounds, then
