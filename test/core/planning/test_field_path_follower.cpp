@@ -87,7 +87,9 @@ TEST(FieldPathReference, PlansNoTurnInPlaceKeepsTheFieldsBoundsAndStopsAtTheLast
     if (r.tool_down) down_time += dt;
     // Tool down only on the rows (|y - row| within the detour's offset near the obstacle).
     // Each row runs on by run_out past its end (row 1 back to x = -run_out).
-    if (r.tool_down) EXPECT_TRUE(r.pose.x > -s.field.run_out - 1e-6 && r.pose.x < 30.0 + s.field.run_out + 1e-6) << t;
+    if (r.tool_down) {
+      EXPECT_TRUE(r.pose.x > -s.field.run_out - 1e-6 && r.pose.x < 30.0 + s.field.run_out + 1e-6) << t;
+    }
   }
   EXPECT_LE(peak_lateral, lateral * (1.0 + 1e-6));
   EXPECT_NEAR(peak_v, s.field.row_speed, 1e-6);
