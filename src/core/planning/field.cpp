@@ -276,7 +276,11 @@ FieldPath::FieldPath(const FieldParams& params, const std::vector<Obstacle>& obs
   int n = params_.rows;
   if (n > 1) turn_ = HeadlandTurn(params_.row_spacing, 1.0 / params_.min_turn_radius, params_.max_curvature_rate);
 
-  // Geometry.
+  // Geometry. With a plan, the seed drill's tool point (run_out behind the axle) must reach each row's end while the
+  // robot is still on the row's line: every row is driven on by run_out past its end before its turn, so the turn,
+  // which ends at the same along-row position, leaves the next row run_out before its start (a straight lead-in).
+  // The thesis path (no plan) keeps the thesis's rows.
+  const double ext = params_.avoidance.plan_detours ? params_.run_out : 0.0;
   double s = 0.0;
   bool cut = false;
   for (int i = 0; i < n; ++i) {
@@ -286,20 +290,23 @@ FieldPath::FieldPath(const FieldParams& params, const std::vector<Obstacle>& obs
     row.length = params_.row_length;
     row.p0 = rowStart(i);
     row.heading = h;
+    if (i > 0) {  // the lead-in left by the previous row's run-out; the tool is asked for from the row's start
+      row.along0 = -ext;
+      row.length += ext;
+    }
     if (plan) {
-      const RowPlan rp = planRow(i, row.p0, h, row.length, params_.row_speed, obstacles, params_.avoidance,
+      const RowPlan rp = planRow(i, row.p0, h, params_.row_length, params_.row_speed, obstacles, params_.avoidance,
                                  params_.potential.influence_distance, status_);
       row.detour_first = detours_.size();
       row.detour_count = rp.detours.size();
       detours_.insert(detours_.end(), rp.detours.begin(), rp.detours.end());
       if (rp.cut) {  // the path ends here, at rest
-        row.length = rp.stop;
+        row.length = rp.stop - row.along0;
         n = i + 1;
         cut = true;
       }
     }
-    // The tool point reaches the last row's end (a planned field's; the thesis path, without a plan, is the thesis's).
-    if (i == n - 1 && !cut && params_.avoidance.plan_detours) row.length += params_.run_out;
+    if (!cut) row.length += ext;  // the tool point reaches the row's end on its line
     if (i == 0 && params_.approach && params_.avoidance.plan_detours && params_.start_pose) {
       planApproach(row, n == 1 ? 0.0 : params_.turn_speed, obstacles);
       if (has_approach_) {
@@ -311,7 +318,9 @@ FieldPath::FieldPath(const FieldParams& params, const std::vector<Obstacle>& obs
         elements_.push_back(ap);
         s = ap.length;
         row.s0 = s;
-        row.along0 = approach_.curve.joinAlong();
+        // The approach joins the row before its start (approachLead()), so the robot has settled and the tool is
+        // down when the tool point reaches the row's start.
+        row.along0 = approach_.curve.joinAlong() - approachLead();
         row.tool_from = row.along0 + params_.approach_settle;
         row.length -= row.along0;
       }
@@ -323,7 +332,7 @@ FieldPath::FieldPath(const FieldParams& params, const std::vector<Obstacle>& obs
       t.s0 = s;
       t.length = turn_.length();
       t.turn = true;
-      t.p0 = row.p0 + params_.row_length * unitVector(h);
+      t.p0 = row.p0 + (params_.row_length + ext) * unitVector(h);
       t.heading = h;
       t.side = (params_.rows_to_left ? 1.0 : -1.0) * (i % 2 == 0 ? 1.0 : -1.0);
       elements_.push_back(t);
@@ -348,9 +357,23 @@ FieldPath::FieldPath(const FieldParams& params, const std::vector<Obstacle>& obs
   }
 }
 
+double FieldPath::approachLead() const {
+  return params_.avoidance.plan_detours ? params_.approach_settle + params_.run_out : 0.0;
+}
+
 void FieldPath::planApproach(const Element& row, double v_out, const std::vector<Obstacle>& obstacles) {
   const AvoidanceParams& av = params_.avoidance;
   const double vr = params_.row_speed, a = params_.max_accel, keep = 1.0 - av.tracking_reserve;
+  // A start on the row's start needs no approach (the tool point, behind it on the line, reaches the row on it).
+  approach_ = core::planApproach(row.p0, row.heading, *params_.start_pose, ApproachLimits(), {});
+  if (!approach_.needed) {
+    has_approach_ = false;
+    return;
+  }
+  // Otherwise the approach is planned onto the row's line extended back by approachLead(): it joins there at the
+  // earliest, approach_settle plus the tool's run-out before the row's start.
+  const double lead = approachLead();
+  const Eigen::Vector2d p0 = row.p0 - lead * unitVector(row.heading);
   ApproachLimits lim;
   lim.max_curvature = av.max_curvature;
   lim.max_curvature_rate = params_.max_curvature_rate;
@@ -359,12 +382,12 @@ void FieldPath::planApproach(const Element& row, double v_out, const std::vector
   lim.row_speed = vr;
   lim.clearance = av.pathClearance(params_.potential.influence_distance);
   // Join where the row speed can still drop to the first detour's speed, or to the row end's.
-  lim.join_limit = row.length - rampDistance(vr, v_out, a);
+  lim.join_limit = lead + row.along0 + row.length - rampDistance(vr, v_out, a);
   if (row.detour_count > 0) {
     const Detour& d = detours_[row.detour_first];
-    lim.join_limit = std::min(lim.join_limit, d.begin - rampDistance(vr, d.speed, a));
+    lim.join_limit = std::min(lim.join_limit, lead + d.begin - rampDistance(vr, d.speed, a));
   }
-  approach_ = core::planApproach(row.p0, row.heading, *params_.start_pose, lim, obstacles);
+  approach_ = core::planApproach(p0, row.heading, *params_.start_pose, lim, obstacles);
   has_approach_ = approach_.needed && approach_.ok;
   if (approach_.needed && !approach_.ok) {
     status_.within_bounds = false;

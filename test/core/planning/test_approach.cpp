@@ -105,8 +105,8 @@ TEST(Approach, StartsAtTheStartPoseAndJoinsTheRowWithContinuousBoundedCurvature)
     EXPECT_NEAR(p.y(), 3.0, 1e-9);
     EXPECT_NEAR(th, 0.0, 1e-9);
     EXPECT_NEAR(k, 0.0, 1e-9);
-    EXPECT_GE(p.x(), 0.0);
-    EXPECT_LT(p.x(), 20.0 - 0.3 - s.field.avoidance.pathClearance(0.5));  // before the first detour
+    EXPECT_GE(p.x(), -(s.field.approach_settle + s.field.run_out) - 1e-9);  // at the earliest this far before the start
+    EXPECT_LT(p.x(), 20.0 - 0.3 - s.field.avoidance.pathClearance(0.5));    // before the first detour
   }
 }
 
@@ -144,12 +144,17 @@ TEST(Approach, StartBehindTheRowOnItsLineDrivesStraightOnAndLowersTheToolAfterTh
   const FieldRunSetup s = thesisField();
   const FieldPath path(withStart(s.field, Pose2D{-3.0, 3.0, 0.0}), s.obstacles);
   ASSERT_TRUE(path.hasApproach());
-  EXPECT_NEAR(path.approach().curve.joinAlong(), 0.0, 1e-12);  // joins at the row start
-  EXPECT_NEAR(path.approach().curve.length(), 3.0, 1e-9);
+  // It joins the row's line approach_settle + run_out before the row's start (the curve counts from there), so the
+  // tool is asked for settle past the join, run_out before the row's start: before the tool point, run_out behind
+  // the axle, reaches the row.
+  const double lead = s.field.approach_settle + s.field.run_out;
+  EXPECT_GT(s.field.run_out, 0.4);
+  EXPECT_NEAR(path.approach().curve.joinAlong(), 0.0, 1e-12);
+  EXPECT_NEAR(path.approach().curve.length(), 3.0 - lead, 1e-9);
   for (double t = 0.0; t < 10.0; t += 1e-3) {
     const TargetState st = path.at(t);
     EXPECT_NEAR(st.p.y(), 3.0, 1e-12);
-    EXPECT_EQ(st.tool_down, st.p.x() >= s.field.approach_settle) << "t " << t << " x " << st.p.x();
+    EXPECT_EQ(st.tool_down, st.p.x() >= s.field.approach_settle - lead) << "t " << t << " x " << st.p.x();
   }
 }
 

@@ -328,3 +328,108 @@ TEST(FieldSoil, PatchesWhollyOutsideTheFieldAreNamed) {
   EXPECT_NEAR(ground[2].x(), 22.0, 1e-12);
   EXPECT_NEAR(ground[2].y(), 7.0, 1e-12);
 }
+
+namespace {
+/// The seed drill's tool point, `run_out` behind the axle's target along its heading.
+Eigen::Vector2d toolPoint(const sowing_robot::core::TargetState& s, double run_out) {
+  return s.p - run_out * sowing_robot::core::unitVector(s.heading);
+}
+/// Along-row position and lateral offset of p from row i of `path` (row i runs from rowStart(i) along heading_i).
+void rowFrame(const FieldPath& path, const FieldParams& f, int i, const Eigen::Vector2d& p, double& along,
+              double& lateral) {
+  const Eigen::Vector2d u = sowing_robot::core::unitVector(f.heading + (i % 2 == 1 ? M_PI : 0.0));
+  const Eigen::Vector2d d = p - path.rowStart(i);
+  along = d.dot(u);
+  lateral = u.x() * d.y() - u.y() * d.x();
+}
+}  // namespace
+
+// With a plan, every row is driven on by run_out past its end: the headland turn starts when the tool point, which
+// trails the axle by run_out, is at the row's end on its line; the turn ends run_out before the next row's start, so
+// the tool point comes onto that row on its line. The thesis path (no plan) turns at the axle's row end.
+TEST(FieldPath, WithAPlanTheToolPointIsOnTheRowLineAtEachRowsEndAndStart) {
+  for (const double spacing : {1.5, 0.75}) {  // rounded and bulb turns
+    FieldParams f = threeRows(spacing);
+    f.run_out = 0.45;
+    const FieldPath path(f);
+    int ends = 0, starts = 0;
+    bool was_turn = false;
+    int row = 0;
+    double first_down_along = std::numeric_limits<double>::quiet_NaN();
+    for (double t = 0.0; t <= path.duration(); t += 1e-3) {
+      const bool turn = path.onTurn(t);
+      const sowing_robot::core::TargetState st = path.at(t);
+      const Eigen::Vector2d tool = toolPoint(st, f.run_out);
+      double along, lateral;
+      if (turn && !was_turn) {  // the turn starts: the tool point at the row's end, on its line
+        rowFrame(path, f, row, tool, along, lateral);
+        EXPECT_NEAR(along, f.row_length, 2e-3) << "row " << row << " spacing " << spacing;
+        EXPECT_NEAR(lateral, 0.0, 1e-9) << "row " << row;
+        ++ends;
+        ++row;
+      }
+      if (!turn && was_turn) {  // the turn ends run_out before the next row's start, heading along it
+        rowFrame(path, f, row, st.p, along, lateral);
+        EXPECT_NEAR(along, -f.run_out, 2e-3) << "row " << row << " spacing " << spacing;
+        EXPECT_NEAR(lateral, 0.0, 1e-9) << "row " << row;
+        ++starts;
+      }
+      if (!turn && row > 0) {  // from the turn's end the axle and the tool point are on the row's line
+        rowFrame(path, f, row, tool, along, lateral);
+        EXPECT_NEAR(lateral, 0.0, 1e-9) << "row " << row << " t " << t;
+        if (std::isnan(first_down_along) && row == 1 && st.tool_down) first_down_along = along;
+      }
+      was_turn = turn;
+    }
+    EXPECT_EQ(ends, 2);
+    EXPECT_EQ(starts, 2);
+    // The tool is asked for from the row's start (the axle's), while the tool point is still behind it.
+    EXPECT_NEAR(first_down_along, -f.run_out, 2e-3);
+    // The last row ends at rest with the tool point at its end.
+    double along, lateral;
+    rowFrame(path, f, 2, toolPoint(path.at(path.duration() + 1.0), f.run_out), along, lateral);
+    EXPECT_NEAR(along, f.row_length, 1e-9);
+    EXPECT_NEAR(lateral, 0.0, 1e-9);
+    // Each of the two turns adds 2 run_out of row, the last row's end one more.
+    FieldParams thesis = f;
+    thesis.avoidance.plan_detours = false;
+    EXPECT_NEAR(path.length() - FieldPath(thesis).length(), 5.0 * f.run_out, 1e-9);
+  }
+}
+
+// The thesis path (no plan) is the thesis's whatever run_out: the turns start at the axle's row end.
+TEST(FieldPath, WithoutAPlanTheRunOutChangesNothing) {
+  FieldParams f = threeRows(1.5);
+  f.avoidance.plan_detours = false;
+  const FieldPath plain(f);
+  f.run_out = 0.45;
+  const FieldPath with(f);
+  EXPECT_EQ(plain.duration(), with.duration());
+  for (double t = 0.0; t < plain.duration() + 1.0; t += 0.013) {
+    EXPECT_EQ(plain.at(t).p, with.at(t).p);
+    EXPECT_EQ(plain.at(t).tool_down, with.at(t).tool_down);
+  }
+}
+
+// The approach joins the first row's line approach_settle + run_out before its start (where it fits): the tool is
+// asked for before the tool point reaches the row's start, with the tool point on the line.
+TEST(FieldPath, TheApproachSettlesBeforeTheFirstRowsStart) {
+  FieldParams f = threeRows(1.5);
+  f.run_out = 0.45;
+  const Eigen::Vector2d u = sowing_robot::core::unitVector(f.heading), n(-u.y(), u.x());
+  const Eigen::Vector2d s = Eigen::Vector2d(f.start_x, f.start_y) - 6.0 * u + 0.4 * n;
+  f.start_pose = sowing_robot::core::Pose2D{s.x(), s.y(), f.heading - 0.2};
+  const FieldPath path(f);
+  ASSERT_TRUE(path.hasApproach());
+  bool reached = false;
+  for (double t = 0.0; t < 20.0 && !reached; t += 1e-3) {
+    const sowing_robot::core::TargetState st = path.at(t);
+    double along, lateral;
+    rowFrame(path, f, 0, toolPoint(st, f.run_out), along, lateral);
+    if (along < 0.0) continue;
+    reached = true;
+    EXPECT_TRUE(st.tool_down) << "t " << t;
+    EXPECT_NEAR(lateral, 0.0, 1e-9);
+  }
+  EXPECT_TRUE(reached);
+}

@@ -25,7 +25,7 @@ FieldRunSetup threeRows() {
   s.field.potential.beta = 4.0;
   s.field.follower = FieldFollower::kPath;
   s.obstacles = {{15.0, 4.0, 0.3}};
-  s.scenario.duration = 105.0;
+  s.scenario.duration = 107.2;  // the path lasts 106.8 s from the row start (every row runs on by run_out)
   s.scenario.duration += approachExtraTime(s);
   return s;
 }
@@ -53,13 +53,17 @@ TEST(CoveragePath, RowsAreSingleSegmentsWithTheToolDownAndTurnsAreEvenlySampledW
     EXPECT_NEAR(a.y(), 3.0 + i, 1e-9);
     EXPECT_NEAR(b.y(), 3.0 + i, 1e-9);
     // The tool's changes are found on the 1 ms sampling: within 1 mm at 1 m/s at either end.
-    // The last row runs on until the tool point, which trails the axle by run_out, is at its end.
-    EXPECT_NEAR(std::fabs(b.x() - a.x()), 30.0 + (i == 2 ? f.run_out : 0.0), 2e-3) << "row " << i;
+    // Every row runs on until the tool point, which trails the axle by run_out, is at its end.
+    EXPECT_NEAR(std::fabs(b.x() - a.x()), 30.0 + f.run_out, 2e-3) << "row " << i;
   }
-  // The turns: points every 5 cm (to the sampling's 1 ms), all within the headland beyond the rows.
+  // The turns and the lead-ins they leave: points every 5 cm (to the sampling's 1 ms), all within the headland beyond
+  // the rows.
   for (std::size_t k = 0; k < c.tool_down.size(); ++k) {
     if (c.tool_down[k]) continue;
-    EXPECT_LT((c.points[k + 1] - c.points[k]).norm(), 0.05 + 1e-3 + 1e-9);
+    // A lead-in (on a row's line, y = 3, 4 or 5) is straight: one segment of up to run_out.
+    const bool on_line = std::fabs(c.points[k].y() - std::round(c.points[k].y())) < 1e-9 &&
+                         std::fabs(c.points[k + 1].y() - std::round(c.points[k + 1].y())) < 1e-9;
+    EXPECT_LT((c.points[k + 1] - c.points[k]).norm(), (on_line ? f.run_out : 0.0) + 0.05 + 1e-3 + 1e-9);
     EXPECT_TRUE(c.points[k].x() >= 30.0 - 1e-9 || c.points[k].x() <= 1e-9) << c.points[k].transpose();
   }
   EXPECT_THROW(coveragePath(path, 0.0), std::invalid_argument);
@@ -82,7 +86,10 @@ TEST(FieldPathReference, PlansNoTurnInPlaceKeepsTheFieldsBoundsAndStopsAtTheLast
     peak_v = std::max(peak_v, r.v);
     if (r.tool_down) down_time += dt;
     // Tool down only on the rows (|y - row| within the detour's offset near the obstacle).
-    if (r.tool_down) EXPECT_TRUE(r.pose.x > -1e-6 && r.pose.x < 30.0 + s.field.run_out + 1e-6) << t;
+    // Each row runs on by run_out past its end (row 1 back to x = -run_out).
+    if (r.tool_down) {
+      EXPECT_TRUE(r.pose.x > -s.field.run_out - 1e-6 && r.pose.x < 30.0 + s.field.run_out + 1e-6) << t;
+    }
   }
   EXPECT_LE(peak_lateral, lateral * (1.0 + 1e-6));
   EXPECT_NEAR(peak_v, s.field.row_speed, 1e-6);

@@ -61,10 +61,13 @@ struct FieldParams {
   /// The robot's start pose [m, m, rad]. Not a parameter: the caller sets it (the node from plant_sim's
   /// start/{x, y, theta}, as avoidance.footprint_radius from the URDF). Unset: no approach.
   std::optional<Pose2D> start_pose;
-  /// How far the seed drill's tool point trails the axle [m] (>= 0): the last row is driven this much past its end,
-  /// so the tool reaches the row's end and sows it (the axle stopping at the end leaves that stretch unsown). Not a
-  /// parameter: the caller sets it from the URDF's tool_link (0.45 m). 0, or without avoidance.plan_detours (the
-  /// thesis path): the axle stops at the row's end.
+  /// How far the seed drill's tool point trails the axle [m] (>= 0). With avoidance.plan_detours every row is driven
+  /// this much past its end (the last one to rest, the others into their headland turn), so the tool point reaches
+  /// the row's end on its line and sows it (a turn started at the axle's row end swings the tool off the line, and
+  /// the drill lifts, short of the end); the turn then ends this much before the next row's start, a straight
+  /// lead-in. An approach joins the first row approach_settle + run_out before its start. Not a parameter: the
+  /// caller sets it from the URDF's tool_link (0.45 m). 0, or without avoidance.plan_detours (the thesis path):
+  /// the rows, turns and approach are the thesis's.
   double run_out = 0.0;
   PotentialFieldParams potential;  ///< alpha, beta, repulsion (see PotentialField)
   AvoidanceParams avoidance;       ///< planned detours around the inflated obstacles (detour.h)
@@ -115,7 +118,9 @@ class HeadlandTurn {
 /// With obstacles and avoidance.plan_detours, the rows carry planned detours (detour.h) driven at their
 /// detour speed, and the path ends early, at rest, before a group it cannot pass. With a plan, approach
 /// and a start_pose off the row start, the path begins at that pose on an approach (tool up) that joins
-/// the first row; the part of the row before the join is not driven.
+/// the first row's line, approach_settle + run_out before its start where it fits (later where not); the
+/// part of the row before the join is not driven. With a plan the rows run on by run_out past their ends
+/// (FieldParams::run_out).
 class FieldPath : public TargetTrajectory {
  public:
   /// Throws std::invalid_argument on invalid parameters or obstacles.
@@ -144,7 +149,7 @@ class FieldPath : public TargetTrajectory {
     std::size_t detour_first = 0, detour_count = 0;  ///< its detours in detours_ (rows only)
     bool turn = false;
     bool approach = false;   ///< the approach from the start pose (tool up)
-    double along0 = 0.0;     ///< along-row position where a row's driven part starts (the join) [m]
+    double along0 = 0.0;     ///< along-row position where a row's driven part starts (join, lead-in: < 0) [m]
     double tool_from = 0.0;  ///< along-row position from which the tool may go down (join + settle) [m]
     Eigen::Vector2d p0 = Eigen::Vector2d::Zero();
     double heading = 0.0;  ///< direction at the start [rad]
@@ -155,6 +160,9 @@ class FieldPath : public TargetTrajectory {
     double t0 = 0.0, s0 = 0.0, duration = 0.0, v0 = 0.0, v1 = 0.0;
   };
   void addPhase(double distance, double v0, double v1);
+  /// How far before the first row's start the approach joins its line at the earliest [m]: approach_settle +
+  /// run_out with a plan (the tool is down before the tool point reaches the row), else 0.
+  double approachLead() const;
   /// Plans approach_ from params_.start_pose to `row` (the first, planned); v_out: its end speed.
   void planApproach(const Element& row, double v_out, const std::vector<Obstacle>& obstacles);
   /// Speed phases of one row of `length` from v_in to v_out through its detours' speed windows.

@@ -7,8 +7,9 @@
 // tool_down goes false on a field: on the headland turns, i.e. once the tool point is beyond the ends of
 // every row (an open-ended row, the line, has no far end). Two documented differences to the seed
 // drill, which also needs the reference's tool_down: on an approach the draft starts when the tool
-// point first reaches the row, not after approach_settle; and after the field's end the tool stays down
-// (the robot is at rest there, and the draft with it).
+// point first reaches the row, not after approach_settle (with a planned field's run_out the settle ends
+// before the row's start, FieldPath); and after the field's end the tool stays down (the robot is at rest
+// there, and the draft with it).
 #pragma once
 
 #include <Eigen/Core>
