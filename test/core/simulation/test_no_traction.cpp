@@ -141,9 +141,13 @@ TEST(NoTraction, OnANoGripPatchTheRobotStopsAndTheRunEndsSayingWhereAndWhy) {
         pair, v.entered, r.text().c_str(), r.t, v.last_t, v.moved_after, v.wheels_after, v.spin_at_end);
     ASSERT_TRUE(r.detected) << pair;
     ASSERT_GE(v.entered, 0.0) << pair;
-    // The verdict: within the window (5 s) plus the time the robot takes to stall (< 3 s) of the patch.
-    EXPECT_LT(r.t - v.entered, 8.0) << pair;
+    // The verdict: within the window (5 s) plus the time the robot takes to stall on the patch. The pairs stall within
+    // 2.5 s; rpp+atsmc creeps on, its wheels gripping and slipping by turns, for up to 5.3 s, and that time moves by
+    // seconds with round-off changes of the plan (7.5 s and 10.3 s to the verdict for paths 3e-7 m apart): 11 s
+    // bounds the creep, and the place of the verdict (below) bounds how far it gets.
+    EXPECT_LT(r.t - v.entered, 11.0) << pair;
     EXPECT_GE(r.where.x, kPatchStart - 0.5) << pair;
+    EXPECT_LT(r.where.x, kPatchStart + 1.5) << pair;  // stalled within about a metre of the patch (11.0 m)
     EXPECT_NE(r.text().find("grip budget"), std::string::npos) << r.text();
     // The run ends no_traction_hold after the verdict, with the robot held: it neither moves nor spins its wheels.
     EXPECT_NEAR(v.last_t, r.t + g.config.traction_control.no_traction_hold, 2e-3) << pair;
