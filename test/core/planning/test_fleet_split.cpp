@@ -146,6 +146,32 @@ TEST_F(FleetSplit, TheFleetSowsAtLeast2point7TimesTheRateOfOneRobot) {
   EXPECT_NEAR(three.energy_per_ha / one.energy_per_ha, 1.0, 0.05);
 }
 
+TEST(CoverageJoin, JoinsTwoPosesToolUpWithinTheTurnBounds) {
+  const CoverageParams p = drill();
+  for (const Pose2D& to :
+       {Pose2D{20.0, 5.0, 0.0}, Pose2D{-3.0, 8.0, M_PI}, Pose2D{0.0, 1.0, M_PI}, Pose2D{4.0, -6.0, 2.0}}) {
+    const Pose2D from{0.0, 0.0, 0.0};
+    const CoveragePath j = coverageJoin(from, to, p);
+    ASSERT_GE(j.points.size(), 2u);
+    EXPECT_LT(j.points.front().norm(), 1e-12);
+    EXPECT_LT((j.points.back() - Eigen::Vector2d(to.x, to.y)).norm(), 1e-9);
+    EXPECT_EQ(j.tool_down.size() + 1, j.points.size());
+    for (const bool t : j.tool_down) EXPECT_FALSE(t);
+    // Leaves along from's heading and arrives along to's; the circle through three points keeps min_turn_radius.
+    const Eigen::Vector2d d0 = j.points[1] - j.points[0], d1 = j.points.back() - j.points[j.points.size() - 2];
+    EXPECT_LT(std::fabs(std::atan2(d0.y(), d0.x()) - from.theta), 0.2);
+    EXPECT_LT(std::fabs(std::remainder(std::atan2(d1.y(), d1.x()) - to.theta, 2.0 * M_PI)), 0.2);
+    for (std::size_t i = 1; i + 1 < j.points.size(); ++i) {
+      const Eigen::Vector2d a = j.points[i] - j.points[i - 1], b = j.points[i + 1] - j.points[i],
+                            c = j.points[i + 1] - j.points[i - 1];
+      const double kappa = 2.0 * std::fabs(a.x() * b.y() - a.y() * b.x()) / (a.norm() * b.norm() * c.norm());
+      EXPECT_LT(kappa, 1.07 / p.min_turn_radius) << "point " << i;
+    }
+  }
+  EXPECT_EQ(coverageJoin({1.0, 2.0, 0.5}, {1.0, 2.0, 0.5}, p).points.size(), 1u);
+  EXPECT_THROW(coverageJoin({NAN, 0.0, 0.0}, {1.0, 0.0, 0.0}, p), std::invalid_argument);
+}
+
 TEST(FleetEnergy, AStraightAtConstantSpeedDrawsTheRollingResistancesPowerAndTheCopperLoss) {
   PathParams pp;
   pp.v_max = 1.0;
