@@ -799,5 +799,17 @@ CoveragePath coverageFrom(const CoveragePlan& plan, const Pose2D& start, const C
   return out;
 }
 
+CoveragePath coverageJoin(const Pose2D& from, const Pose2D& to, const CoverageParams& params) {
+  const std::string e = params.validate();
+  if (!e.empty()) throw std::invalid_argument(e);
+  for (const Pose2D* p : {&from, &to})
+    if (!std::isfinite(p->x) || !std::isfinite(p->y) || !std::isfinite(p->theta))
+      throw std::invalid_argument("coverageJoin: the poses must be finite");
+  RouteBuilder join(params);
+  join.start({from.x, from.y});
+  join.connect({{from.x, from.y}, from.theta}, {{to.x, to.y}, to.theta});
+  return std::move(join.path);
+}
+
 }  // namespace core
 }  // namespace sowing_robot

@@ -102,5 +102,12 @@ CoveragePlan planCoverage(const FieldBoundary& field, const CoverageParams& para
 /// arguments; throws std::invalid_argument on invalid params, a non-finite pose or a plan without a route.
 CoveragePath coverageFrom(const CoveragePlan& plan, const Pose2D& start, const CoverageParams& params);
 
+/// A tool-up join from pose `from` to pose `to` [m, m, rad] within the route's turn bounds, as the route joins its
+/// parts: a U-turn (after a straight) between opposite headings offset sideways, else the shortest
+/// turn-straight-turn (a straight line, as the route's straight joins, where none is found). Its points run from
+/// from's position to to's (one point, no segment, when the poses coincide). A pure function of its arguments; throws
+/// std::invalid_argument on invalid params or a non-finite pose. For sub-routes (a fleet's share, fleet_split.h).
+CoveragePath coverageJoin(const Pose2D& from, const Pose2D& to, const CoverageParams& params);
+
 }  // namespace core
 }  // namespace sowing_robot
