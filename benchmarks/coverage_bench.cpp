@@ -1,30 +1,34 @@
-// coverage_bench: the coverage planner's time and figures (docs/coverage.md). Figures only, never a pass/fail.
-//   coverage_bench [runs]    (default 20: the median planning time of that many plans per field)
-// Fields: the L-shaped hectare of test_coverage_planner (140 x 50 m and 60 x 50 m, a pond and a tree), and a
+// coverage_bench: the coverage planner's time and figures, and the L field sown in-process (docs/coverage.md).
+// Figures only, never a pass/fail.
+//   coverage_bench [runs] [--no-sow]   (runs, default 20: the median planning time of that many plans per field)
+// Fields: config/fields/l_field.geojson (the 1 ha L-shaped field with a pond and a power pole, field_file.md), and a
 // 10 ha field (a pentagon of about 430 x 260 m with a pond, a copse and two poles). Drill and turns of
 // config/field.yaml: one row per pass, row_spacing 1 m, min_turn_radius 0.5 m, max_curvature_rate 10 1/m^2; two
-// headland passes; heading auto.
+// headland passes; heading auto; each swath driven on by the tool's 0.45 m (coverage/run_out).
+// Then the L field sown in-process on one core (core/evaluation/coverage_run.h) with the recommended set-up: the
+// field profile (config/profiles/field.yaml: traction plant on dry soil, motors, layers, fused feedback), rpp+pid with
+// its gains (config/tuned/field/rpp+pid.yaml), from 1 m before the first swath: the wall time (target <= 60 s), the
+// simulated time, the planned row length, the sown share (target >= 98 %) and the area sown; and where the wall time
+// goes (the same route with the profile's layers and then its fused feedback taken out).
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "sowing_robot/core/evaluation/coverage_run.h"
 #include "sowing_robot/core/planning/coverage_metrics.h"
 #include "sowing_robot/core/planning/coverage_planner.h"
+#include "sowing_robot/field_file/field_file.h"
+#include "sowing_robot/scenario_file/scenario_loader.h"
 
 using namespace sowing_robot::core;
 
 namespace {
-
-FieldBoundary lShapedHectare() {
-  FieldBoundary f;
-  f.outer = {{0, 0}, {140, 0}, {140, 50}, {60, 50}, {60, 100}, {0, 100}};
-  f.voids = {{{20, 20}, {35, 18}, {38, 32}, {22, 35}}};
-  f.circles = {Obstacle{100.0, 25.0, 3.0}};
-  return f;
-}
 
 FieldBoundary tenHectares() {
   FieldBoundary f;
@@ -61,10 +65,86 @@ void run(const char* name, const FieldBoundary& field, const CoverageParams& par
       params.max_curvature_rate, plan.straight_joins);
 }
 
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+/// 1 m before the plan's first swath, facing along it.
+Pose2D beforeFirstSwath(const CoveragePlan& plan) {
+  const Swath& first = plan.swaths.front();
+  const Eigen::Vector2d along = (first.b - first.a).normalized(), behind = first.a - along;
+  return {behind.x(), behind.y(), std::atan2(along.y(), along.x())};
+}
+
+/// One sowing of `plan`: its figures, its wall time and the process's CPU time over it [s] (the machine is shared:
+/// CPU time is the steadier figure under load).
+CoverageRunReport sow(const CoveragePlan& plan, CoverageRunSetup setup, double& wall, double& cpu) {
+  setup.start = beforeFirstSwath(plan);
+  const auto t0 = Clock::now();
+  const std::clock_t c0 = std::clock();
+  CoverageRunReport r = runCoverage(plan, setup);
+  cpu = static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
+  wall = secondsSince(t0);
+  return r;
+}
+
+/// One line of a variant of the run: its wall time per control period.
+void sowVariant(const char* label, const CoveragePlan& plan, const CoverageRunSetup& setup) {
+  double wall = 0.0, cpu = 0.0;
+  const CoverageRunReport r = sow(plan, setup, wall, cpu);
+  const double periods = r.sim_time / secondsFromNanos(setup.scenario.control_period_ns);
+  std::printf("  %s: %.1f s wall, %.1f s CPU (%.2f us CPU per control period), %s, sown %.2f %%\n", label, wall, cpu,
+              1e6 * cpu / periods, r.finished ? "finished" : "NOT finished", 100.0 * r.sown_share);
+}
+
+/// The L field sown with the recommended set-up, then the same without the profile's feedback, layers and traction
+/// plant in turn (where the time goes).
+void sowLField(const FieldBoundary& field, CoverageParams p) {
+  namespace sf = sowing_robot::scenario_file;
+  CoverageRunSetup setup;
+  const std::string e =
+      parseControllerPair("rpp+pid", setup.scenario.outer, setup.scenario.inner, setup.scenario.sliding.adaptive);
+  if (!e.empty()) throw std::invalid_argument(e);
+  const sf::ProfileFiles profile = sf::resolveProfile("field", SOWING_SOURCE_DIR);
+  sf::applyProfileTo(profile.file, setup.loop);
+  sf::applyTunedGains(sf::tunedGainsFile(profile.gains_dir, setup.scenario), setup.scenario);
+  p.run_out = std::max(0.0, -setup.loop.tool.x());
+  setup.coverage = p;
+  const auto t0 = Clock::now();
+  const CoveragePlan plan = planCoverage(field, p);
+  std::printf("L field sown in-process, one core (plan %.0f ms, path %.0f m, %zu swaths):\n", 1e3 * secondsSince(t0),
+              plan.path_length, plan.swaths.size());
+  double wall = 0.0, cpu = 0.0;
+  const CoverageRunReport r = sow(plan, setup, wall, cpu);
+  const double periods = r.sim_time / secondsFromNanos(setup.scenario.control_period_ns);
+  std::printf(
+      "  field profile, rpp+pid, dry soil: wall %.1f s (target <= 60 s), CPU %.1f s (%.2f us per control "
+      "period)\n%s\n",
+      wall, cpu, 1e6 * cpu / periods, r.summary().c_str());
+  std::fflush(stdout);
+  // Where the time goes: the same route and pair fed the truth (no EKF), then without motors and layers, then on the
+  // no-slip plant.
+  CoverageRunSetup variant = setup;
+  variant.loop.feedback = Feedback::ground_truth;
+  sowVariant("the same fed the truth (no EKF)", plan, variant);
+  variant.loop = LoopConfig();
+  variant.loop.traction = setup.loop.traction;
+  sowVariant("fed the truth, traction plant without motors or layers", plan, variant);
+  variant.loop.traction.reset();
+  sowVariant("fed the truth, the no-slip plant", plan, variant);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  const int runs = argc > 1 ? std::max(1, std::atoi(argv[1])) : 20;
+  int runs = 20;
+  bool sow_field = true;
+  for (int i = 1; i < argc; ++i) {
+    if (std::string(argv[i]) == "--no-sow")
+      sow_field = false;
+    else
+      runs = std::max(1, std::atoi(argv[i]));
+  }
   CoverageParams p;
   p.rows_per_pass = 1;
   p.row_spacing = 1.0;
@@ -72,9 +152,13 @@ int main(int argc, char** argv) {
   p.min_turn_radius = 0.5;
   p.max_curvature_rate = 10.0;
   p.heading = "auto";
+  p.run_out = 0.45;  // the URDF's tool_link: 0.45 m behind the axle
   try {
-    run("L-shaped 1 ha, two voids", lShapedHectare(), p, runs);
+    const FieldBoundary l_field =
+        sowing_robot::field_file::loadFieldBoundary(std::string(SOWING_SOURCE_DIR) + "/config/fields/l_field.geojson");
+    run("L-shaped 1 ha, two voids (config/fields/l_field.geojson)", l_field, p, runs);
     run("10 ha, four voids", tenHectares(), p, std::max(1, runs / 4));
+    if (sow_field) sowLField(l_field, p);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "coverage_bench: %s\n", e.what());
     return 1;

@@ -23,12 +23,24 @@ namespace {
 const std::string kSource = SOWING_SOURCE_DIR;
 const std::string kBin = SOWING_BIN_DIR;
 
-const std::vector<std::string> kPrograms{
-    "benchmark",   "run_scenario",         "param_docs",        "bag_recorder",
-    "plant_sim",   "kinematic_controller", "torque_controller", "reference_generator",
-    "run_monitor", "seed_drill",           "state_estimator",   "pso_tuner",
-    "tune",        "cmd_vel_limiter",      "fleet_monitor",     "seed_map",
-    "field_info"};
+const std::vector<std::string> kPrograms{"benchmark",
+                                         "run_scenario",
+                                         "param_docs",
+                                         "bag_recorder",
+                                         "plant_sim",
+                                         "kinematic_controller",
+                                         "torque_controller",
+                                         "reference_generator",
+                                         "run_monitor",
+                                         "seed_drill",
+                                         "state_estimator",
+                                         "pso_tuner",
+                                         "tune",
+                                         "cmd_vel_limiter",
+                                         "fleet_monitor",
+                                         "seed_map",
+                                         "field_info",
+                                         "sow_field"};
 const std::vector<std::string> kScripts{"run",
                                         "test",
                                         "sim",

@@ -21,21 +21,17 @@ CoverageFigures coverageFigures(const FieldBoundary& field, const CoveragePlan& 
   f.field_area = bg::area(geo::outerPolygon(field));
   f.workable_area = bg::area(workable);
 
-  // The tool-down stretches of the route as lines: each swath is one, each headland loop one.
+  // What the tool sweeps: each swath from its start to its end, each headland loop closed. Not the route's tool-down
+  // stretches: those are the axle's, which on a swath run run_out ahead of the tool point (CoverageParams::run_out).
   geo::MultiLine sown, swaths;
-  const CoveragePath& route = plan.route;
-  geo::Line run;
-  for (std::size_t i = 0; i + 1 < route.points.size(); ++i) {
-    if (route.tool_down[i]) {
-      if (run.empty()) run.push_back(geo::toPoint(route.points[i]));
-      run.push_back(geo::toPoint(route.points[i + 1]));
-    }
-    if ((!route.tool_down[i] || i + 2 == route.points.size()) && !run.empty()) {
-      sown.push_back(run);
-      run.clear();
-    }
+  for (const Ring& ring : plan.headland_rings) {
+    geo::Line loop;
+    for (const Eigen::Vector2d& q : ring) loop.push_back(geo::toPoint(q));
+    if (!ring.empty()) loop.push_back(geo::toPoint(ring.front()));
+    sown.push_back(loop);
   }
   for (const Swath& s : plan.swaths) swaths.push_back(geo::Line{geo::toPoint(s.a), geo::toPoint(s.b)});
+  sown.insert(sown.begin(), swaths.begin(), swaths.end());
 
   const geo::MultiPolygon all = geo::strip(sown, w);
   double summed = 0.0;

@@ -48,6 +48,9 @@ const ParamTable<CoverageParams>& coverageTable() {
              "spacing of the route's points on its turns"),
       number("coverage/heading_step", &C::heading_step, M_PI / 36.0, Limits::above(0.0, M_PI / 2.0), "rad",
              "step of the heading sweep of heading auto"),
+      number("coverage/run_out", &C::run_out, 0.0, Limits::nonNegative(), "m",
+             "each swath is driven on this far past its end and the tool lowered this far past its start: the tool "
+             "point's distance behind the axle (the URDF's tool_link, as the field's run-out)"),
   });
   return table;
 }
@@ -712,8 +715,12 @@ CoveragePlan planCoverage(const FieldBoundary& field, const CoverageParams& para
       } else {
         route.connect(at, entry);
       }
-      route.lineTo(s.b, true);
-      at = {s.b, entry.h};
+      // The tool point trails the axle by run_out: it enters the row run_out after the swath's start and reaches its
+      // end run_out past it, in the headland (k working widths of room).
+      const Eigen::Vector2d on = params.run_out * unitVector(entry.h);
+      route.lineTo(s.a + on, false);
+      route.lineTo(s.b + on, true);
+      at = {s.b + on, entry.h};
       plan.swaths.push_back(s);
       dir = -dir;
     }

@@ -287,3 +287,40 @@ TEST(CoverageMetrics, AreaSownFollowsTheSeedRuns) {
   EXPECT_NEAR(areaSown(seeds, 0.5, 0.1), 1.0, 1e-9);
   EXPECT_THROW(areaSown(seeds, 0.0, 0.1), std::invalid_argument);
 }
+
+// The tool point trails the axle by run_out: each swath is driven on that far past its end, the tool lowered that far
+// past its start (the axle's stretch with the tool point over the row); what the tool sweeps, and so the figures, stay.
+TEST(CoveragePlanner, RunOutDrivesEachSwathOnPastItsEnd) {
+  FieldBoundary f;
+  f.outer = rectangle(0, 0, 40, 20);
+  f.circles = {Obstacle{20.0, 10.0, 2.0}};
+  CoverageParams p = fieldYamlParams();
+  const CoveragePlan without = planCoverage(f, p);
+  p.run_out = 0.45;
+  const CoveragePlan with = planCoverage(f, p);
+  ASSERT_EQ(with.swaths.size(), without.swaths.size());
+  const CoveragePath& route = with.route;
+  for (const Swath& s : with.swaths) {
+    const Eigen::Vector2d on = p.run_out * (s.b - s.a).normalized();
+    // The segment from a + run_out to b + run_out is in the route, tool down, after a tool-up one from a.
+    bool found = false;
+    for (std::size_t i = 1; i + 1 < route.points.size(); ++i) {
+      if ((route.points[i] - (s.a + on)).norm() < 1e-9 && (route.points[i + 1] - (s.b + on)).norm() < 1e-9) {
+        found = true;
+        EXPECT_TRUE(route.tool_down[i]);
+        EXPECT_FALSE(route.tool_down[i - 1]);
+        EXPECT_LT((route.points[i - 1] - s.a).norm(), 1e-9);
+      }
+    }
+    EXPECT_TRUE(found) << "swath from (" << s.a.transpose() << ")";
+  }
+  const CoverageFigures a = coverageFigures(f, without), b = coverageFigures(f, with);
+  EXPECT_NEAR(b.covered_share, a.covered_share, 1e-6);  // the headland loops start elsewhere: Boost's rounding
+  EXPECT_NEAR(b.overlap_share, a.overlap_share, 1e-6);
+  EXPECT_GT(with.path_length, without.path_length);
+  EXPECT_EQ(with.straight_joins, 0);
+  EXPECT_LE(with.peak_curvature, 1.0 / p.min_turn_radius + 1e-9);
+  CoverageParams bad = p;
+  bad.run_out = -0.1;
+  EXPECT_THROW(planCoverage(f, bad), std::invalid_argument);
+}

@@ -1,10 +1,10 @@
 // How well a coverage plan (coverage_planner.h) covers its field, and the area a seed record sowed. Purely
 // geometric (Boost.Geometry areas of the tool's strips), so it lives beside the planner.
 //
-// Covered: the union of the strips a tool of the working width sweeps along the route where the tool is down
-// (swaths and headland loops, flat at their ends). Overlap: the strips' summed areas minus their union, as a share
-// of the union (0 when no ground is sown twice). Missed: the workable field (the boundary minus the voids) not
-// covered, as a share of the workable field.
+// Covered: the union of the strips a tool of the working width sweeps along the swaths and the headland loops (flat
+// at their ends; the tool's, not the axle's, which drives each swath on by its run-out). Overlap: the strips' summed
+// areas minus their union, as a share of the union (0 when no ground is sown twice). Missed: the workable field (the
+// boundary minus the voids) not covered, as a share of the workable field.
 #pragma once
 
 #include <vector>

@@ -51,13 +51,17 @@ struct CoverageParams {
   RoutePattern pattern;
   double sample_spacing;  ///< spacing of the route's points on its curves [m]
   double heading_step;    ///< step of the heading sweep of "auto" [rad]
+  /// How far each swath is driven on past its end [m], >= 0: the tool point trails the axle by this much (the URDF's
+  /// tool_link, as FieldParams::run_out), so the axle drives run_out past the row's end for the tool point to reach
+  /// it, and the tool goes down where the tool point enters the row, run_out after the swath's start.
+  double run_out;
   double workingWidth() const { return rows_per_pass * row_spacing; }
   /// The heading in force: "" and `out` set, or the error ("auto" leaves out untouched and returns "").
   std::string parseHeading(bool& is_auto, double& out) const;
   std::string validate() const;
 };
 /// coverage/{rows_per_pass, row_spacing, headland_passes, heading, min_turn_radius, max_curvature_rate,
-/// pattern, sample_spacing, heading_step}.
+/// pattern, sample_spacing, heading_step, run_out}.
 const ParamTable<CoverageParams>& coverageTable();
 
 /// One swath: its centre line from a to b in the direction it is driven, and its tool rows (same direction).
@@ -74,8 +78,10 @@ struct CoveragePlan {
   std::vector<Ring> inner_field;     ///< the inner field's rings (outer rings and holes)
   std::vector<Ring> headland_rings;  ///< the headland passes' centre lines, in the order they are driven
   std::vector<Swath> swaths;         ///< in route order
-  CoveragePath route;                ///< swaths, turns and headland loops; tool down on swaths and headland loops
-  double heading = 0.0;              ///< the swath heading used [rad], in [0, pi)
+  /// Swaths, turns and headland loops; tool down on the headland loops and on each swath from run_out past its start
+  /// to run_out past its end (the axle's stretch on which the tool point, run_out behind it, is over the row).
+  CoveragePath route;
+  double heading = 0.0;                                 ///< the swath heading used [rad], in [0, pi)
   RoutePattern pattern = RoutePattern::kBoustrophedon;  ///< the pattern used (never kAuto)
   int parts = 0;                                        ///< parts of the inner field swept one after the other
   double working_width = 0.0;                           ///< [m]
