@@ -12,7 +12,6 @@
 #include "sowing_robot/ros/common/msg_checks.h"
 #include "sowing_robot/ros/common/node_failure.h"
 #include "sowing_robot/ros/common/reconfigure_bridge.h"
-#include "sowing_robot/ros/common/urdf_params.h"
 
 namespace sowing_robot {
 
@@ -45,25 +44,8 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
     if (error.empty() && p.error().empty()) error = path.validate();
   }
   if (settings.type == Type::kField) {
-    loadTable(p, core::fieldTable(), field);
-    if (error.empty()) error = loadObstacles(p, "obstacles", obstacles);
-    // The plan keeps the body clear, not the axle point: the obstacles are inflated by the footprint's
-    // circumscribed radius, from the URDF's collision geometry (the one source of the robot's shape).
-    p.allow("robot_description");
-    std::string key, xml;
-    core::Footprint footprint;
-    if (error.empty() && (!pnh.searchParam("robot_description", key) || !pnh.getParam(key, xml)))
-      error = "parameter robot_description (the URDF) is not set";
-    if (error.empty()) error = footprintFromUrdf(xml, footprint);
-    field.avoidance.footprint_radius = footprint.circumscribedRadius();
-    // The last row is driven until the seed drill's tool point (seed_drill/tool_link, where sim.launch loads
-    // config/seed_drill.yaml, as plant_sim reads it) reaches its end, so the row is sown to it.
-    std::string tool_link = "tool_link";
-    nh.param<std::string>("seed_drill/tool_link", tool_link, tool_link);
-    if (error.empty()) error = toolRunOutFromUrdf(xml, tool_link, field.run_out);
-    // The reference starts where the robot does (run/start) and joins the first row on a bounded approach.
-    field.start_pose = run.start();
-    if (error.empty() && p.error().empty()) error = field.validate();
+    const std::string plan_error = loadFieldPlan(p, nh, run.start(), field, obstacles);
+    if (error.empty()) error = plan_error;
   } else {
     // Said before the unknown-key list (which would only name the key): why it is not read.
     for (const char* key : {"field", "potential", "obstacles"})

@@ -2,7 +2,7 @@
 """rostest (realtime pipeline): inject NaN wheel torques and NaN references, then kill the torque
 controller for 1 s of simulated time and start it again. Checks: the state (ground_truth) stays finite throughout, the
 plant, kinematic controller and plant timeout each log their warning, the robot coasts (zero torque
-applied) while the controller is away, and it is back on the line (|e_y| < 3 cm) 10 s of simulated time
+applied) while the controller is away, and it is back on the line (|e_y| < 3 cm) 6 s of simulated time
 after the restarted controller's first torque.
 
 Every verdict is on simulated time or on an event waited for: the wall clock only bounds a hang
@@ -24,7 +24,13 @@ from rosgraph_msgs.msg import Log
 from sowing_robot.msg import ReferenceState, TrackingError, WheelTorque
 
 WALL_LIMIT = 120.0  # [s wall] bounds a hang only: anything waited for comes in a few seconds on an idle machine
-SETTLE = 10.0       # [s sim] from the restarted controller's first torque to the check that it is back on the line
+# [s sim] from the restarted controller's first torque to the check that it is back on the line. The outage leaves
+# |e_y| ~0.5 m and |e_theta| ~0.3 rad; 0.5, 1, 2, 3, 5 s after the return e_y was -0.49, -0.50, -0.31, -0.16,
+# -0.010 m and e_theta 0.021 rad at 5 s (10 s: 3 mm), so 6 s leaves the checks' bounds (3 cm, 0.05 rad) their margin.
+SETTLE = 6.0
+# [s sim] the NaNs; the torque controller is killed 2 s later. The robot starts on the line (fault_injection.test),
+# so it is there from the start: waiting 6 s, as for the thesis's approach from 3 m beside it, judged nothing more.
+FAULTS_AT = 2.0
 
 
 class FaultInjection(unittest.TestCase):
@@ -87,7 +93,8 @@ class FaultInjection(unittest.TestCase):
         return e if e is not None and e.header.stamp.to_sec() >= t_sim else None
 
     def test_faults(self):
-        self.wait_until(6.0)
+        outage = FAULTS_AT + 2.0  # the torque controller's kill
+        self.wait_until(FAULTS_AT)
         # 1. NaN torques and NaN references for 0.5 s.
         nan = float("nan")
         for _ in range(50):
@@ -100,7 +107,7 @@ class FaultInjection(unittest.TestCase):
             r.x, r.y = nan, 3.0
             self.ref_pub.publish(r)
             rospy.sleep(0.01)
-        self.wait_until(8.0)
+        self.wait_until(outage)
         # the warnings travel through /rosout: waited for, not read at a moment
         self.wait_for(lambda: self.logged("plant_sim", "non-finite wheel torque"), "warning from plant_sim")
         self.wait_for(lambda: self.logged("kinematic_controller", "non-finite reference"),
@@ -108,8 +115,8 @@ class FaultInjection(unittest.TestCase):
         self.assertEqual(self.nonfinite_odom, 0)
 
         # 2. Kill the torque controller, wait 1 s of simulated time, start it again.
-        self.wait_for(lambda: self.error_since(8.0) is not None, "tracking_error at t = 8 s")
-        self.assertLess(abs(self.error_since(8.0).y), 0.05, "not on the line before the outage: %s" % self.last_error)
+        self.wait_for(lambda: self.error_since(outage) is not None, "tracking_error at t = %g s" % outage)
+        self.assertLess(abs(self.error_since(outage).y), 0.05, "not on the line before the outage: %s" % self.last_error)
         rosnode.kill_nodes(["/torque_controller"])
         t_kill = rospy.get_rostime().to_sec()
         self.wait_until(t_kill + 1.0)

@@ -30,7 +30,6 @@
 #include "sowing_robot/ros/common/msg_checks.h"
 #include "sowing_robot/ros/common/param_reader.h"
 #include "sowing_robot/ros/common/publisher_links.h"
-#include "sowing_robot/ros/common/urdf_params.h"
 #include "sowing_robot/ros/plant_sim/traction.h"
 
 using namespace sowing_robot;
@@ -114,21 +113,12 @@ TEST(FusedLockstep, NodePipelineEqualsTheInProcessEstimatedLoop) {
   ros::param::get("/reference_generator/type", type);
   core::FieldSource* field_source = nullptr;
   if (type == "field") {
+    // The plan from the node's parameters, read by the node's own function (component_params.h).
     ParamReader fieldp(ros::NodeHandle("/reference_generator"));
     core::FieldParams field;
-    loadTable(fieldp, core::fieldTable(), field);
     std::vector<core::Obstacle> obstacles;
-    std::string xml;
-    ASSERT_TRUE(ros::param::get("/robot_description", xml));
-    core::Footprint footprint;
-    ASSERT_EQ(core::firstError(
-                  {fieldp.error(), loadObstacles(fieldp, "obstacles", obstacles), footprintFromUrdf(xml, footprint)}),
+    ASSERT_EQ(core::firstError({loadFieldPlan(fieldp, ros::NodeHandle(), sc.start, field, obstacles), fieldp.error()}),
               "");
-    field.avoidance.footprint_radius = footprint.circumscribedRadius();
-    std::string tool_link = "tool_link";
-    ros::param::get("seed_drill/tool_link", tool_link);
-    ASSERT_EQ(toolRunOutFromUrdf(xml, tool_link, field.run_out), "");
-    field.start_pose = sc.start;
     std::unique_ptr<core::FieldSource> f = core::makeFieldSource(field, obstacles);
     field_source = f.get();
     source = std::move(f);

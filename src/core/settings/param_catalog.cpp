@@ -13,6 +13,7 @@
 #include "sowing_robot/core/model/motor.h"
 #include "sowing_robot/core/model/sensors.h"
 #include "sowing_robot/core/model/traction.h"
+#include "sowing_robot/core/planning/coverage_planner.h"
 #include "sowing_robot/core/planning/field.h"
 #include "sowing_robot/core/planning/path_plan.h"
 #include "sowing_robot/core/planning/speed_governor.h"
@@ -139,6 +140,12 @@ const std::vector<CatalogSection>& parameterCatalog() {
        "while the wheels slip",
        concat(ReferenceGeneratorSettings::table(), fieldTable(), pathTable(), speedGovernorTable()),
        {"obstacles", "path/points"}},
+      {"coverage_planner",
+       "the coverage planner (core/planning/coverage_planner.h: planCoverage(), docs/coverage.md): headlands, swaths "
+       "and one route over a field with voids. No node reads these keys yet (a node would refuse them): they are "
+       "CoverageParams' keys for its callers, here so that their defaults and ranges are documented with the rest",
+       infos(coverageTable()),
+       {}},
       {"seed_drill",
        "the seed drill: spacing and scoring of the seeds against the plan",
        infos(SeedDrillSettings::table()),

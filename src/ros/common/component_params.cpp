@@ -100,6 +100,30 @@ std::string loadObstacles(ParamReader& p, const std::string& key, std::vector<co
   });
 }
 
+std::string loadFieldPlan(ParamReader& p, const ros::NodeHandle& nh, const core::Pose2D& start,
+                          core::FieldParams& field, std::vector<core::Obstacle>& obstacles) {
+  loadTable(p, core::fieldTable(), field);
+  std::string error = loadObstacles(p, "obstacles", obstacles);
+  // The plan keeps the body clear, not the axle point: the obstacles are inflated by the footprint's
+  // circumscribed radius, from the URDF's collision geometry (the one source of the robot's shape).
+  p.allow("robot_description");
+  std::string key, xml;
+  core::Footprint footprint;
+  if (error.empty() && (!p.handle().searchParam("robot_description", key) || !p.handle().getParam(key, xml)))
+    error = "parameter robot_description (the URDF) is not set";
+  if (error.empty()) error = footprintFromUrdf(xml, footprint);
+  field.avoidance.footprint_radius = footprint.circumscribedRadius();
+  // The last row is driven until the seed drill's tool point (seed_drill/tool_link, where sim.launch loads
+  // config/seed_drill.yaml, as plant_sim reads it) reaches its end, so the row is sown to it.
+  std::string tool_link = "tool_link";
+  nh.param<std::string>("seed_drill/tool_link", tool_link, tool_link);
+  if (error.empty()) error = toolRunOutFromUrdf(xml, tool_link, field.run_out);
+  // The reference starts where the robot does (run/start) and joins the first row on a bounded approach.
+  field.start_pose = start;
+  if (error.empty() && p.error().empty()) error = field.validate();
+  return error;
+}
+
 void requireValid(const ParamReader& p, const std::string& validate_message) {
   if (!p.error().empty()) refuseToStart(p.error());
   const std::string unknown = p.unknownKeys();

@@ -18,7 +18,8 @@ struct CatalogSection {
   std::vector<std::string> lists;  ///< keys holding lists, documented apart (obstacles, gains)
 };
 
-/// Every node namespace with its parameters, in the order docs/parameters.md lists them.
+/// Every node namespace with its parameters, in the order docs/parameters.md lists them; and the coverage
+/// planner's table (coverage_planner, before any node reads it).
 const std::vector<CatalogSection>& parameterCatalog();
 
 /// The whole of docs/parameters.md.

@@ -81,6 +81,15 @@ std::string readMembers(XmlRpc::XmlRpcValue& map, const std::string& name, const
 /// Returns "" or one line naming the bad entry (absent key: empty list).
 std::string loadObstacles(ParamReader& p, const std::string& key, std::vector<core::Obstacle>& out);
 
+/// What reference_generator plans a field from with type field, read as it reads it (and the lockstep tester, to
+/// plan the same field in-process): field/... and potential/... (fieldTable()) and the obstacles list from p (the
+/// node's namespace); the footprint's circumscribed radius (avoidance/footprint_radius: the obstacles are inflated
+/// by it) and the last row's run-out to the seed drill's tool point (`seed_drill/tool_link`, relative to nh) from
+/// the URDF in robot_description (searched upwards from p's namespace); `start` as the start pose. Then
+/// FieldParams::validate() if nothing failed before. Returns "" or the first error (p's own errors stay in p).
+std::string loadFieldPlan(ParamReader& p, const ros::NodeHandle& nh, const core::Pose2D& start,
+                          core::FieldParams& field, std::vector<core::Obstacle>& obstacles);
+
 /// Everything one node needs checked: reader errors, unknown keys, then the given validate() text.
 /// Refuses to start on the first problem: throws badParameter (node_failure.h).
 void requireValid(const ParamReader& p, const std::string& validate_message);
