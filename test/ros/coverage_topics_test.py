@@ -115,7 +115,7 @@ class CoverageTopics(unittest.TestCase):
         self.assertGreater(n_swaths, 100, "the 1 ha field at 1 m is more than 100 swaths")
         self.assertEqual(len(lines.points), 2 * n_swaths)
         self.assertEqual(len(plan.row_starts), n_swaths, "rows on `plan` (seed drill) != swaths")
-        self.assertEqual(plan.obstacle_radii, [])
+        self.assertEqual(len(plan.obstacle_radii), 0)
         # the route: from the start pose; then onto the first swath's start
         p0 = route.poses[0].pose.position
         self.assertAlmostEqual(p0.x, start[0], places=6)
