@@ -13,7 +13,7 @@ using visualization_msgs::MarkerArray;
 
 struct Style {
   float r, g, b, a;
-  double width;  ///< line width [m]: seen at the scale of a whole field (about 6 px per metre for 1 ha)
+  double width;  ///< line width [m]: seen at the scale of a whole field (about 5 px per metre for 1 ha)
   double z;      ///< drawn above the ground's grid, the later layers above the earlier
 };
 
