@@ -13,6 +13,9 @@ namespace sowing_robot {
 namespace {
 constexpr double kProgressPeriod = 0.1;   // [s] of simulated time between periodic ~progress messages
 constexpr double kPlannedSpacing = 0.05;  // [m] between planned_path poses
+// at most this many planned_path poses: a whole field's route (10 km) at 5 cm would be a 16 MB latched message, in
+// rviz and in every lean bag; paths up to 1 km keep the 5 cm
+constexpr int kMaxPlannedPoses = 20000;
 constexpr std::size_t kMaxSent = 100000;  // references remembered for states not yet come (100 s at 1 kHz)
 }  // namespace
 
@@ -91,7 +94,7 @@ void PathFollower::planChanged(const char* why) {
   nav_msgs::Path out;
   out.header.frame_id = frame_;
   out.header.stamp = ros::Time::now();
-  const int n = std::max(1, static_cast<int>(std::ceil(plan.length() / kPlannedSpacing)));
+  const int n = std::clamp(static_cast<int>(std::ceil(plan.length() / kPlannedSpacing)), 1, kMaxPlannedPoses);
   for (int i = 0; i <= n; ++i) {
     const core::Reference r = plan.at(plan.timeAt(plan.length() * i / n));
     geometry_msgs::PoseStamped p;

@@ -2,18 +2,66 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
 #include "sowing_robot/core/common/validation.h"
+#include "sowing_robot/core/planning/coverage_follower.h"
 #include "sowing_robot/core/planning/field_path_follower.h"
 #include "sowing_robot/core/planning/seeding.h"
+#include "sowing_robot/field_file/field_file.h"
 #include "sowing_robot/ros/common/component_params.h"
 #include "sowing_robot/ros/common/msg_checks.h"
 #include "sowing_robot/ros/common/node_failure.h"
 #include "sowing_robot/ros/common/reconfigure_bridge.h"
 
 namespace sowing_robot {
+
+namespace {
+
+/// Of the field's keys, type coverage reads the speeds only (coverageFollowerParams): the rows' layout is the file's,
+/// and field/min_turn_radius is coverage/min_turn_radius. Any other field/ key is then refused as unknown.
+const core::ParamTable<core::FieldParams>& fieldSpeedsTable() {
+  static const core::ParamTable<core::FieldParams> table = [] {
+    std::vector<core::ParamEntry<core::FieldParams>> speeds;
+    for (const auto& e : core::fieldTable().entries())
+      if (e.info.key == "field/row_speed" || e.info.key == "field/turn_speed" || e.info.key == "field/max_accel")
+        speeds.push_back(e);
+    return core::ParamTable<core::FieldParams>(speeds);
+  }();
+  return table;
+}
+
+/// type coverage: the field file read (with field_origin in place of a GeoJSON file's own, when given) and planned,
+/// and the route from the start pose. "" or one line naming what is wrong: the file library's "PATH: ..." or the
+/// planner's, after the file's name.
+std::string planField(const core::ReferenceGeneratorSettings& settings, const std::string& origin_key,
+                      const core::CoverageParams& coverage, const core::Pose2D& start, core::CoveragePlan& plan,
+                      core::CoveragePath& route) {
+  std::optional<field_file::GeoOrigin> origin;
+  if (!settings.field_origin.empty()) {
+    field_file::GeoOrigin o;
+    const std::string e = seed_map::parseOrigin(settings.field_origin, o);
+    if (!e.empty()) return origin_key + " = '" + settings.field_origin + "': " + e;
+    origin = o;
+  }
+  core::FieldBoundary field;
+  try {
+    field = field_file::loadFieldBoundary(settings.field_file, origin);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  try {
+    plan = core::planCoverage(field, coverage);
+    route = core::coverageFrom(plan, start, coverage);
+  } catch (const std::invalid_argument& e) {
+    return settings.field_file + ": " + e.what();
+  }
+  return "";
+}
+
+}  // namespace
 
 ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) {
   ParamReader p(pnh);
@@ -38,6 +86,9 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
   std::vector<core::Obstacle> obstacles;
   core::PathParams path;
   std::vector<Eigen::Vector2d> path_points;
+  core::CoverageParams coverage;
+  core::CoveragePlan coverage_plan;
+  core::CoveragePath coverage_route;
   if (settings.type == Type::kPath) {
     loadTable(p, core::pathTable(), path);
     if (error.empty()) error = loadPathPoints(p, path_points);
@@ -47,13 +98,32 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
     const std::string plan_error = loadFieldPlan(p, nh, run.start(), field, obstacles);
     if (error.empty()) error = plan_error;
   } else {
-    // Said before the unknown-key list (which would only name the key): why it is not read.
+    // Said before the unknown-key list (which would only name the key): why it is not read. Type coverage reads the
+    // field's speeds (its other field/ keys are refused as unknown).
     for (const char* key : {"field", "potential", "obstacles"})
-      if (pnh.hasParam(key))
+      if (pnh.hasParam(key) && !(settings.type == Type::kCoverage && std::string(key) == "field"))
         p.fail(pnh.resolveName(key) +
                " is set but type is not 'field': field, potential and obstacles are read only "
                "with type: field (set " +
                pnh.resolveName("type") + ": field, or remove them)");
+  }
+  if (settings.type == Type::kCoverage) {
+    loadTable(p, fieldSpeedsTable(), field);
+    loadTable(p, core::coverageTable(), coverage);
+    if (error.empty() && p.error().empty()) error = coverage.validate();
+    if (error.empty() && p.error().empty() && settings.field_file.empty())
+      error = pnh.resolveName("field_file") + " is not set: type coverage plans the field of a field file " +
+              "(sim.launch field_file:=PATH)";
+    // Planned here, before the unknown-key check ends the start-up: a field that cannot be planned is a bad
+    // parameter, said in one line (the file's name and what is wrong with it).
+    if (error.empty() && p.error().empty())
+      error =
+          planField(settings, pnh.resolveName("field_origin"), coverage, run.start(), coverage_plan, coverage_route);
+  } else {
+    for (const char* key : {"coverage", "field_file", "field_origin"})
+      if (pnh.hasParam(key) && !(std::string(key) != "coverage" && pnh.param<std::string>(key, "").empty()))
+        p.fail(pnh.resolveName(key) + " is set but type is not 'coverage': coverage/, field_file and field_origin " +
+               "are read only with type: coverage (set " + pnh.resolveName("type") + ": coverage, or remove them)");
   }
   if (settings.type != Type::kPath && pnh.hasParam("path"))
     p.fail(pnh.resolveName("path") + " is set but type is not 'path': path/ is read only with type: path (set " +
@@ -80,6 +150,24 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
     path_source = f.get();
     source_ = std::move(f);
     logSettings("reference_generator", core::pathTable(), path);
+  } else if (settings.type == Type::kCoverage) {
+    std::unique_ptr<core::PathReference> f;
+    try {
+      f = std::make_unique<core::PathReference>(core::coverageReference(coverage_plan, run.start(), field, coverage));
+    } catch (const std::invalid_argument& e) {
+      throw badParameter(settings.field_file + ": " + e.what());
+    }
+    path_source = f.get();
+    source_ = std::move(f);
+    coverage_rows_ = coverage_plan.rows();
+    logSettings("reference_generator", core::coverageTable(), coverage);
+    logSettings("reference_generator", fieldSpeedsTable(), field);
+    ROS_INFO(
+        "reference_generator: %s planned: %zu swath(s) in %d part(s) at heading %.3f rad, %zu headland ring(s), "
+        "route %.1f m (%.1f m tool up) from the start (%.3f, %.3f, %.3f)",
+        settings.field_file.c_str(), coverage_plan.swaths.size(), coverage_plan.parts, coverage_plan.heading,
+        coverage_plan.headland_rings.size(), coverage_plan.path_length, coverage_plan.turn_length, run.start().x,
+        run.start().y, run.start().theta);
   } else {
     std::unique_ptr<core::FieldSource> f;
     try {
@@ -133,7 +221,12 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
   }
   if (path_source)
     path_follower_ = std::make_unique<PathFollower>(nh, pnh, *path_source, odom_frame_,
-                                                    field_ ? "the field's rows and turns" : "path/points");
+                                                    field_                             ? "the field's rows and turns"
+                                                    : settings.type == Type::kCoverage ? "the coverage plan"
+                                                                                       : "path/points");
+  // The field file's local frame is the odom frame (the world-fixed frame of this simulation: there is no map).
+  if (settings.type == Type::kCoverage)
+    coverage_topics_ = std::make_unique<CoverageTopics>(nh, coverage_plan, coverage_route, odom_frame_);
   publishPlan();
   clock_sub_ = nh.subscribe("/clock", 10, &ReferenceGenerator::clockCallback, this, ros::TransportHints().tcpNoDelay());
   if (governor_) {
@@ -221,6 +314,13 @@ void ReferenceGenerator::publishPlan() {
     plan.reason = s.code == core::AvoidanceStatus::Code::kOk ? s.bounds_note : s.reason;
     plan.within_bounds = s.within_bounds;
     plan.detours = static_cast<std::uint32_t>(s.detours);
+  } else if (!coverage_rows_.empty()) {  // type coverage: the swaths' tool rows; the voids are not obstacles
+    for (const core::RowSegment& r : coverage_rows_) {
+      plan.row_starts.push_back(point(r.a));
+      plan.row_ends.push_back(point(r.b));
+    }
+    plan.status = "ok";
+    plan.within_bounds = true;
   } else if (!path_follower_) {  // type line (type path: no rows, no obstacles)
     plan.row_starts.push_back(point(line_));
     plan.row_ends.push_back(point(line_ + Eigen::Vector2d(1e5, 0.0)));  // the thesis line, open-ended

@@ -8,7 +8,8 @@
 //   feedback (nav_msgs/Odometry, what the controllers are fed): the robot's progress along the path:
 //     ~progress (PathProgress, latched; every 0.1 s of simulated time and on each change of status), and the
 //     end-of-path report in the log, once per path, when the robot is within path/goal_tolerance of the goal.
-//   planned_path (nav_msgs/Path, latched): the drivable path (corners rounded, every 5 cm) for rviz.
+//   planned_path (nav_msgs/Path, latched): the drivable path (corners rounded, every 5 cm, at most 20000
+//     poses: a longer path, a whole field's route, more sparsely) for rviz.
 // The progress never feeds back into the references: in lockstep they stay a function of time and of the
 // paths received.
 #pragma once

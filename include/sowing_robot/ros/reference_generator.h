@@ -10,6 +10,10 @@
 //               run time, and `field_markers` (latched) shows obstacles, influence zones and rows.
 //               With field/follower path: core::FieldPathReference, the field's rows and turns as a path
 //               through the follower of type path (core/planning/field_path_follower.h), with its reports.
+//   type coverage: the field of a field file (field_file, docs/field_file.md) planned by the coverage planner
+//               (coverage/..., core/planning/coverage_planner.h) and its route followed from run/start by the
+//               path follower (coverageReference, core/planning/coverage_follower.h); the plan on coverage/...
+//               (ros/coverage_topics.h), its swaths' tool rows on `plan` for the seed drill.
 //   type path:  core::PathReference (a given path, rounded and timed: core/planning/path_plan.h), from
 //               path/points or nav_msgs/Path on `path`; ros/path_follower.h says what it reports.
 // Speed governor (speed_governor/..., core/planning/speed_governor.h; off by default): the source's time runs
@@ -42,6 +46,7 @@
 #include "sowing_robot/core/planning/speed_governor.h"
 #include "sowing_robot/ros/common/path_buffer.h"
 #include "sowing_robot/ros/common/ready_roster.h"
+#include "sowing_robot/ros/coverage_topics.h"
 #include "sowing_robot/ros/path_follower.h"
 
 namespace sowing_robot {
@@ -82,6 +87,11 @@ class ReferenceGenerator {
   core::FieldReference* potential_ = nullptr;      ///< field_ with field/follower potential, else null
   std::vector<core::Obstacle> obstacles_;          ///< the obstacles in force (type field)
   std::unique_ptr<PathFollower> path_follower_;    ///< type path, field/follower path: inputs, progress; else null
+
+  // type coverage, else null / empty
+  std::unique_ptr<CoverageTopics> coverage_topics_;  ///< the plan on coverage/...
+  std::vector<core::RowSegment> coverage_rows_;      ///< the plan's tool rows (sent on `plan`)
+
   ros::Subscriber clock_sub_, obstacles_sub_, traction_sub_;
   ros::Publisher ref_pub_, path_pub_, marker_pub_, plan_pub_;
   std::string odom_frame_ = "odom";    ///< run/odom_frame

@@ -186,13 +186,24 @@ const ParamTable<ReferenceGeneratorSettings>& ReferenceGeneratorSettings::table(
   using S = ReferenceGeneratorSettings;
   static const ParamTable<S> table({
       choice("type", &S::type, S::Type::kLine,
-             {{"line", S::Type::kLine}, {"field", S::Type::kField}, {"path", S::Type::kPath}},
+             {{"line", S::Type::kLine},
+              {"field", S::Type::kField},
+              {"path", S::Type::kPath},
+              {"coverage", S::Type::kCoverage}},
              "line: the thesis's sowing line of Table 5.2; field: rows and headland turns (config/field*.yaml) "
              "followed by the potential field or the path follower (field/follower); "
-             "path: a given path (path/points, or nav_msgs/Path on `path`) with a speed profile (config/path.yaml)"),
+             "path: a given path (path/points, or nav_msgs/Path on `path`) with a speed profile (config/path.yaml); "
+             "coverage: the field of field_file planned by the coverage planner (coverage/..., config/coverage.yaml) "
+             "and its route followed by the path follower from run/start"),
       number("line/x0", &S::line_x0, 0.0, Limits::any(), "m", "type line: x_d = x0 + v_r t"),
       number("line/v_r", &S::line_v_r, 1.0, Limits::closed(0.0, 10.0), "m/s", "type line: reference speed v_r"),
       number("line/y", &S::line_y, 3.0, Limits::any(), "m", "type line: y_d"),
+      text("field_file", &S::field_file, "",
+           "type coverage: the field file, GeoJSON in WGS84 or a local-frame YAML (docs/field_file.md), in the odom "
+           "frame"),
+      text("field_origin", &S::field_origin, "",
+           "type coverage, a GeoJSON file: the local frame's origin LAT,LON[,ALT] [deg, deg, m] in place of the "
+           "file's \"origin\"; \"\": the file's"),
       number("path_spacing", &S::path_spacing, 0.1, Limits::positive(), "m", "distance between reference_path points"),
       number("lookahead", &S::lookahead, 0.05, Limits::closed(1e-6, 10.0), "s",
              "references are sent this far ahead of /clock, so the loop never waits for this node; obstacle and "

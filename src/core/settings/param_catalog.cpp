@@ -135,10 +135,12 @@ const std::vector<CatalogSection>& parameterCatalog() {
       {"reference_generator",
        "the reference: the thesis line, a field of rows through the potential field "
        "(field/ and potential/ keys and obstacles are read only with type field), or a given path "
-       "(path/ keys, read only with type path; path/points: [[x, y], ...] in the odom frame [m]); speed_governor/ "
+       "(path/ keys, read only with type path; path/points: [[x, y], ...] in the odom frame [m]), or a field file "
+       "planned by the coverage planner (coverage/ keys, config/coverage.yaml, read only with type coverage, which "
+       "reads of field/ only row_speed, turn_speed and max_accel); speed_governor/ "
        "(opt-in, core/planning/speed_governor.h; needs torque_controller/traction_control/enabled) slows any of them "
        "while the wheels slip",
-       concat(ReferenceGeneratorSettings::table(), fieldTable(), pathTable(), speedGovernorTable()),
+       concat(ReferenceGeneratorSettings::table(), fieldTable(), pathTable(), coverageTable(), speedGovernorTable()),
        {"obstacles", "path/points"}},
       {"coverage_planner",
        "the coverage planner (core/planning/coverage_planner.h: planCoverage(), docs/coverage.md): headlands, swaths "

@@ -84,10 +84,14 @@ struct TorqueControllerSettings : ControllerPair {
 /// obstacles are read only with type field, the path's keys (PathParams, pathTable(), and path/points) only
 /// with type path.
 struct ReferenceGeneratorSettings {
-  enum class Type { kLine, kField, kPath };
+  enum class Type { kLine, kField, kPath, kCoverage };
   ReferenceGeneratorSettings();
-  Type type;  ///< line (the thesis line), field (rows and turns, field/follower) or path (a given path, path_plan.h)
+  /// line (the thesis line), field (rows and turns, field/follower), path (a given path, path_plan.h) or coverage
+  /// (a field file planned by the coverage planner, coverage_planner.h, and followed as a path)
+  Type type;
   double line_x0, line_v_r, line_y;
+  std::string field_file;    ///< type coverage: the field file (docs/field_file.md)
+  std::string field_origin;  ///< type coverage: "LAT,LON[,ALT]" in place of a GeoJSON file's origin, or ""
   double path_spacing, lookahead;
   std::string validate() const { return table().checkRanges(*this); }
   static const ParamTable<ReferenceGeneratorSettings>& table();
