@@ -110,6 +110,8 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
   if (settings.type == Type::kCoverage) {
     loadTable(p, fieldSpeedsTable(), field);
     loadTable(p, core::coverageTable(), coverage);
+    // Each swath is driven on until the tool point reaches its end (the URDF's tool offset), unless set.
+    if (error.empty() && !pnh.hasParam("coverage/run_out")) error = loadToolRunOut(p, nh, coverage.run_out);
     if (error.empty() && p.error().empty()) error = coverage.validate();
     if (error.empty() && p.error().empty() && settings.field_file.empty())
       error = pnh.resolveName("field_file") + " is not set: type coverage plans the field of a field file " +

@@ -50,7 +50,9 @@ const ParamTable<CoverageParams>& coverageTable() {
              "step of the heading sweep of heading auto"),
       number("coverage/run_out", &C::run_out, 0.0, Limits::nonNegative(), "m",
              "each swath is driven on this far past its end and the tool lowered this far past its start: the tool "
-             "point's distance behind the axle (the URDF's tool_link, as the field's run-out)"),
+             "point's distance behind the axle; reference_generator and sow_field take the URDF's tool_link offset "
+             "(0.45 m) "
+             "when it is not set"),
   });
   return table;
 }

@@ -100,24 +100,41 @@ std::string loadObstacles(ParamReader& p, const std::string& key, std::vector<co
   });
 }
 
+namespace {
+/// The URDF in robot_description, searched upwards from p's namespace.
+std::string robotDescription(ParamReader& p, std::string& xml) {
+  p.allow("robot_description");
+  std::string key;
+  if (!p.handle().searchParam("robot_description", key) || !p.handle().getParam(key, xml))
+    return "parameter robot_description (the URDF) is not set";
+  return "";
+}
+}  // namespace
+
+std::string loadToolRunOut(ParamReader& p, const ros::NodeHandle& nh, double& run_out) {
+  std::string xml;
+  std::string error = robotDescription(p, xml);
+  // The seed drill's tool point: seed_drill/tool_link, where sim.launch loads config/seed_drill.yaml, as plant_sim
+  // reads it.
+  std::string tool_link = "tool_link";
+  nh.param<std::string>("seed_drill/tool_link", tool_link, tool_link);
+  if (error.empty()) error = toolRunOutFromUrdf(xml, tool_link, run_out);
+  return error;
+}
+
 std::string loadFieldPlan(ParamReader& p, const ros::NodeHandle& nh, const core::Pose2D& start,
                           core::FieldParams& field, std::vector<core::Obstacle>& obstacles) {
   loadTable(p, core::fieldTable(), field);
   std::string error = loadObstacles(p, "obstacles", obstacles);
   // The plan keeps the body clear, not the axle point: the obstacles are inflated by the footprint's
   // circumscribed radius, from the URDF's collision geometry (the one source of the robot's shape).
-  p.allow("robot_description");
-  std::string key, xml;
+  std::string xml;
   core::Footprint footprint;
-  if (error.empty() && (!p.handle().searchParam("robot_description", key) || !p.handle().getParam(key, xml)))
-    error = "parameter robot_description (the URDF) is not set";
+  if (error.empty()) error = robotDescription(p, xml);
   if (error.empty()) error = footprintFromUrdf(xml, footprint);
   field.avoidance.footprint_radius = footprint.circumscribedRadius();
-  // The last row is driven until the seed drill's tool point (seed_drill/tool_link, where sim.launch loads
-  // config/seed_drill.yaml, as plant_sim reads it) reaches its end, so the row is sown to it.
-  std::string tool_link = "tool_link";
-  nh.param<std::string>("seed_drill/tool_link", tool_link, tool_link);
-  if (error.empty()) error = toolRunOutFromUrdf(xml, tool_link, field.run_out);
+  // The rows are driven on until the seed drill's tool point reaches their ends, so each row is sown to its end.
+  if (error.empty()) error = loadToolRunOut(p, nh, field.run_out);
   // The reference starts where the robot does (run/start) and joins the first row on a bounded approach.
   field.start_pose = start;
   if (error.empty() && p.error().empty()) error = field.validate();

@@ -81,6 +81,10 @@ std::string readMembers(XmlRpc::XmlRpcValue& map, const std::string& name, const
 /// Returns "" or one line naming the bad entry (absent key: empty list).
 std::string loadObstacles(ParamReader& p, const std::string& key, std::vector<core::Obstacle>& out);
 
+/// How far the seed drill's tool point (`seed_drill/tool_link`, relative to nh) trails base_link in the URDF of
+/// robot_description (searched upwards from p's namespace) [m]: the run-out a field's rows are driven on by.
+std::string loadToolRunOut(ParamReader& p, const ros::NodeHandle& nh, double& run_out);
+
 /// What reference_generator plans a field from with type field, read as it reads it (and the lockstep tester, to
 /// plan the same field in-process): field/... and potential/... (fieldTable()) and the obstacles list from p (the
 /// node's namespace); the footprint's circumscribed radius (avoidance/footprint_radius: the obstacles are inflated
