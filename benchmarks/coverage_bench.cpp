@@ -145,13 +145,7 @@ int main(int argc, char** argv) {
     else
       runs = std::max(1, std::atoi(argv[i]));
   }
-  CoverageParams p;
-  p.rows_per_pass = 1;
-  p.row_spacing = 1.0;
-  p.headland_passes = 2;
-  p.min_turn_radius = 0.5;
-  p.max_curvature_rate = 10.0;
-  p.heading = "auto";
+  CoverageParams p;  // the table's defaults: config/field.yaml's drill and turns, heading auto
   p.run_out = 0.45;  // the URDF's tool_link: 0.45 m behind the axle
   try {
     const FieldBoundary l_field =

@@ -40,13 +40,7 @@ int main(int argc, char** argv) {
   if (counts.empty()) counts = {1, 3};
   try {
     const FieldBoundary field = sowing_robot::field_file::loadFieldBoundary(path);
-    CoverageParams cp;
-    cp.rows_per_pass = 1;
-    cp.row_spacing = 1.0;
-    cp.headland_passes = 2;
-    cp.min_turn_radius = 0.5;
-    cp.max_curvature_rate = 10.0;
-    cp.heading = "auto";
+    const CoverageParams cp;  // the table's defaults: config/field.yaml's drill and turns, heading auto
     const CoveragePlan plan = planCoverage(field, cp);
     double min_x = 1e18, min_y = 1e18;
     for (const Eigen::Vector2d& p : field.outer) {

@@ -27,16 +27,9 @@ FieldBoundary lField() {
   return f;
 }
 
-CoverageParams drill() {
-  CoverageParams p;
-  p.rows_per_pass = 1;
-  p.row_spacing = 1.0;
-  p.headland_passes = 2;
-  p.min_turn_radius = 0.5;
-  p.max_curvature_rate = 10.0;
-  p.heading = "auto";
-  return p;
-}
+/// The table's defaults: config/field.yaml's drill and turns (one row per pass, 1 m apart, two headland passes,
+/// min_turn_radius 0.5 m, rate 10 1/m^2), heading auto.
+CoverageParams drill() { return CoverageParams(); }
 
 /// Three robots side by side south of the field, 5 m apart, facing north.
 std::vector<Pose2D> starts(int n) {
