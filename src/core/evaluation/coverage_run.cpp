@@ -76,8 +76,8 @@ CoverageRunReport runCoverage(const CoveragePlan& plan, const CoverageRunSetup& 
   rep.drive_work = sums.work;
   rep.effort = sums.effort;
   const State& x = lr.run.final_state;
-  const CoveragePath route = coverageFrom(plan, setup.start, setup.coverage);
-  rep.route_end_distance = std::hypot(x[X] - route.points.back().x(), x[Y] - route.points.back().y());
+  const Eigen::Vector2d goal = reference.plan().goal();  // the route's last point, as planned before the run
+  rep.route_end_distance = std::hypot(x[X] - goal.x(), x[Y] - goal.y());
   rep.diverged = lr.run.diverged;
   rep.no_traction = lr.no_traction;
   rep.finished =
