@@ -26,19 +26,19 @@ int main(int argc, char** argv) {
   namespace cli = sowing_robot::cli;
   cli::exitOnHelp(argc, argv, kUsage);
   bool markdown = false;
-  std::vector<std::string> files;
+  std::vector<std::string> files, stray;  // stray: arguments before any option (read as a --sync without files)
   cli::po::options_description options;
-  options.add_options()("markdown", cli::po::bool_switch(&markdown))("sync", cli::po::value(&files)->multitoken());
+  options.add_options()("markdown", cli::po::bool_switch(&markdown))("sync", cli::po::value(&files)->multitoken())(
+      "stray", cli::po::value(&stray));
+  cli::Parse parse{"param_docs", options, {}, [](const std::string&) {
+                     return "--sync needs FILE.yaml... (see param_docs --help)";
+                   }};
+  parse.positional.add("stray", -1);
   cli::po::variables_map vm;
-  std::string error =
-      cli::parseOptions(argc, argv,
-                        {"param_docs",
-                         options,
-                         {},
-                         [](const std::string&) { return "--sync needs FILE.yaml... (see param_docs --help)"; }},
-                        vm);
+  std::string error = cli::parseOptions(argc, argv, parse, vm);
   if (error.empty() && !markdown && files.empty())
-    error = "--markdown or --sync FILE.yaml... is needed (see param_docs --help)";
+    error = stray.empty() ? "--markdown or --sync FILE.yaml... is needed (see param_docs --help)"
+                          : "--sync needs FILE.yaml... (see param_docs --help)";
   if (!error.empty()) {
     std::fprintf(stderr, "param_docs: %s\n", error.c_str());
     return cli::kUsageExit;
