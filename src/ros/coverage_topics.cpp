@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "sowing_robot/ros/common/markers.h"
 #include "sowing_robot/ros/common/msg_checks.h"
 
 namespace sowing_robot {
@@ -25,19 +26,8 @@ constexpr Style kHeadland{1.0f, 0.6f, 0.1f, 0.9f, 0.15, 0.03};
 constexpr Style kSwath{0.3f, 0.8f, 0.3f, 0.7f, 0.12, 0.03};
 
 Marker lineMarker(const std::string& frame, const std::string& ns, int id, int type, const Style& s) {
-  Marker m;
-  m.header.frame_id = frame;  // stamp 0: rviz uses the latest transform (the frame is world-fixed)
-  m.ns = ns;
-  m.id = id;
-  m.type = type;
-  m.action = Marker::ADD;
-  m.pose.orientation.w = 1.0;
+  Marker m = rvizMarker(frame, ns, id, {type, s.r, s.g, s.b, s.a, s.width});
   m.pose.position.z = s.z;
-  m.scale.x = s.width;
-  m.color.r = s.r;
-  m.color.g = s.g;
-  m.color.b = s.b;
-  m.color.a = s.a;
   return m;
 }
 
@@ -59,10 +49,7 @@ Marker ringMarker(const core::Ring& ring, const std::string& frame, const std::s
 /// A DELETEALL first, so a re-published plan replaces the old one whole in rviz.
 MarkerArray cleared(const std::string& frame) {
   MarkerArray out;
-  Marker clear;
-  clear.header.frame_id = frame;
-  clear.action = Marker::DELETEALL;
-  out.markers.push_back(clear);
+  out.markers.push_back(deleteAllMarker(frame));
   return out;
 }
 

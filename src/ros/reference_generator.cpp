@@ -12,6 +12,7 @@
 #include "sowing_robot/core/planning/seeding.h"
 #include "sowing_robot/field_file/field_file.h"
 #include "sowing_robot/ros/common/component_params.h"
+#include "sowing_robot/ros/common/markers.h"
 #include "sowing_robot/ros/common/msg_checks.h"
 #include "sowing_robot/ros/common/node_failure.h"
 #include "sowing_robot/ros/common/reconfigure_bridge.h"
@@ -335,44 +336,25 @@ void ReferenceGenerator::publishPlan() {
 void ReferenceGenerator::publishMarkers() {
   using visualization_msgs::Marker;
   visualization_msgs::MarkerArray out;
-  Marker clear;
-  clear.header.frame_id = odom_frame_;
-  clear.action = Marker::DELETEALL;
-  out.markers.push_back(clear);
-  auto marker = [this](const std::string& ns, int id, int type, float r, float g, float b, float a) {
-    Marker m;
-    m.header.frame_id = odom_frame_;  // stamp 0: rviz uses the latest transform
-    m.ns = ns;
-    m.id = id;
-    m.type = type;
-    m.action = Marker::ADD;
-    m.pose.orientation.w = 1.0;
-    m.color.r = r;
-    m.color.g = g;
-    m.color.b = b;
-    m.color.a = a;
-    return m;
-  };
+  out.markers.push_back(deleteAllMarker(odom_frame_));
   const double d = field_->params().potential.influence_distance;
   for (std::size_t i = 0; i < obstacles_.size(); ++i) {
     const core::Obstacle& o = obstacles_[i];
-    Marker body = marker("obstacles", static_cast<int>(i), Marker::CYLINDER, 0.55f, 0.35f, 0.17f, 1.0f);
+    const double body_d = 2.0 * o.radius, zone_d = 2.0 * (o.radius + d);
+    Marker body = rvizMarker(odom_frame_, "obstacles", static_cast<int>(i),
+                             {Marker::CYLINDER, 0.55f, 0.35f, 0.17f, 1.0f, body_d, body_d, 0.5});
     body.pose.position.x = o.x;
     body.pose.position.y = o.y;
     body.pose.position.z = 0.25;
-    body.scale.x = body.scale.y = 2.0 * o.radius;
-    body.scale.z = 0.5;
     out.markers.push_back(body);
-    Marker zone = marker("influence_zones", static_cast<int>(i), Marker::CYLINDER, 1.0f, 0.6f, 0.0f, 0.25f);
+    Marker zone = rvizMarker(odom_frame_, "influence_zones", static_cast<int>(i),
+                             {Marker::CYLINDER, 1.0f, 0.6f, 0.0f, 0.25f, zone_d, zone_d, 0.02});
     zone.pose.position.x = o.x;
     zone.pose.position.y = o.y;
     zone.pose.position.z = 0.01;
-    zone.scale.x = zone.scale.y = 2.0 * (o.radius + d);
-    zone.scale.z = 0.02;
     if (potential_) out.markers.push_back(zone);  // the path follower has no repulsion: no zone to show
   }
-  Marker rows = marker("rows", 0, Marker::LINE_LIST, 0.1f, 0.8f, 0.1f, 1.0f);
-  rows.scale.x = 0.03;
+  Marker rows = rvizMarker(odom_frame_, "rows", 0, {Marker::LINE_LIST, 0.1f, 0.8f, 0.1f, 1.0f, 0.03});
   for (const core::RowSegment& r : core::rowsOf(field_->params())) {
     geometry_msgs::Point pa, pb;
     pa.x = r.a.x();

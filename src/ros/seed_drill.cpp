@@ -8,6 +8,7 @@
 
 #include "sowing_robot/core/simulation/lockstep.h"
 #include "sowing_robot/ros/common/component_params.h"
+#include "sowing_robot/ros/common/markers.h"
 #include "sowing_robot/ros/common/msg_checks.h"
 #include "sowing_robot/ros/common/seed_message.h"
 #include "sowing_robot/ros/common/urdf_params.h"
@@ -37,16 +38,9 @@ SeedDrillNode::SeedDrillNode(ros::NodeHandle nh, ros::NodeHandle pnh) {
   logSettings("seed_drill", core::SeedDrillSettings::table(), settings_);
   ROS_INFO("seed_drill: tool point (%.3f, %.3f) m in base_link; waiting for the plan", tool_x_, tool_y_);
 
-  chunk_.header.frame_id = run.odom_frame;
-  chunk_.ns = "seeds";
-  chunk_.type = visualization_msgs::Marker::SPHERE_LIST;
-  chunk_.action = visualization_msgs::Marker::ADD;
-  chunk_.pose.orientation.w = 1.0;
-  chunk_.scale.x = chunk_.scale.y = chunk_.scale.z = settings_.marker_size;
-  chunk_.color.r = 0.95f;
-  chunk_.color.g = 0.85f;
-  chunk_.color.b = 0.3f;
-  chunk_.color.a = 1.0f;
+  const double size = settings_.marker_size;
+  chunk_ = rvizMarker(run.odom_frame, "seeds", 0,
+                      {visualization_msgs::Marker::SPHERE_LIST, 0.95f, 0.85f, 0.3f, 1.0f, size, size, size});
   seeds_pub_ = nh.advertise<visualization_msgs::MarkerArray>("seeds", kLockstepQueue);
   record_pub_ = nh.advertise<Seed>("seeds/record", kLockstepQueue);
   odom_frame_ = run.odom_frame;

@@ -14,6 +14,8 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "sowing_robot/cli/options.h"
+
 namespace sowing_robot {
 namespace seed_map {
 
@@ -189,29 +191,31 @@ std::string writeGeoJson(const std::string& path, const std::vector<core::Seed>&
 }
 
 std::string parseArguments(const std::vector<std::string>& args, Options& options) {
+  namespace po = cli::po;
   Options o;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    if (a == "--csv" || a == "--geojson" || a == "--origin" || a == "--topic") {
-      if (i + 1 >= args.size() || args[i + 1].empty()) return a + " needs a value (see seed_map --help)";
-      const std::string& v = args[++i];
-      if (a == "--csv") o.csv = v;
-      if (a == "--geojson") o.geojson = v;
-      if (a == "--topic") o.topic = v;
-      if (a == "--origin") {
-        GeoOrigin origin;
-        const std::string error = parseOrigin(v, origin);
-        if (!error.empty()) return error;
-        o.origin = origin;
-      }
-    } else if (a.size() > 1 && a[0] == '-') {
-      return "unknown option '" + a + "' (see seed_map --help)";
-    } else if (!o.bag.empty()) {
-      return "one bag at a time (got " + o.bag + " and " + a + ")";
-    } else {
-      o.bag = a;
-    }
+  std::string origin_text;
+  std::vector<std::string> bags;
+  po::options_description declared;
+  declared.add_options()("csv", po::value(&o.csv))("geojson", po::value(&o.geojson))("origin", po::value(&origin_text))(
+      "topic", po::value(&o.topic))("bag", po::value(&bags));
+  cli::Parse parse{"seed_map", declared};
+  parse.positional.add("bag", -1);
+  std::vector<const char*> argv{"seed_map"};
+  for (const std::string& a : args) argv.push_back(a.c_str());
+  po::variables_map vm;
+  const std::string error = cli::parseOptions(static_cast<int>(argv.size()), argv.data(), parse, vm);
+  if (!error.empty()) return error;
+  for (const char* key : {"csv", "geojson", "origin", "topic"})
+    if (vm.count(key) && vm[key].as<std::string>().empty())
+      return "--" + std::string(key) + " needs a value (see seed_map --help)";
+  if (vm.count("origin")) {
+    GeoOrigin origin;
+    const std::string e = parseOrigin(origin_text, origin);
+    if (!e.empty()) return e;
+    o.origin = origin;
   }
+  if (bags.size() > 1) return "one bag at a time (got " + bags[0] + " and " + bags[1] + ")";
+  if (!bags.empty()) o.bag = bags[0];
   if (o.bag.empty()) return "no bag given (see seed_map --help)";
   if (o.csv.empty() && o.geojson.empty()) return "nothing to write: give --csv FILE and/or --geojson FILE";
   if (!o.geojson.empty() && !o.origin)

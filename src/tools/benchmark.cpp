@@ -32,6 +32,7 @@
 #include <string>
 #include <vector>
 
+#include "sowing_robot/cli/options.h"
 #include "sowing_robot/cli/usage.h"
 #include "sowing_robot/core/evaluation/benchmark.h"
 #include "sowing_robot/core/evaluation/estimated_bench.h"
@@ -197,40 +198,31 @@ struct Options {
 
 /// Reads and checks the options; false (with `exit_code` and the error line printed) on a bad request.
 bool parseOptions(int argc, char** argv, Options& o, int& exit_code) {
-  static const std::vector<std::string> kOptions{"--controllers",  "--scenarios", "--output",
-                                                 "--scenario-dir", "--tuned-dir", "--seeds",
-                                                 "--threads",      "--base-seed", "--profile"};
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (std::find(kOptions.begin(), kOptions.end(), a) == kOptions.end()) {
-      exit_code = sowing_robot::cli::unknownOption("benchmark", a);
+  namespace cli = sowing_robot::cli;
+  std::string controllers, scenarios;
+  cli::po::options_description options;
+  options.add_options()("controllers", cli::po::value(&controllers))("scenarios", cli::po::value(&scenarios))(
+      "output", cli::po::value(&o.output))("scenario-dir", cli::po::value(&o.scenario_dir))(
+      "tuned-dir", cli::po::value(&o.tuned_dir))("seeds", cli::po::value<std::string>())(
+      "threads", cli::po::value<std::string>())("base-seed", cli::po::value<std::string>())("profile",
+                                                                                            cli::po::value(&o.profile));
+  cli::po::variables_map vm;
+  const std::string parse_error = cli::parseOptions(
+      argc, argv, {"benchmark", options, {}, [](const std::string& a) { return "missing value after " + a; }}, vm);
+  if (!parse_error.empty()) {
+    exit_code = fail(parse_error);
+    return false;
+  }
+  if (vm.count("controllers")) o.controllers = splitComma(controllers);
+  if (vm.count("scenarios")) o.scenario_names = splitComma(scenarios);
+  o.tuned_dir_given = vm.count("tuned-dir") > 0;
+  for (const auto& [key, n] :
+       {std::pair<const char*, long long*>{"seeds", &o.seeds}, {"threads", &o.threads}, {"base-seed", &o.base_seed}}) {
+    if (!vm.count(key)) continue;
+    const std::string& v = vm[key].as<std::string>();
+    if (!parseInteger(v.c_str(), *n)) {
+      exit_code = fail("--" + std::string(key) + " needs an integer, not '" + v + "'");
       return false;
-    }
-    if (i + 1 >= argc) {
-      exit_code = fail("missing value after " + a);
-      return false;
-    }
-    const char* v = argv[++i];
-    if (a == "--controllers") {
-      o.controllers = splitComma(v);
-    } else if (a == "--scenarios") {
-      o.scenario_names = splitComma(v);
-    } else if (a == "--output") {
-      o.output = v;
-    } else if (a == "--scenario-dir") {
-      o.scenario_dir = v;
-    } else if (a == "--tuned-dir") {
-      o.tuned_dir = v;
-      o.tuned_dir_given = true;
-    } else if (a == "--profile") {
-      o.profile = v;
-    } else {  // --seeds, --threads or --base-seed: kOptions has no other
-      long long n;
-      if (!parseInteger(v, n)) {
-        exit_code = fail(a + " needs an integer, not '" + v + "'");
-        return false;
-      }
-      (a == "--seeds" ? o.seeds : a == "--threads" ? o.threads : o.base_seed) = n;
     }
   }
   std::string error;

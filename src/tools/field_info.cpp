@@ -7,7 +7,9 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
+#include "sowing_robot/cli/options.h"
 #include "sowing_robot/cli/usage.h"
 #include "sowing_robot/core/common/polygon.h"
 #include "sowing_robot/field_file/field_file.h"
@@ -31,41 +33,27 @@ int main(int argc, char** argv) {
   namespace ff = sowing_robot::field_file;
   namespace cli = sowing_robot::cli;
   cli::exitOnHelp(argc, argv, kUsage);
-  std::string path;
+  std::vector<std::string> files;
+  std::string origin_text;
+  cli::po::options_description options;
+  options.add_options()("origin", cli::po::value(&origin_text))("file", cli::po::value(&files));
+  cli::Parse parse{"field_info", options, {}, [](const std::string&) { return "--origin needs LAT,LON[,ALT]"; }};
+  parse.positional.add("file", -1);
+  cli::po::variables_map vm;
+  std::string error = cli::parseOptions(argc, argv, parse, vm);
   std::optional<ff::GeoOrigin> origin;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--origin" || a.rfind("--origin=", 0) == 0) {
-      std::string value;
-      if (a == "--origin") {
-        if (i + 1 >= argc) {
-          std::fprintf(stderr, "field_info: --origin needs LAT,LON[,ALT]\n");
-          return cli::kUsageExit;
-        }
-        value = argv[++i];
-      } else {
-        value = a.substr(9);
-      }
-      ff::GeoOrigin o;
-      const std::string e = sowing_robot::seed_map::parseOrigin(value, o);
-      if (!e.empty()) {
-        std::fprintf(stderr, "field_info: %s\n", e.c_str());
-        return cli::kUsageExit;
-      }
-      origin = o;
-    } else if (a.size() > 1 && a[0] == '-') {
-      return cli::unknownOption("field_info", a);
-    } else if (!path.empty()) {
-      std::fprintf(stderr, "field_info: one file at a time (got %s and %s)\n", path.c_str(), a.c_str());
-      return cli::kUsageExit;
-    } else {
-      path = a;
-    }
+  if (error.empty() && vm.count("origin")) {
+    ff::GeoOrigin o;
+    error = sowing_robot::seed_map::parseOrigin(origin_text, o);
+    origin = o;
   }
-  if (path.empty()) {
-    std::fprintf(stderr, "field_info: no field file given (see field_info --help)\n");
+  if (error.empty() && files.size() > 1) error = "one file at a time (got " + files[0] + " and " + files[1] + ")";
+  if (error.empty() && files.empty()) error = "no field file given (see field_info --help)";
+  if (!error.empty()) {
+    std::fprintf(stderr, "field_info: %s\n", error.c_str());
     return cli::kUsageExit;
   }
+  const std::string& path = files.front();
   ff::FieldFile f;
   try {
     f = ff::readFieldFile(path, origin);

@@ -1,12 +1,12 @@
 // param_docs: what follows from the parameter tables, written out. Usage: kUsage below (--help).
 #include <cstdio>
-#include <cstring>
 #include <fstream>
 #include <iostream>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "sowing_robot/cli/options.h"
 #include "sowing_robot/cli/usage.h"
 #include "sowing_robot/core/settings/param_catalog.h"
 
@@ -23,35 +23,47 @@ const char* const kUsage =
 
 int main(int argc, char** argv) {
   using namespace sowing_robot::core;
-  sowing_robot::cli::exitOnHelp(argc, argv, kUsage);
-  if (argc >= 2 && std::strcmp(argv[1], "--markdown") == 0) {
+  namespace cli = sowing_robot::cli;
+  cli::exitOnHelp(argc, argv, kUsage);
+  bool markdown = false;
+  std::vector<std::string> files, stray;  // stray: arguments before any option (read as a --sync without files)
+  cli::po::options_description options;
+  options.add_options()("markdown", cli::po::bool_switch(&markdown))("sync", cli::po::value(&files)->multitoken())(
+      "stray", cli::po::value(&stray));
+  cli::Parse parse{"param_docs", options, {}, [](const std::string&) {
+                     return "--sync needs FILE.yaml... (see param_docs --help)";
+                   }};
+  parse.positional.add("stray", -1);
+  cli::po::variables_map vm;
+  std::string error = cli::parseOptions(argc, argv, parse, vm);
+  if (error.empty() && !markdown && files.empty())
+    error = stray.empty() ? "--markdown or --sync FILE.yaml... is needed (see param_docs --help)"
+                          : "--sync needs FILE.yaml... (see param_docs --help)";
+  if (!error.empty()) {
+    std::fprintf(stderr, "param_docs: %s\n", error.c_str());
+    return cli::kUsageExit;
+  }
+  if (markdown) {
     std::cout << parametersMarkdown();
     return 0;
   }
-  if (argc >= 3 && std::strcmp(argv[1], "--sync") == 0) {
-    int rc = 0;
-    for (int i = 2; i < argc; ++i) {
-      std::ifstream in(argv[i]);
-      if (!in) {
-        std::fprintf(stderr, "param_docs: cannot read %s\n", argv[i]);
-        return 2;
-      }
-      std::stringstream text;
-      text << in.rdbuf();
-      std::vector<std::string> problems;
-      const std::string synced = syncYamlComments(text.str(), argv[i], problems);
-      for (const auto& p : problems) std::fprintf(stderr, "param_docs: %s\n", p.c_str());
-      if (!problems.empty()) rc = 1;
-      if (synced != text.str()) {
-        std::ofstream(argv[i]) << synced;
-        std::printf("param_docs: rewrote %s\n", argv[i]);
-      }
+  int rc = 0;
+  for (const std::string& file : files) {
+    std::ifstream in(file);
+    if (!in) {
+      std::fprintf(stderr, "param_docs: cannot read %s\n", file.c_str());
+      return 2;
     }
-    return rc;
+    std::stringstream text;
+    text << in.rdbuf();
+    std::vector<std::string> problems;
+    const std::string synced = syncYamlComments(text.str(), file, problems);
+    for (const auto& p : problems) std::fprintf(stderr, "param_docs: %s\n", p.c_str());
+    if (!problems.empty()) rc = 1;
+    if (synced != text.str()) {
+      std::ofstream(file) << synced;
+      std::printf("param_docs: rewrote %s\n", file.c_str());
+    }
   }
-  if (argc >= 2 && argv[1][0] == '-' && std::strcmp(argv[1], "--sync") != 0)
-    return sowing_robot::cli::unknownOption("param_docs", argv[1]);
-  std::fprintf(stderr, "param_docs: %s (see param_docs --help)\n",
-               argc < 2 ? "--markdown or --sync FILE.yaml... is needed" : "--sync needs FILE.yaml...");
-  return 2;
+  return rc;
 }

@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "sowing_robot/cli/options.h"
 #include "sowing_robot/cli/usage.h"
 #include "sowing_robot/core/common/validation.h"
 #include "sowing_robot/core/simulation/field_run.h"
@@ -66,80 +67,69 @@ struct Options {
   TractionParams traction;  // enabled by --traction
 };
 
-/// An option's value is missing: what was expected ("--start Y").
-struct MissingValue {
-  std::string what;
-};
-
 /// Reads the options into `o`; false, with the error line printed and `exit_code` set, on a bad one.
 bool parseOptions(int argc, char** argv, Options& o, int& exit_code) {
-  try {
-    for (int i = 1; i < argc; ++i) {
-      const std::string a = argv[i];
-      auto value = [&](const char* what) {
-        if (i + 1 >= argc) throw MissingValue{what};
-        return std::strtod(argv[++i], nullptr);
-      };
-      if (a == "--field")
-        o.field = true;
-      else if (a == "--potential-only")
-        o.potential_only = true;
-      else if (a == "--no-approach")
-        o.approach = false;
-      else if (a == "--path-follower")
-        o.path_follower = true;
-      else if (a == "--start") {
-        o.start.x = value("--start X");
-        o.start.y = value("--start Y");
-        o.start.theta = value("--start THETA");
-      } else if (a == "--tsmc")
-        o.modes.push_back(false);
-      else if (a == "--atsmc")
-        o.modes.push_back(true);
-      else if (a == "--disturbance")
-        o.sc.disturbance.sinusoidal = true;
-      else if (a == "--mismatch")
-        o.sc.disturbance.mass_scale = o.sc.disturbance.inertia_scale = value("--mismatch");
-      else if (a == "--noise")
-        o.sc.disturbance.noise_std = value("--noise");
-      else if (a == "--duration")
-        o.sc.duration = value("--duration");
-      else if (a == "--rate")
-        o.sc.control_period_ns = static_cast<std::int64_t>(1e9 / value("--rate") + 0.5);
-      else if (a == "--width")
-        o.sc.sliding.switching.width = value("--width");
-      else if (a == "--repeat")
-        o.repeat = static_cast<int>(value("--repeat"));
-      else if (a == "--traction") {
-        o.traction.enabled = true;
-        o.traction.mu_peak = value("--traction");
-        o.traction.mu_slide = 0.75 * o.traction.mu_peak;
-      } else if (a == "--wet")
-        o.wet = true;
-      else if (a == "--draft")
-        o.traction.draft_force = value("--draft");
-      else if (a == "--slip-stiffness")
-        o.traction.slip_stiffness = value("--slip-stiffness");
-      else if (a == "--rolling-resistance")
-        o.traction.rolling_resistance = value("--rolling-resistance");
-      else if (a == "--yaml" && i + 1 < argc)
-        o.yaml = argv[++i];
-      else if (a == "--switching" && i + 1 < argc) {
-        if (!SwitchFunction::parse(argv[++i], o.sc.sliding.switching.type)) {
-          std::fprintf(stderr, "run_scenario: unknown switching '%s'\n", argv[i]);
-          exit_code = 2;
-          return false;
-        }
-      } else {
-        exit_code = sowing_robot::cli::unknownOption("run_scenario", a);
-        return false;
-      }
-    }
-  } catch (const MissingValue& missing) {
-    std::fprintf(stderr, "run_scenario: %s needs a value\n", missing.what.c_str());
-    exit_code = 2;
+  namespace cli = sowing_robot::cli;
+  namespace po = cli::po;
+  auto flag = [] { return po::value<std::vector<std::string>>()->zero_tokens()->composing(); };
+  auto number = [] { return po::value<std::string>(); };
+  po::options_description options;
+  options.add_options()("field", flag())("potential-only", flag())("no-approach", flag())("path-follower", flag())(
+      "tsmc", flag())("atsmc", flag())("disturbance", flag())("wet", flag())(
+      "start", po::value<std::vector<std::string>>()->multitoken())("mismatch", number())("noise", number())(
+      "duration", number())("rate", number())("width", number())("repeat", number())("traction", number())(
+      "draft", number())("slip-stiffness", number())("rolling-resistance", number())("yaml", po::value(&o.yaml))(
+      "switching", po::value<std::string>());
+  cli::Parse parse{"run_scenario", options, {}, [](const std::string& a) {
+                     return (a == "--start" ? a + " X" : a) + " needs a value";
+                   }};
+  parse.fixed_arity = {{"start", 3}};
+  po::variables_map vm;
+  std::vector<std::string> order;
+  std::string error = cli::parseOptions(argc, argv, parse, vm, &order);
+  if (error.empty() && vm.count("start")) {
+    const auto& xyt = vm["start"].as<std::vector<std::string>>();
+    if (xyt.size() < 3) error = std::string(xyt.size() == 1 ? "--start Y" : "--start THETA") + " needs a value";
+    if (xyt.size() > 3) error = "unknown option '" + xyt[3] + "' (see run_scenario --help)";
+    if (error.empty())
+      o.start = {std::strtod(xyt[0].c_str(), nullptr), std::strtod(xyt[1].c_str(), nullptr),
+                 std::strtod(xyt[2].c_str(), nullptr)};
+  }
+  if (error.empty() && vm.count("switching") &&
+      !SwitchFunction::parse(vm["switching"].as<std::string>().c_str(), o.sc.sliding.switching.type))
+    error = "unknown switching '" + vm["switching"].as<std::string>() + "'";
+  if (!error.empty()) {
+    std::fprintf(stderr, "run_scenario: %s\n", error.c_str());
+    exit_code = cli::kUsageExit;
     return false;
   }
+  for (const std::string& key : order) {  // the modes in the order given
+    if (key == "tsmc" || key == "atsmc") o.modes.push_back(key == "atsmc");
+  }
+  o.field = vm.count("field") > 0;
+  o.potential_only = vm.count("potential-only") > 0;
+  o.approach = vm.count("no-approach") == 0;
+  o.path_follower = vm.count("path-follower") > 0;
+  o.wet = vm.count("wet") > 0;
+  if (vm.count("disturbance")) o.sc.disturbance.sinusoidal = true;
+  // The numbers as strtod reads them (no check: the scenario's validate() and the traction's say what is wrong).
+  auto value = [&vm](const char* key, auto set) {
+    if (vm.count(key)) set(std::strtod(vm[key].as<std::string>().c_str(), nullptr));
+  };
+  value("mismatch", [&](double v) { o.sc.disturbance.mass_scale = o.sc.disturbance.inertia_scale = v; });
+  value("noise", [&](double v) { o.sc.disturbance.noise_std = v; });
+  value("duration", [&](double v) { o.sc.duration = v; });
+  value("rate", [&](double v) { o.sc.control_period_ns = static_cast<std::int64_t>(1e9 / v + 0.5); });
+  value("width", [&](double v) { o.sc.sliding.switching.width = v; });
+  value("repeat", [&](double v) { o.repeat = static_cast<int>(v); });
+  value("traction", [&](double v) {
+    o.traction.enabled = true;
+    o.traction.mu_peak = v;
+    o.traction.mu_slide = 0.75 * v;
+  });
+  value("draft", [&](double v) { o.traction.draft_force = v; });
+  value("slip-stiffness", [&](double v) { o.traction.slip_stiffness = v; });
+  value("rolling-resistance", [&](double v) { o.traction.rolling_resistance = v; });
   return true;
 }
 

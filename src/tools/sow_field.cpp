@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "sowing_robot/cli/options.h"
 #include "sowing_robot/cli/usage.h"
 #include "sowing_robot/core/evaluation/coverage_run.h"
 #include "sowing_robot/core/planning/coverage_metrics.h"
@@ -64,30 +65,26 @@ std::string parsePose(const std::string& text, core::Pose2D& pose) {
 
 /// The command's arguments into `o`; "" or the one line why not.
 std::string parseArguments(int argc, char** argv, Options& o) {
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    const bool known = a == "--field" || a == "--profile" || a == "--outer" || a == "--inner" || a == "--start" ||
-                       a == "--origin" || a == "--seed-map";
-    if (!known) return "unknown option '" + a + "' (see sow_field --help)";
-    if (i + 1 >= argc) return a + " needs a value (see sow_field --help)";
-    const std::string v = argv[++i];
-    if (a == "--field") o.field = v;
-    if (a == "--profile") o.profile = v;
-    if (a == "--outer") o.outer = v;
-    if (a == "--inner") o.inner = v;
-    if (a == "--seed-map") o.seed_map = v;
-    if (a == "--start") {
-      core::Pose2D p;
-      const std::string e = parsePose(v, p);
-      if (!e.empty()) return e;
-      o.start = p;
-    }
-    if (a == "--origin") {
-      ff::GeoOrigin g;
-      const std::string e = sm::parseOrigin(v, g);
-      if (!e.empty()) return e;
-      o.origin = g;
-    }
+  namespace cli = sowing_robot::cli;
+  std::string start, origin;
+  cli::po::options_description options;
+  options.add_options()("field", cli::po::value(&o.field))("profile", cli::po::value(&o.profile))(
+      "outer", cli::po::value(&o.outer))("inner", cli::po::value(&o.inner))("start", cli::po::value(&start))(
+      "origin", cli::po::value(&origin))("seed-map", cli::po::value(&o.seed_map));
+  cli::po::variables_map vm;
+  const std::string error = cli::parseOptions(argc, argv, {"sow_field", options}, vm);
+  if (!error.empty()) return error;
+  if (vm.count("start")) {
+    core::Pose2D p;
+    const std::string e = parsePose(start, p);
+    if (!e.empty()) return e;
+    o.start = p;
+  }
+  if (vm.count("origin")) {
+    ff::GeoOrigin g;
+    const std::string e = sm::parseOrigin(origin, g);
+    if (!e.empty()) return e;
+    o.origin = g;
   }
   if (o.field.empty()) return "no field file given (--field FILE; see sow_field --help)";
   const bool csv = o.seed_map.size() > 4 && o.seed_map.compare(o.seed_map.size() - 4, 4, ".csv") == 0;

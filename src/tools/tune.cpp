@@ -33,6 +33,7 @@
 #include <string>
 #include <vector>
 
+#include "sowing_robot/cli/options.h"
 #include "sowing_robot/cli/usage.h"
 #include "sowing_robot/core/evaluation/checkpoint.h"
 #include "sowing_robot/core/evaluation/tuning.h"
@@ -87,28 +88,28 @@ struct Args {
 
 /// "" or one line.
 std::string parseArgs(int argc, char** argv, Args& a) {
-  for (int i = 1; i < argc; ++i) {
-    const std::string k = argv[i];
-    if (k == "--resume") {
-      a.resume = true;
-      continue;
-    }
-    if (k != "--config" && k != "--controller" && k != "--output" && k != "--checkpoint" && k != "--progress" &&
-        k != "--threads" && k != "--stop-after")
-      return "unknown option '" + k + "' (see tune --help)";
-    if (i + 1 >= argc) return "missing value after " + k;
-    const std::string v = argv[++i];
-    if (k == "--config") a.config = v;
-    if (k == "--controller") a.controller = v;
-    if (k == "--output") a.output = v;
-    if (k == "--checkpoint") a.checkpoint = v;
-    if (k == "--progress") a.progress = v;
-    if (k == "--threads" || k == "--stop-after") {
-      long long n;
-      if (!parseInt(v, n) || n < 0) return k + " needs an integer >= 0, not '" + v + "'";
-      (k == "--threads" ? a.threads : a.stop_after) = n;
-    }
-  }
+  namespace cli = sowing_robot::cli;
+  std::string threads, stop_after;
+  cli::po::options_description options;
+  options.add_options()("config", cli::po::value(&a.config))("controller", cli::po::value(&a.controller))(
+      "output", cli::po::value(&a.output))("checkpoint", cli::po::value(&a.checkpoint))(
+      "progress", cli::po::value(&a.progress))("threads", cli::po::value(&threads))(
+      "stop-after", cli::po::value(&stop_after))("resume", cli::po::bool_switch(&a.resume));
+  cli::po::variables_map vm;
+  const std::string error = cli::parseOptions(
+      argc, argv, {"tune", options, {}, [](const std::string& k) { return "missing value after " + k; }}, vm);
+  if (!error.empty()) return error;
+  // --threads N, --stop-after K: an integer >= 0 when given.
+  auto count = [&vm](const std::string& key, const std::string& v, long long& n) -> std::string {
+    if (!vm.count(key)) return "";
+    long long value;
+    if (!parseInt(v, value) || value < 0) return "--" + key + " needs an integer >= 0, not '" + v + "'";
+    n = value;
+    return "";
+  };
+  std::string e = count("threads", threads, a.threads);
+  if (e.empty()) e = count("stop-after", stop_after, a.stop_after);
+  if (!e.empty()) return e;
   if (a.config.empty()) return "--config FILE is required (see tune --help)";
   if (a.resume && a.checkpoint.empty()) return "--resume needs --checkpoint FILE";
   return "";

@@ -9,6 +9,7 @@
 #include <cstdio>
 
 #include "sowing_robot/ros/common/component_params.h"
+#include "sowing_robot/ros/common/markers.h"
 #include "sowing_robot/ros/common/msg_checks.h"
 
 namespace sowing_robot {
@@ -186,18 +187,9 @@ void TractionModel::publishSoil() {
     // Darker blue for less grip: wet soil.
     const float wet =
         static_cast<float>(1.0 - std::clamp(patch.mu_peak / std::max(cfg_.traction.mu_peak, 1e-9), 0.0, 1.0));
-    visualization_msgs::Marker outline;
-    outline.header.frame_id = cfg_.odom_frame;
-    outline.ns = "soil_outline";
-    outline.id = static_cast<int>(i);
-    outline.type = visualization_msgs::Marker::LINE_STRIP;
-    outline.action = visualization_msgs::Marker::ADD;
-    outline.pose.orientation.w = 1.0;
-    outline.scale.x = 0.05;
-    outline.color.r = 0.1f;
-    outline.color.g = 0.3f;
-    outline.color.b = 0.9f;
-    outline.color.a = 1.0f;
+    visualization_msgs::Marker outline =
+        rvizMarker(cfg_.odom_frame, "soil_outline", static_cast<int>(i),
+                   {visualization_msgs::Marker::LINE_STRIP, 0.1f, 0.3f, 0.9f, 1.0f, 0.05});
     for (std::size_t k = 0; k <= patch.polygon.size(); ++k) {
       geometry_msgs::Point pt;
       pt.x = patch.polygon[k % patch.polygon.size()].x();

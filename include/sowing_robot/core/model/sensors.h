@@ -30,6 +30,12 @@
 //
 // Every sensor has its own std::mt19937_64, seeded from SensorParams::seed and a per-sensor offset
 // (kEncoderSeedOffset, ...), so adding one sensor's draws never changes another's.
+//
+// The plant carries the sensors of PlantSensorSet (the end of this file): SensorSuite (simulation/sensor_feeds.h)
+// builds each from (SensorParams, the nominal RobotParams) or from SensorParams alone, and reads each on the true
+// state through start(state) at time 0 and read(t, state, dt) every step. A new sensor: its class here with those
+// two, its parameters in SensorParams and sensorsTable(), and its entry in PlantSensorSet; its message is one
+// registration in ros/plant_sim/sensors.cpp.
 #pragma once
 
 #include <Eigen/Core>
@@ -37,10 +43,13 @@
 #include <deque>
 #include <random>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "sowing_robot/core/common/param_table.h"
 #include "sowing_robot/core/common/types.h"
+#include "sowing_robot/core/model/plant.h"
+#include "sowing_robot/core/model/robot_params.h"
 
 namespace sowing_robot {
 namespace core {
@@ -98,6 +107,9 @@ class EncoderOdometry {
   /// R, L: the NOMINAL wheel radius and half track [m]. Throws std::invalid_argument for invalid params
   /// or R, L not finite and > 0.
   EncoderOdometry(const SensorParams& params, double R, double L);
+  /// The dead reckoning of the nominal robot (its R and L).
+  EncoderOdometry(const SensorParams& params, const RobotParams& nominal)
+      : EncoderOdometry(params, nominal.R, nominal.L) {}
 
   /// Start at `pose` with zero covariance; the wheels' true angles are phi_r, phi_l (read once, so the
   /// first increment counts from here). The generator is re-seeded.
@@ -112,6 +124,10 @@ class EncoderOdometry {
   /// Variance [m²] of one wheel-travel increment from quantisation and jitter: (R res)² (1/6 + 2 noise²).
   double incrementVariance() const { return q0_; }
   const Odometry2D& last() const { return out_; }
+
+  /// SensorSuite's reading: reset at the state's pose and wheel angles; update on its wheel angles.
+  void start(const State& s) { reset({s[X], s[Y], s[THETA]}, s[PHI_R], s[PHI_L]); }
+  void read(double, const State& s, double dt) { update(s[PHI_R], s[PHI_L], dt); }
 
  private:
   SensorParams params_;
@@ -137,10 +153,20 @@ class YawRateSensor {
   double measure(double omega_true);
   double noise() const { return params_.imu.noise; }
 
+  /// SensorSuite's reading: re-seeded and measured once at the start state (before the first period), then
+  /// once per step; last() is the latest measurement [rad/s].
+  void start(const State& s) {
+    reset();
+    last_ = measure(s[OMEGA]);
+  }
+  void read(double, const State& s, double) { last_ = measure(s[OMEGA]); }
+  double last() const { return last_; }
+
  private:
   SensorParams params_;
   std::mt19937_64 rng_;
   std::normal_distribution<double> normal_{0.0, 1.0};
+  double last_ = 0.0;
 };
 
 struct FixMeasurement {
@@ -185,6 +211,13 @@ class PositionFixSensor {
   bool inDropout(double stamp) const { return schedule_.inDropout(stamp); }
   std::size_t pending() const { return pending_.size(); }
 
+  /// SensorSuite's reading: the first sample at time 0 on the start state, then sample() every step.
+  void start(const State& s) {
+    reset(0.0);
+    sample(0.0, {s[X], s[Y], s[THETA]});
+  }
+  void read(double t, const State& s, double) { sample(t, {s[X], s[Y], s[THETA]}); }
+
  private:
   SensorParams params_;
   FixSchedule schedule_;
@@ -192,6 +225,9 @@ class PositionFixSensor {
   std::normal_distribution<double> normal_{0.0, 1.0};
   std::deque<FixMeasurement> pending_;
 };
+
+/// The sensors the plant carries, in the order SensorSuite starts and reads them.
+using PlantSensorSet = std::tuple<EncoderOdometry, YawRateSensor, PositionFixSensor>;
 
 }  // namespace core
 }  // namespace sowing_robot

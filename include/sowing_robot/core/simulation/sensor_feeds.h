@@ -4,8 +4,8 @@
 //               truth, the encoder odometry or the EKF's estimate (LoopConfig::feedback).
 // SensorSuite is the set of sensors the plant carries (model/sensors.h), read on the true state: the same
 // class plant_sim publishes from (ros/plant_sim/sensors.h), so the in-process loop and the node pipeline
-// read them in one way. A new sensor: its class in model/sensors.*, a member of SensorSuite read in
-// start() and update(), and its message in plant_sim (the ROS side's one registration).
+// read them in one way. A new sensor: its class and its entry in model/sensors.h's PlantSensorSet (the suite
+// builds, starts and reads every entry), and its message in plant_sim (the ROS side's one registration).
 #pragma once
 
 #include <algorithm>
@@ -13,6 +13,8 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <tuple>
+#include <type_traits>
 #include <vector>
 
 #include "sowing_robot/core/estimation/ekf.h"
@@ -39,42 +41,55 @@ struct StateFeed {
   void finish(LoopResult&) const {}
 };
 
-/// The sensors the plant carries, read on its true state: the wheel encoders' dead reckoning (nominal R,
-/// L), the yaw-rate gyro and the position fix (sampled, delivered after its latency).
+/// The sensors the plant carries (model/sensors.h's PlantSensorSet), read on its true state: the wheel encoders'
+/// dead reckoning (nominal R, L), the yaw-rate gyro and the position fix (sampled, delivered after its latency).
 class SensorSuite {
  public:
   SensorSuite(const SensorParams& params, const RobotParams& nominal)
-      : encoders_(params, nominal.R, nominal.L), gyro_(params), fix_(params) {}
+      : sensors_(build(params, nominal, static_cast<PlantSensorSet*>(nullptr))) {}
 
-  /// At the start state, time 0: encoders and gyro reset, the first fix sampled, the yaw rate measured once
-  /// before the first period.
+  /// At the start state, time 0: every sensor's start() (the encoders and the gyro reset, the first fix sampled,
+  /// the yaw rate measured once before the first period).
   void start(const State& s) {
-    encoders_.reset(pose(s), s[PHI_R], s[PHI_L]);
-    gyro_.reset();
-    fix_.reset(0.0);
-    fix_.sample(0.0, pose(s));
-    yaw_rate_ = gyro_.measure(s[OMEGA]);
+    std::apply([&s](auto&... sensor) { (sensor.start(s), ...); }, sensors_);
   }
   /// Every sensor on the true state s at time t, dt after the previous reading.
   void update(double t, const State& s, double dt) {
-    encoders_.update(s[PHI_R], s[PHI_L], dt);
-    yaw_rate_ = gyro_.measure(s[OMEGA]);
-    fix_.sample(t, pose(s));
+    std::apply([&](auto&... sensor) { (sensor.read(t, s, dt), ...); }, sensors_);
   }
+  /// One sensor of the set, by its class.
+  template <class Sensor>
+  Sensor& sensor() {
+    return std::get<Sensor>(sensors_);
+  }
+  template <class Sensor>
+  const Sensor& sensor() const {
+    return std::get<Sensor>(sensors_);
+  }
+
   /// The encoders' last dead-reckoning update.
-  const Odometry2D& odometry() const { return encoders_.last(); }
-  const EncoderOdometry& encoders() const { return encoders_; }
+  const Odometry2D& odometry() const { return encoders().last(); }
+  const EncoderOdometry& encoders() const { return sensor<EncoderOdometry>(); }
   /// The gyro's last reading [rad/s].
-  double yawRate() const { return yaw_rate_; }
+  double yawRate() const { return sensor<YawRateSensor>().last(); }
   /// The fixes whose latency has passed by t (each once).
-  std::vector<FixMeasurement> dueFixes(double t) { return fix_.due(t); }
+  std::vector<FixMeasurement> dueFixes(double t) { return sensor<PositionFixSensor>().due(t); }
 
  private:
-  static Pose2D pose(const State& s) { return {s[X], s[Y], s[THETA]}; }
-  EncoderOdometry encoders_;
-  YawRateSensor gyro_;
-  PositionFixSensor fix_;
-  double yaw_rate_ = 0.0;
+  /// A sensor built from the parameters and the nominal robot when it takes both, else from the parameters.
+  template <class Sensor>
+  static Sensor make(const SensorParams& params, const RobotParams& nominal) {
+    if constexpr (std::is_constructible_v<Sensor, const SensorParams&, const RobotParams&>)
+      return Sensor(params, nominal);
+    else
+      return Sensor(params);
+  }
+  template <class... Sensors>
+  static std::tuple<Sensors...> build(const SensorParams& params, const RobotParams& nominal, std::tuple<Sensors...>*) {
+    return std::tuple<Sensors...>(make<Sensors>(params, nominal)...);
+  }
+
+  PlantSensorSet sensors_;
 };
 
 /// plant_sim's sensors and state_estimator, as the closed loop's feedback source (closed_loop.h): the

@@ -9,6 +9,8 @@
 // The true state goes out on ground_truth (SimulatedPlant). update() reads the sensors once per plant
 // step; publish() sends what they read, and may be called again for the same step (a lockstep re-send:
 // the same odom and imu again, no fix twice).
+// Each topic is one registration in the constructor (sensors.cpp): its name, its message's set-up (frames, the
+// constant covariances) and its fill from the suite's last reading; a new sensor's message is one more.
 #pragma once
 
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
@@ -17,14 +19,25 @@
 #include <ros/ros.h>
 #include <sensor_msgs/Imu.h>
 
+#include <memory>
 #include <string>
+#include <vector>
 
 #include "sowing_robot/core/model/plant.h"
 #include "sowing_robot/core/model/robot_params.h"
 #include "sowing_robot/core/model/sensors.h"
 #include "sowing_robot/core/simulation/sensor_feeds.h"
+#include "sowing_robot/ros/common/msg_checks.h"
 
 namespace sowing_robot {
+
+/// What a sensor topic's message set-up reads (PlantSensors' registrations).
+struct SensorTopicSetup {
+  const core::SensorParams& params;
+  const core::RobotParams& nominal;  ///< the robot the encoders' dead reckoning assumes
+  const core::SensorSuite& suite;
+  const std::string &odom_frame, &base_frame;
+};
 
 class PlantSensors {
  public:
@@ -41,16 +54,50 @@ class PlantSensors {
   void publish(const ros::Time& stamp);
   /// The odom -> base_link transform of the last odom published.
   geometry_msgs::TransformStamped odomTransform() const;
-  unsigned odomSubscribers() const { return odom_pub_.getNumSubscribers(); }
+  unsigned odomSubscribers() const { return odom_->publisher().getNumSubscribers(); }
 
  private:
+  using Setup = SensorTopicSetup;
+  /// One sensor's topic: its message, set up once and filled and sent at every publish().
+  class Topic {
+   public:
+    virtual ~Topic() = default;
+    virtual void publish(core::SensorSuite& suite, const ros::Time& stamp) = 0;
+  };
+  template <class Msg>
+  class TopicOf final : public Topic {
+   public:
+    /// The fields that never change.
+    using Init = void (*)(Msg& msg, const Setup& setup);
+    /// The suite's last reading into msg, stamped `stamp`, sent on pub (publishShared): once, or once per delivered
+    /// measurement (none when none is due).
+    using Fill = void (*)(core::SensorSuite& suite, Msg& msg, const ros::Time& stamp, const ros::Publisher& pub);
+    TopicOf(ros::NodeHandle& nh, const char* topic, Init init, Fill fill, const Setup& setup)
+        : pub_(nh.advertise<Msg>(topic, kLockstepQueue)), fill_(fill) {
+      init(msg_, setup);
+    }
+    void publish(core::SensorSuite& suite, const ros::Time& stamp) override { fill_(suite, msg_, stamp, pub_); }
+    const Msg& message() const { return msg_; }
+    const ros::Publisher& publisher() const { return pub_; }
+
+   private:
+    ros::Publisher pub_;
+    Fill fill_;
+    Msg msg_;
+  };
+  /// Advertises `topic` and sets its message up; publish() then sends it, in the order of the registrations.
+  template <class Msg>
+  const TopicOf<Msg>* add(ros::NodeHandle& nh, const char* topic, typename TopicOf<Msg>::Init init,
+                          typename TopicOf<Msg>::Fill fill, const Setup& setup) {
+    topics_.push_back(std::make_unique<TopicOf<Msg>>(nh, topic, init, fill, setup));
+    return static_cast<const TopicOf<Msg>*>(topics_.back().get());
+  }
+
   core::SensorParams params_;
   core::SensorSuite sensors_;
   double time_ = 0.0;
-  ros::Publisher odom_pub_, imu_pub_, fix_pub_;
-  nav_msgs::Odometry odom_msg_;
-  sensor_msgs::Imu imu_msg_;
-  geometry_msgs::PoseWithCovarianceStamped fix_msg_;
+  std::vector<std::unique_ptr<Topic>> topics_;
+  const TopicOf<nav_msgs::Odometry>* odom_ = nullptr;  // odomTransform() and odomSubscribers() read it
 };
 
 }  // namespace sowing_robot
