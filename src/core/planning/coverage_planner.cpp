@@ -827,18 +827,26 @@ class FieldJoiner {
   /// across on top of the length.
   void crossRings(Way& best, const Pose& a, double s_a, const TravelRing& ra, const Pose& b, double s_b,
                   const TravelRing& rb, double across_weight) {
-    std::size_t ia = 0, ib = 0;
-    double gap = kInf;
-    for (std::size_t i = 0; i < ra.points().size(); ++i)
-      for (std::size_t j = 0; j < rb.points().size(); ++j) {
-        const double d = (ra.points()[i] - rb.points()[j]).squaredNorm();
-        if (d < gap) {
-          gap = d;
-          ia = i;
-          ib = j;
-        }
+    // The rings' closest points: every vertex of each projected onto the other.
+    double gap = kInf, s1 = 0.0, s2 = 0.0;
+    for (std::size_t i = 0; i < ra.points().size(); ++i) {
+      double s, d;
+      rb.project(ra.points()[i], s, d);
+      if (d < gap) {
+        gap = d;
+        s1 = ra.arcOf(i);
+        s2 = s;
       }
-    const double s1 = ra.arcOf(ia), s2 = rb.arcOf(ib);
+    }
+    for (std::size_t j = 0; j < rb.points().size(); ++j) {
+      double s, d;
+      ra.project(rb.points()[j], s, d);
+      if (d < gap) {
+        gap = d;
+        s1 = s;
+        s2 = rb.arcOf(j);
+      }
+    }
     Piece offs[2];
     double s_offs[2];
     for (int i = 0; i < 2; ++i) s_offs[i] = offOf(rb, b, s_b, i == 0 ? 1 : -1, band_, offs[i]);
