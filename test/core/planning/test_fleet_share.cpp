@@ -3,7 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <cstdio>
 #include <memory>
 #include <stdexcept>
 #include <vector>
@@ -80,13 +79,6 @@ TEST(FleetShare, EveryRobotPlansTheSameSplitAndDrivesItsOwnShare) {
   const Pose2D r = routeStart(plan);
   EXPECT_DOUBLE_EQ(r.x, plan.route.points.front().x());
   EXPECT_DOUBLE_EQ(r.y, plan.route.points.front().y());
-  // Not kept apart, the two come closer than 2 m (what test_fleet_yield's run-time yield must prevent).
-  const FleetCheck check = checkFleet(a.fleet, plan, FleetParams());
-  std::printf(
-      "small field: %zu swaths; shares %d+%d swaths, %.1f s and %.1f s; planned min separation %.2f m at %.1f s\n",
-      plan.swaths.size(), a.fleet.shares[0].swaths, a.fleet.shares[1].swaths, a.fleet.shares[0].timed.duration(),
-      a.fleet.shares[1].timed.duration(), check.min_separation, check.min_separation_time);
-  EXPECT_LT(check.min_separation, 1.2);
 }
 
 TEST(FleetShare, TheReferenceWaitsThenFollowsItsPath) {
