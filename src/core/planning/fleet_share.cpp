@@ -112,7 +112,7 @@ void FleetShareReference::restart() {
   hold_ = started_ = false;
   first_ = true;
   rate_ = 1.0;
-  tau_ = last_t_ = 0.0;
+  tau_ = last_t_ = lost_ = 0.0;
 }
 
 double FleetShareReference::progress() const {
@@ -130,14 +130,15 @@ Reference FleetShareReference::evaluate(double t) {
     r.stop = true;
     return r;
   }
-  // The first period after the wait starts the source at its time 0.
+  // The source's time: the time since the wait less what the holds took (so without a hold it is t - wait exactly).
   const double driven = started_ ? dt : 0.0;
   started_ = true;
   const double before = rate_;
-  const double step = ramp_ > 0.0 ? driven / ramp_ : 1.0;
+  const double step = driven / ramp_;
   rate_ = hold_ ? std::max(0.0, rate_ - step) : std::min(1.0, rate_ + step);
   const double rate_dot = driven > 0.0 ? (rate_ - before) / driven : 0.0;
-  tau_ += 0.5 * (before + rate_) * driven;
+  lost_ += (1.0 - 0.5 * (before + rate_)) * driven;
+  tau_ = std::max(tau_, t - wait_ - lost_);
   Reference r = source_->next(tau_);
   if (rate_ <= 0.0) {  // a hold: at rest where the time stopped, the hold path (docs/stops.md)
     r.v = r.omega = r.v_dot = r.omega_dot = 0.0;

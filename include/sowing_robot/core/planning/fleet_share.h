@@ -82,6 +82,7 @@ class FleetShareReference : public ReferenceSource {
   double wait_, ramp_;
   bool hold_ = false, started_ = false, first_ = true;
   double rate_ = 1.0, tau_ = 0.0, last_t_ = 0.0;
+  double lost_ = 0.0;  ///< [s] of source time the holds took
 };
 
 }  // namespace core
