@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <set>
 
 #include "sowing_robot/ros/common/component_params.h"
@@ -34,6 +35,27 @@ FleetMonitor::FleetMonitor(ros::NodeHandle nh, ros::NodeHandle pnh) {
     subs_.push_back(nh.subscribe<nav_msgs::Odometry>(
         name(i) + "/ground_truth", 200000, [this, i](const nav_msgs::Odometry::ConstPtr& m) { truthCallback(i, m); },
         ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay()));
+  }
+  if (s.yield) {
+    yield_ = true;
+    decision_ns_ = std::llround(s.decision_period * 1e9);
+    if (decision_ns_ % run.periodNs() != 0)
+      throw badParameter(pnh.resolveName("decision_period") + " must be a multiple of the control period");
+    yield_distance_ = s.yield_distance;
+    yield_hysteresis_ = s.yield_hysteresis;
+    statuses_.resize(static_cast<std::size_t>(s.robots));
+    yields_.assign(static_cast<std::size_t>(s.robots), 0);
+    held_.assign(static_cast<std::size_t>(s.robots), 0);
+    last_hold_.assign(static_cast<std::size_t>(s.robots), false);
+    verdict_pub_ = nh.advertise<FleetVerdict>("/fleet/verdict", 1, true);
+    for (int i = 0; i < s.robots; ++i)
+      subs_.push_back(nh.subscribe<FleetRobotStatus>(
+          name(i) + "/fleet/status", 100000, [this, i](const FleetRobotStatus::ConstPtr& m) { statusCallback(i, m); },
+          ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay()));
+    ROS_INFO(
+        "fleet_monitor: yield on: every %.3f s of simulated time, the later robot of a pair closer than %.3f m holds "
+        "(until farther than %.3f m); verdicts on %s",
+        s.decision_period, yield_distance_, yield_distance_ + yield_hysteresis_, verdict_pub_.getTopic().c_str());
   }
   ROS_INFO("fleet_monitor: %d robots (robot_0 ... robot_%d), safety_distance %.3f m; /clock is the slowest robot's",
            s.robots, s.robots - 1, s.safety_distance);
@@ -72,6 +94,72 @@ void FleetMonitor::truthCallback(int robot, const nav_msgs::Odometry::ConstPtr& 
   if (!begun.empty() || t >= next_report_) publishReport();
 }
 
+void FleetMonitor::statusCallback(int robot, const FleetRobotStatus::ConstPtr& msg) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const std::int64_t stamp = static_cast<std::int64_t>(msg->header.stamp.toNSec());
+  if (stamp <= decided_ns_ || stamp % decision_ns_ != 0) return;  // a repeat, or off the decision grid
+  statuses_[static_cast<std::size_t>(robot)][stamp] = *msg;
+  decide();
+}
+
+void FleetMonitor::decide() {
+  for (;;) {
+    const std::int64_t next = decided_ns_ < 0 ? 0 : decided_ns_ + decision_ns_;
+    std::vector<core::FleetYield::State> states;
+    std::vector<int> ranks;
+    for (auto& robot : statuses_) {
+      const auto it = robot.find(next);
+      if (it == robot.end()) return;  // not every robot's state at `next` yet
+      core::FleetYield::State st;
+      st.x = it->second.x;
+      st.y = it->second.y;
+      st.progress = it->second.progress;
+      st.started = it->second.started;
+      states.push_back(st);
+      ranks.push_back(it->second.rank);
+    }
+    FleetVerdict verdict;
+    verdict.header.stamp.fromNSec(static_cast<std::uint64_t>(next));
+    try {
+      if (!fleet_yield_) fleet_yield_.emplace(ranks, yield_distance_, yield_hysteresis_);
+      const std::vector<bool>& holds = fleet_yield_->update(states);
+      verdict.hold.assign(holds.begin(), holds.end());
+    } catch (const std::invalid_argument& e) {
+      // No verdict is no answer: the robots would wait for ever. Nobody holds, and the run says why.
+      ROS_ERROR_THROTTLE(1.0, "fleet_monitor: no yield decision at t = %.3f s: %s; nobody holds", 1e-9 * next,
+                         e.what());
+      verdict.hold.assign(statuses_.size(), false);
+    }
+    for (std::size_t i = 0; i < verdict.hold.size(); ++i) {
+      // A robot waiting for its start or finished stands anyway: its hold is neither a yield nor held time.
+      const bool driving = states[i].started && states[i].progress < 1.0;
+      if (verdict.hold[i] && !last_hold_[i] && driving) {
+        ++yields_[i];
+        ROS_INFO("fleet_monitor: %s yields at t = %.3f s (a robot of higher priority within %.3f m)",
+                 name(static_cast<int>(i)).c_str(), 1e-9 * next, yield_distance_);
+      } else if (!verdict.hold[i] && last_hold_[i] && driving) {
+        ROS_INFO("fleet_monitor: %s goes on at t = %.3f s", name(static_cast<int>(i)).c_str(), 1e-9 * next);
+      }
+      if (verdict.hold[i] && driving) ++held_[i];
+      last_hold_[i] = verdict.hold[i] && driving;
+      statuses_[i].erase(statuses_[i].begin(), statuses_[i].upper_bound(next));
+    }
+    verdict_pub_.publish(verdict);
+    decided_ns_ = next;
+  }
+}
+
+std::string FleetMonitor::yieldSummary() const {
+  std::string out = "yield: decided to t = " + std::to_string(1e-9 * std::max<std::int64_t>(0, decided_ns_)) + " s;";
+  for (std::size_t i = 0; i < yields_.size(); ++i) {
+    char text[120];
+    std::snprintf(text, sizeof text, " %s %d yield(s), held %.1f s;", name(static_cast<int>(i)).c_str(), yields_[i],
+                  core::secondsFromNanos(held_[i] * decision_ns_));
+    out += text;
+  }
+  return out;
+}
+
 void FleetMonitor::publishReport() {
   FleetProximity r;
   r.header.stamp.fromNSec(static_cast<std::uint64_t>(std::max<std::int64_t>(0, proximity_->lastCompared())));
@@ -106,8 +194,12 @@ void FleetMonitor::watchForEnd() {
       }
       const bool done = clock >= duration_ - 1e-9;
       at_end = at_end && done;
-      monitors = monitors || running.count("/" + robot + "/run_monitor") > 0;
-      const bool plant = running.count("/" + robot + "/plant_sim") > 0;
+      // As nodelets (nodelets:=true) the robot's nodes live in its manager: their loaders (--no-bond) outlive it.
+      const bool manager = running.count("/" + robot + "/sowing_manager") > 0;
+      if (manager) managers_seen_.insert(robot);
+      const bool manager_gone = managers_seen_.count(robot) > 0 && !manager;
+      monitors = monitors || (running.count("/" + robot + "/run_monitor") > 0 && !manager_gone);
+      const bool plant = running.count("/" + robot + "/plant_sim") > 0 && !manager_gone;
       if (plant) plants_seen_.insert(robot);  // (one that has not started yet is not gone)
       if (!done && !plant && plants_seen_.count(robot)) {
         char text[160];
@@ -130,6 +222,7 @@ void FleetMonitor::watchForEnd() {
         proximity_->closestA() < 0 ? "-"
                                    : (name(proximity_->closestA()) + " and " + name(proximity_->closestB())).c_str(),
         proximity_->closestTime(), proximity_->encounters().size(), safety_distance_);
+    if (yield_) ROS_INFO("fleet_monitor: %s", yieldSummary().c_str());
     ros::requestShutdown();
     return;
   }

@@ -19,51 +19,6 @@
 
 namespace sowing_robot {
 
-namespace {
-
-/// Of the field's keys, type coverage reads the speeds only (coverageFollowerParams): the rows' layout is the file's,
-/// and field/min_turn_radius is coverage/min_turn_radius. Any other field/ key is then refused as unknown.
-const core::ParamTable<core::FieldParams>& fieldSpeedsTable() {
-  static const core::ParamTable<core::FieldParams> table = [] {
-    std::vector<core::ParamEntry<core::FieldParams>> speeds;
-    for (const auto& e : core::fieldTable().entries())
-      if (e.info.key == "field/row_speed" || e.info.key == "field/turn_speed" || e.info.key == "field/max_accel")
-        speeds.push_back(e);
-    return core::ParamTable<core::FieldParams>(speeds);
-  }();
-  return table;
-}
-
-/// type coverage: the field file read (with field_origin in place of a GeoJSON file's own, when given) and planned,
-/// and the route from the start pose. "" or one line naming what is wrong: the file library's "PATH: ..." or the
-/// planner's, after the file's name.
-std::string planField(const core::ReferenceGeneratorSettings& settings, const std::string& origin_key,
-                      const core::CoverageParams& coverage, const core::Pose2D& start, core::CoveragePlan& plan,
-                      core::CoveragePath& route) {
-  std::optional<field_file::GeoOrigin> origin;
-  if (!settings.field_origin.empty()) {
-    field_file::GeoOrigin o;
-    const std::string e = seed_map::parseOrigin(settings.field_origin, o);
-    if (!e.empty()) return origin_key + " = '" + settings.field_origin + "': " + e;
-    origin = o;
-  }
-  core::FieldBoundary field;
-  try {
-    field = field_file::loadFieldBoundary(settings.field_file, origin);
-  } catch (const std::invalid_argument& e) {
-    return e.what();
-  }
-  try {
-    plan = core::planCoverage(field, coverage);
-    route = core::coverageFrom(plan, start, coverage);
-  } catch (const std::invalid_argument& e) {
-    return settings.field_file + ": " + e.what();
-  }
-  return "";
-}
-
-}  // namespace
-
 ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) {
   ParamReader p(pnh);
   const core::RunSettings run = loadRunSettings(nh, p);
@@ -87,9 +42,7 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
   std::vector<core::Obstacle> obstacles;
   core::PathParams path;
   std::vector<Eigen::Vector2d> path_points;
-  core::CoverageParams coverage;
-  core::CoveragePlan coverage_plan;
-  core::CoveragePath coverage_route;
+  CoverageRoute coverage;
   if (settings.type == Type::kPath) {
     loadTable(p, core::pathTable(), path);
     if (error.empty()) error = loadPathPoints(p, path_points);
@@ -109,24 +62,17 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
                pnh.resolveName("type") + ": field, or remove them)");
   }
   if (settings.type == Type::kCoverage) {
-    loadTable(p, fieldSpeedsTable(), field);
-    loadTable(p, core::coverageTable(), coverage);
-    // Each swath is driven on until the tool point reaches its end (the URDF's tool offset), unless set.
-    if (error.empty() && !pnh.hasParam("coverage/run_out")) error = loadToolRunOut(p, nh, coverage.run_out);
-    if (error.empty() && p.error().empty()) error = coverage.validate();
-    if (error.empty() && p.error().empty() && settings.field_file.empty())
-      error = pnh.resolveName("field_file") + " is not set: type coverage plans the field of a field file " +
-              "(sim.launch field_file:=PATH)";
     // Planned here, before the unknown-key check ends the start-up: a field that cannot be planned is a bad
     // parameter, said in one line (the file's name and what is wrong with it).
-    if (error.empty() && p.error().empty())
-      error =
-          planField(settings, pnh.resolveName("field_origin"), coverage, run.start(), coverage_plan, coverage_route);
+    const std::string plan_error = loadCoverageRoute(p, nh, settings, coverage);
+    if (error.empty()) error = plan_error;
   } else {
-    for (const char* key : {"coverage", "field_file", "field_origin"})
-      if (pnh.hasParam(key) && !(std::string(key) != "coverage" && pnh.param<std::string>(key, "").empty()))
-        p.fail(pnh.resolveName(key) + " is set but type is not 'coverage': coverage/, field_file and field_origin " +
-               "are read only with type: coverage (set " + pnh.resolveName("type") + ": coverage, or remove them)");
+    for (const char* key : {"coverage", "field_file", "field_origin", "fleet"})
+      if (pnh.hasParam(key) &&
+          !(std::string(key) != "coverage" && std::string(key) != "fleet" && pnh.param<std::string>(key, "").empty()))
+        p.fail(pnh.resolveName(key) + " is set but type is not 'coverage': coverage/, fleet/, field_file and " +
+               "field_origin are read only with type: coverage (set " + pnh.resolveName("type") +
+               ": coverage, or remove them)");
   }
   if (settings.type != Type::kPath && pnh.hasParam("path"))
     p.fail(pnh.resolveName("path") + " is set but type is not 'path': path/ is read only with type: path (set " +
@@ -156,21 +102,47 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
   } else if (settings.type == Type::kCoverage) {
     std::unique_ptr<core::PathReference> f;
     try {
-      f = std::make_unique<core::PathReference>(core::coverageReference(coverage_plan, run.start(), field, coverage));
+      f = std::make_unique<core::PathReference>(coverage.follower, coverage.start, coverage.path.points,
+                                                coverage.path.tool_down);
     } catch (const std::invalid_argument& e) {
       throw badParameter(settings.field_file + ": " + e.what());
     }
     path_source = f.get();
-    source_ = std::move(f);
-    coverage_rows_ = coverage_plan.rows();
-    logSettings("reference_generator", core::coverageTable(), coverage);
-    logSettings("reference_generator", fieldSpeedsTable(), field);
+    const core::CoveragePlan& plan = coverage.plan;
+    logSettings("reference_generator", core::coverageTable(), coverage.coverage);
+    logSettings("reference_generator", coverageFieldSpeedsTable(), coverage.field);
     ROS_INFO(
         "reference_generator: %s planned: %zu swath(s) in %d part(s) at heading %.3f rad, %zu headland ring(s), "
-        "route %.1f m (%.1f m tool up) from the start (%.3f, %.3f, %.3f)",
-        settings.field_file.c_str(), coverage_plan.swaths.size(), coverage_plan.parts, coverage_plan.heading,
-        coverage_plan.headland_rings.size(), coverage_plan.path_length, coverage_plan.turn_length, run.start().x,
-        run.start().y, run.start().theta);
+        "route %.1f m (%.1f m tool up); the robot starts at (%.3f, %.3f, %.3f)%s",
+        settings.field_file.c_str(), plan.swaths.size(), plan.parts, plan.heading, plan.headland_rings.size(),
+        plan.path_length, plan.turn_length, coverage.start.x, coverage.start.y, coverage.start.theta,
+        coverage.fleet.robots == 0 ? ", the route's start" : "");
+    if (coverage.fleet.robots == 0) {
+      source_ = std::move(f);
+      coverage_rows_ = plan.rows();
+    } else {
+      logSettings("reference_generator", core::fleetShareTable(), coverage.fleet);
+      const core::RobotShare& own = coverage.share.own();
+      const core::FleetPlan& fleet = coverage.share.fleet;
+      ROS_INFO(
+          "reference_generator: robot %d of %d: share rank %d, swaths %d-%d, %zu headland loop(s), path %.1f m in "
+          "%.1f s planned, after a planned wait of %.1f s; the fleet's plan: makespan %.1f s, %d wait(s) added, "
+          "%s, closest planned %.2f m",
+          coverage.fleet.index, coverage.fleet.robots, own.rank, own.first_swath, own.first_swath + own.swaths - 1,
+          own.loops.size(), own.timed.length(), own.timed.duration(), own.wait, fleet.makespan(), fleet.waits_added,
+          !coverage.fleet.keep_apart ? "not kept apart (fleet/keep_apart false)"
+          : fleet.conflict_free      ? "conflict-free"
+                                     : "conflicts left",
+          fleet.check.min_separation);
+      fleet_rank_ = own.rank;
+      for (int i = 0; i < own.swaths; ++i)
+        for (const core::RowSegment& r : plan.swaths[static_cast<std::size_t>(own.first_swath + i)].rows)
+          coverage_rows_.push_back(r);
+      auto shared = std::make_unique<core::FleetShareReference>(std::move(f), own.wait, coverage.fleet.ramp_time);
+      fleet_ = shared.get();
+      path_source = const_cast<core::PathReference*>(&fleet_->path());
+      source_ = std::move(shared);
+    }
   } else {
     std::unique_ptr<core::FieldSource> f;
     try {
@@ -229,8 +201,31 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
                                                                                        : "path/points");
   // The field file's local frame is the odom frame (the world-fixed frame of this simulation: there is no map).
   if (settings.type == Type::kCoverage)
-    coverage_topics_ = std::make_unique<CoverageTopics>(nh, coverage_plan, coverage_route, odom_frame_);
+    coverage_topics_ = std::make_unique<CoverageTopics>(nh, coverage.plan, coverage.path, odom_frame_);
   publishPlan();
+  std::vector<ros::Subscriber> inputs;
+  if (fleet_ && coverage.fleet.yield) {
+    yield_ = true;
+    fleet_index_ = coverage.fleet.index;
+    decision_ns_ = std::llround(coverage.fleet.decision_period * 1e9);
+    if (decision_ns_ % period_ns_ != 0)
+      throw badParameter(pnh.resolveName("fleet/decision_period") + " must be a multiple of the control period (" +
+                         std::to_string(core::secondsFromNanos(period_ns_)) + " s)");
+    status_.header.frame_id = odom_frame_;
+    status_.rank = fleet_rank_;
+    // Latched both ways: a verdict or a status sent before the other end had connected is not lost (the next one
+    // cannot come before it has been used).
+    status_pub_ = nh.advertise<FleetRobotStatus>("fleet/status", 1, true);
+    verdict_sub_ = nh.subscribe("/fleet/verdict", kLockstepQueue, &ReferenceGenerator::verdictCallback, this,
+                                ros::TransportHints().tcpNoDelay());
+    truth_sub_ = nh.subscribe("ground_truth", kLockstepQueue, &ReferenceGenerator::truthCallback, this,
+                              ros::TransportHints().tcpNoDelay());
+    inputs.push_back(truth_sub_);  // the plant must not step past a state this node has not seen
+    ROS_INFO(
+        "reference_generator: fleet yield on: every %.3f s of simulated time the references wait for the fleet's "
+        "verdict (%s) on this robot's state (%s)",
+        coverage.fleet.decision_period, verdict_sub_.getTopic().c_str(), status_pub_.getTopic().c_str());
+  }
   clock_sub_ = nh.subscribe("/clock", 10, &ReferenceGenerator::clockCallback, this, ros::TransportHints().tcpNoDelay());
   if (governor_) {
     traction_sub_ = nh.subscribe("traction_control/state", kLockstepQueue, &ReferenceGenerator::tractionCallback, this,
@@ -244,7 +239,8 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
       core::secondsFromNanos(period_ns_), lookahead_);
   // last: all subscribed (ready_roster.h). The references replay to late subscribers and the verdicts are latched:
   // only /clock's link is awaited.
-  ready_ = ReadyAnnouncer(nh, pnh, lockstep_, {clock_sub_});
+  inputs.push_back(clock_sub_);
+  ready_ = ReadyAnnouncer(nh, pnh, lockstep_, inputs);
 }
 
 void ReferenceGenerator::obstaclesCallback(const visualization_msgs::MarkerArray::ConstPtr& msg) {
@@ -448,6 +444,9 @@ void ReferenceGenerator::tractionCallback(const TractionControlState::ConstPtr& 
 void ReferenceGenerator::sendUpTo(std::int64_t end) {
   // The governed reference at t_{k+1} needs the verdict of period k (lockstep: wait for it, never guess).
   if (governor_ && lockstep_) end = std::min(end, verdict_ns_ < 0 ? 0 : verdict_ns_ + period_ns_);
+  // The references after a decision stamp wait for the fleet's verdict on it (lockstep and realtime alike: the
+  // verdict needs every robot's state at the stamp, which needs no reference past it).
+  if (yield_) end = std::min(end, fleet_verdict_ns_ < 0 ? 0 : fleet_verdict_ns_ + decision_ns_);
   for (; next_ns_ <= end; next_ns_ += period_ns_) {
     ros::Time stamp;
     stamp.fromNSec(static_cast<std::uint64_t>(next_ns_));
@@ -455,6 +454,18 @@ void ReferenceGenerator::sendUpTo(std::int64_t end) {
     ReferenceState& r = sent_.back();
     fill(r, stamp);
     if (path_follower_) path_follower_->referenceSent(next_ns_);
+    if (yield_ && next_ns_ % decision_ns_ == 0) {
+      if (status_ns_ != next_ns_) {
+        status_ns_ = next_ns_;
+        status_truth_ = false;
+      }
+      status_ref_ = true;
+      status_.header.stamp = stamp;
+      status_.progress = fleet_->progress();
+      status_.started = fleet_->started();
+      status_.standing = fleet_->standing();
+      publishStatus();
+    }
     publishShared(ref_pub_, r);
     geometry_msgs::PoseStamped p;
     p.header = r.header;
@@ -463,6 +474,45 @@ void ReferenceGenerator::sendUpTo(std::int64_t end) {
     p.pose.orientation = yawQuaternion(r.theta);
     if (path_->add(p)) path_pub_.publish(path_->path());
   }
+}
+
+void ReferenceGenerator::truthCallback(const nav_msgs::Odometry::ConstPtr& msg) {
+  const std::int64_t stamp = static_cast<std::int64_t>(msg->header.stamp.toNSec());
+  if (stamp % decision_ns_ != 0 || stamp < status_ns_ || (stamp == status_ns_ && status_truth_)) return;
+  if (stamp != status_ns_) {  // the state came before its reference was sent
+    status_ns_ = stamp;
+    status_ref_ = false;
+  }
+  status_truth_ = true;
+  status_.x = msg->pose.pose.position.x;
+  status_.y = msg->pose.pose.position.y;
+  publishStatus();
+}
+
+void ReferenceGenerator::publishStatus() {
+  if (!status_ref_ || !status_truth_) return;
+  status_pub_.publish(status_);
+  status_ref_ = status_truth_ = false;
+}
+
+void ReferenceGenerator::verdictCallback(const FleetVerdict::ConstPtr& msg) {
+  const std::int64_t stamp = static_cast<std::int64_t>(msg->header.stamp.toNSec());
+  if (stamp <= fleet_verdict_ns_) return;  // the latched one again, or older
+  if (static_cast<std::size_t>(fleet_index_) >= msg->hold.size()) {
+    ROS_ERROR_THROTTLE(1.0, "reference_generator: fleet verdict at t = %.3f s has %zu robot(s), not robot %d: ignored",
+                       msg->header.stamp.toSec(), msg->hold.size(), fleet_index_);
+    return;
+  }
+  if (fleet_verdict_ns_ >= 0 && stamp != fleet_verdict_ns_ + decision_ns_)
+    ROS_ERROR("reference_generator: fleet verdicts missing between t = %.3f s and %.3f s", 1e-9 * fleet_verdict_ns_,
+              1e-9 * stamp);
+  const bool hold = msg->hold[static_cast<std::size_t>(fleet_index_)];
+  if (hold != fleet_->hold())
+    ROS_INFO("reference_generator: the fleet says %s at t = %.3f s", hold ? "hold (yield)" : "go on",
+             msg->header.stamp.toSec());
+  fleet_->setHold(hold);
+  fleet_verdict_ns_ = stamp;
+  if (clock_seen_) sendUpTo(last_clock_ns_ + window_ns_);
 }
 
 void ReferenceGenerator::replayTo(const ros::SingleSubscriberPublisher& sub) {

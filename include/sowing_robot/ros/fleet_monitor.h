@@ -8,6 +8,12 @@
 // prints the fleet's summary; headless (exit_at_end) it ends the launch once every robot's clock has reached
 // run/duration and every robot's run_monitor has printed its metrics and gone, or, with a FATAL line and exit 3,
 // as soon as a robot's plant_sim is gone before its end (the slowest robot's clock would never move again).
+// With yield (a fleet sharing a field): the run-time yield's referee. On every decision stamp t (decision_period) it
+// waits for every robot's fleet/status of t (its true position at t, its progress, its plan rank), applies
+// core::FleetYield (the later robot of a pair within yield_distance holds, never every robot of a group) and publishes
+// the verdict for t on /fleet/verdict (latched); each robot's reference sends nothing past t until it has it. So the
+// verdicts, and every robot's run, depend on the robots' states at the decision stamps only. It counts each robot's
+// yields and the time it was held, and prints them at the end.
 #pragma once
 
 #include <nav_msgs/Odometry.h>
@@ -15,6 +21,7 @@
 #include <rosgraph_msgs/Clock.h>
 
 #include <atomic>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -24,7 +31,10 @@
 #include <vector>
 
 #include "sowing_robot/FleetProximity.h"
+#include "sowing_robot/FleetRobotStatus.h"
+#include "sowing_robot/FleetVerdict.h"
 #include "sowing_robot/core/simulation/fleet_proximity.h"
+#include "sowing_robot/core/simulation/fleet_yield.h"
 #include "sowing_robot/ros/common/node_failure.h"
 
 namespace sowing_robot {
@@ -39,6 +49,11 @@ class FleetMonitor {
  private:
   void clockCallback(int robot, const rosgraph_msgs::Clock::ConstPtr& msg);
   void truthCallback(int robot, const nav_msgs::Odometry::ConstPtr& msg);
+  /// yield: a robot's state on a decision stamp; decides every stamp all robots have reported (under mutex_).
+  void statusCallback(int robot, const FleetRobotStatus::ConstPtr& msg);
+  void decide();
+  /// The yield's figures, one line (under mutex_).
+  std::string yieldSummary() const;
   /// fleet/proximity from what has been compared (under mutex_).
   void publishReport();
   /// The end of a headless run: polled from a thread of its own (not a WallTimer: see run_monitor.h).
@@ -55,9 +70,21 @@ class FleetMonitor {
   ros::Publisher clock_pub_, report_pub_;
   std::vector<ros::Subscriber> subs_;
   std::atomic<bool> stop_{false};
-  std::set<std::string> plants_seen_;   // the robots whose plant_sim the watcher has seen registered
-  std::optional<NodeFailure> failure_;  // set by the watcher before it requests the shutdown
+  std::set<std::string> managers_seen_;  // the robots whose nodelet manager the watcher has seen (nodelets:=true)
+  std::set<std::string> plants_seen_;    // the robots whose plant_sim the watcher has seen registered
+  std::optional<NodeFailure> failure_;   // set by the watcher before it requests the shutdown
   std::thread watcher_;
+
+  // yield
+  bool yield_ = false;
+  std::int64_t decision_ns_ = 0, decided_ns_ = -1;  // the last decision stamp decided [ns]; -1: none
+  double yield_distance_ = 0.0, yield_hysteresis_ = 0.0;
+  std::optional<core::FleetYield> fleet_yield_;
+  std::vector<std::map<std::int64_t, FleetRobotStatus>> statuses_;  // per robot, by stamp, not yet decided
+  std::vector<int> yields_;                                         // per robot: holds begun
+  std::vector<std::int64_t> held_;                                  // per robot: decision periods held
+  std::vector<bool> last_hold_;                                     // per robot: the last verdict
+  ros::Publisher verdict_pub_;
 };
 
 }  // namespace sowing_robot

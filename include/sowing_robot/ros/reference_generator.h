@@ -22,10 +22,17 @@
 // lockstep it is sent only once that verdict is in: the window ends one period after the last verdict (the
 // in-process loop's order, closed_loop.h). In realtime the verdicts are applied as they come, to the
 // references not yet sent.
+// A fleet sharing a field (type coverage, fleet/robots > 0; ros/coverage_route.h): this robot's share of the split
+// plan, standing at its start for its planned wait (core::FleetShareReference). With fleet/yield the fleet decides at
+// run time who holds: on every decision stamp t (a multiple of fleet/decision_period) this node publishes its state at
+// t (fleet/status: ground_truth's position at t, its progress) and sends no reference past t until fleet_monitor's
+// verdict for t has come (/fleet/verdict), which then holds or releases the references after t. Every robot's
+// references thus depend on every robot's states at the decision stamps only, whatever the loops' relative pace.
 #pragma once
 
 #include <dynamic_reconfigure/server.h>
 
+#include <nav_msgs/Odometry.h>
 #include <nav_msgs/Path.h>
 #include <ros/ros.h>
 #include <rosgraph_msgs/Clock.h>
@@ -38,14 +45,18 @@
 #include <vector>
 
 #include "sowing_robot/FieldPlan.h"
+#include "sowing_robot/FleetRobotStatus.h"
+#include "sowing_robot/FleetVerdict.h"
 #include "sowing_robot/ReferenceGeneratorConfig.h"
 #include "sowing_robot/ReferenceState.h"
 #include "sowing_robot/TractionControlState.h"
 #include "sowing_robot/core/common/reference.h"
 #include "sowing_robot/core/planning/field.h"
+#include "sowing_robot/core/planning/fleet_share.h"
 #include "sowing_robot/core/planning/speed_governor.h"
 #include "sowing_robot/ros/common/path_buffer.h"
 #include "sowing_robot/ros/common/ready_roster.h"
+#include "sowing_robot/ros/coverage_route.h"
 #include "sowing_robot/ros/coverage_topics.h"
 #include "sowing_robot/ros/path_follower.h"
 
@@ -63,6 +74,12 @@ class ReferenceGenerator {
   void sendUpTo(std::int64_t end);
   /// The governor: the traction control's verdict of one period, for the references after it.
   void tractionCallback(const TractionControlState::ConstPtr& msg);
+  /// fleet/yield: the fleet's verdict for one decision stamp, for the references after it.
+  void verdictCallback(const FleetVerdict::ConstPtr& msg);
+  /// fleet/yield: the robot's true position on a decision stamp (for its fleet/status).
+  void truthCallback(const nav_msgs::Odometry::ConstPtr& msg);
+  /// fleet/status for the decision stamp once both its reference and its true state are in.
+  void publishStatus();
   /// A late subscriber gets the references already sent for times still ahead.
   void replayTo(const ros::SingleSubscriberPublisher& sub);
   /// The source's reference at stamp into out.
@@ -87,6 +104,18 @@ class ReferenceGenerator {
   core::FieldReference* potential_ = nullptr;      ///< field_ with field/follower potential, else null
   std::vector<core::Obstacle> obstacles_;          ///< the obstacles in force (type field)
   std::unique_ptr<PathFollower> path_follower_;    ///< type path, field/follower path: inputs, progress; else null
+
+  // a fleet's robot (type coverage, fleet/robots > 0), else null / unset
+  core::FleetShareReference* fleet_ = nullptr;  ///< its share's reference (inside source_)
+  int fleet_index_ = 0, fleet_rank_ = 0;
+  bool yield_ = false;                  ///< fleet/yield
+  std::int64_t decision_ns_ = 0;        ///< fleet/decision_period [ns]
+  std::int64_t fleet_verdict_ns_ = -1;  ///< stamp of the last verdict [ns]; -1: none
+  std::int64_t status_ns_ = -1;         ///< the decision stamp whose status is being gathered
+  bool status_ref_ = false, status_truth_ = false;
+  FleetRobotStatus status_;
+  ros::Subscriber verdict_sub_, truth_sub_;
+  ros::Publisher status_pub_;
 
   // type coverage, else null / empty
   std::unique_ptr<CoverageTopics> coverage_topics_;  ///< the plan on coverage/...

@@ -67,16 +67,36 @@ CoveragePath loopPath(const Ring& ring) {
   return p;
 }
 
-/// The route segment of every swath (its index k: points[k] = a, points[k + 1] = b, tool down).
-std::vector<std::size_t> swathSegments(const CoveragePlan& plan) {
-  std::vector<std::size_t> out;
+/// Where every swath is on the route: `first` the index of its start point a, `end` the index of the end of its
+/// tool-down segment (b, or b + run_out along the swath: with coverage/run_out > 0 the route drives from a tool up
+/// for run_out, then tool down to run_out past b).
+struct SwathSpan {
+  std::size_t first = 0, end = 0;
+};
+std::vector<SwathSpan> swathSegments(const CoveragePlan& plan) {
+  std::vector<SwathSpan> out;
   const CoveragePath& r = plan.route;
   std::size_t k = 0;
   for (const Swath& s : plan.swaths) {
+    const Eigen::Vector2d u = (s.b - s.a).normalized();
+    // on the swath's line, at or beyond a along it
+    const auto onLine = [&](const Eigen::Vector2d& p) {
+      const Eigen::Vector2d d = p - s.a;
+      return std::abs(u.x() * d.y() - u.y() * d.x()) < 1e-6 && u.dot(d) > -1e-6;
+    };
     for (; k + 1 < r.points.size(); ++k)
-      if (r.tool_down[k] && (r.points[k] - s.a).norm() < 1e-6 && (r.points[k + 1] - s.b).norm() < 1e-6) break;
-    if (k + 1 >= r.points.size()) throw std::invalid_argument("splitCoverage: a swath is not on the plan's route");
-    out.push_back(k++);
+      if ((r.points[k] - s.a).norm() < 1e-6) {
+        std::size_t j = k;
+        while (j + 1 < r.points.size() && !r.tool_down[j] && onLine(r.points[j + 1])) ++j;
+        if (j + 1 < r.points.size() && r.tool_down[j] && onLine(r.points[j + 1]) &&
+            u.dot(r.points[j + 1] - s.b) > -1e-6) {
+          out.push_back({k, j + 1});
+          k = j + 1;
+          break;
+        }
+      }
+    if (out.size() < static_cast<std::size_t>(&s - plan.swaths.data()) + 1)
+      throw std::invalid_argument("splitCoverage: a swath is not on the plan's route");
   }
   return out;
 }
@@ -198,7 +218,7 @@ FleetPlan splitCoverage(const CoveragePlan& plan, int robots, const std::vector<
 
   // Costs: the whole route timed once; a swath is the time from its start to the next one's (its turn included).
   const CoveragePath& route = plan.route;
-  const std::vector<std::size_t> seg = swathSegments(plan);
+  const std::vector<SwathSpan> seg = swathSegments(plan);
   const PathPlan whole(
       route.points,
       PathStart{{route.points[0].x(), route.points[0].y(), headingOf(route.points[0], route.points[1])}, 0.0}, follower,
@@ -218,8 +238,8 @@ FleetPlan splitCoverage(const CoveragePlan& plan, int robots, const std::vector<
     return s;
   };
   std::vector<double> t_start(n + 1);
-  for (int i = 0; i < n; ++i) t_start[i] = whole.timeAt(followerS(seg[i]));
-  t_start[n] = whole.timeAt(followerS(seg[n - 1] + 1));
+  for (int i = 0; i < n; ++i) t_start[i] = whole.timeAt(followerS(seg[i].first));
+  t_start[n] = whole.timeAt(followerS(seg[n - 1].end));
   std::vector<double> prefix(n + 1, 0.0);  // swath time before swath i
   for (int i = 0; i < n; ++i) prefix[i + 1] = prefix[i] + std::max(0.0, t_start[i + 1] - t_start[i]);
 
@@ -300,8 +320,9 @@ FleetPlan splitCoverage(const CoveragePlan& plan, int robots, const std::vector<
     const Swath& first = plan.swaths[cut[s]];
     sh.path = coverageJoin(sh.start, {first.a.x(), first.a.y(), headingOf(first.a, first.b)}, params);
     CoveragePath block;
-    block.points.assign(route.points.begin() + seg[cut[s]], route.points.begin() + seg[cut[s + 1] - 1] + 2);
-    block.tool_down.assign(route.tool_down.begin() + seg[cut[s]], route.tool_down.begin() + seg[cut[s + 1] - 1] + 1);
+    block.points.assign(route.points.begin() + seg[cut[s]].first, route.points.begin() + seg[cut[s + 1] - 1].end + 1);
+    block.tool_down.assign(route.tool_down.begin() + seg[cut[s]].first,
+                           route.tool_down.begin() + seg[cut[s + 1] - 1].end);
     append(sh.path, block);
     // Its loops nearest entry first.
     std::vector<int> left = slot_loops[s];

@@ -68,6 +68,10 @@ const ParamTable<PlantSimSettings>& PlantSimSettings::table() {
         number("max_speed", &S::max_speed, 20.0, Limits::positive(), "m/s",
                "|v| beyond this (or a non-finite state) stops the run as diverged (exit 2)"),
         flag("exit_at_end", &S::exit_at_end, false, "lockstep: exit when the scenario ends"),
+        flag("start_at_route", &S::start_at_route, false,
+             "start where reference_generator's coverage route begins (type coverage: the route's start, or the "
+             "fleet robot's start pose, ros/coverage_route.h), planned from reference_generator's keys, in place "
+             "of run/start (sim.launch sets it with field_file:=)"),
     });
     return t.nest("", &S::disturbance, disturbanceTable());
   }();
@@ -276,6 +280,18 @@ const ParamTable<FleetMonitorSettings>& FleetMonitorSettings::table() {
       flag("exit_at_end", &S::exit_at_end, false,
            "end the launch once every robot's clock has reached run/duration and its run_monitor has printed "
            "(headless)"),
+      flag("yield", &S::yield, false,
+           "a fleet sharing a field (fleet.launch field_file:=): on every decision stamp, once every robot's "
+           "fleet/status for it is in, decide who holds (core/simulation/fleet_yield.h: the later robot of a pair "
+           "within yield_distance) and publish the verdict on /fleet/verdict; the robots' references wait for it "
+           "(reference_generator fleet/yield)"),
+      number("yield_distance", &S::yield_distance, 3.0, Limits::positive(), "m",
+             "a robot holds while one of higher priority is closer than this (more than safety_distance: a held "
+             "robot slows to a stop over reference_generator's fleet/ramp_time)"),
+      number("yield_hysteresis", &S::yield_hysteresis, 0.5, Limits::nonNegative(), "m",
+             "a held robot goes on once every robot of higher priority is farther than yield_distance + this"),
+      number("decision_period", &S::decision_period, 0.1, Limits::closed(1e-3, 10.0), "s",
+             "simulated time between verdicts (the robots' fleet/decision_period must be the same)"),
   });
   return table;
 }

@@ -15,6 +15,7 @@
 #include "sowing_robot/core/model/traction.h"
 #include "sowing_robot/core/planning/coverage_planner.h"
 #include "sowing_robot/core/planning/field.h"
+#include "sowing_robot/core/planning/fleet_share.h"
 #include "sowing_robot/core/planning/path_plan.h"
 #include "sowing_robot/core/planning/speed_governor.h"
 #include "sowing_robot/core/settings/node_settings.h"
@@ -137,10 +138,12 @@ const std::vector<CatalogSection>& parameterCatalog() {
        "(field/ and potential/ keys and obstacles are read only with type field), or a given path "
        "(path/ keys, read only with type path; path/points: [[x, y], ...] in the odom frame [m]), or a field file "
        "planned by the coverage planner (coverage/ keys, config/coverage.yaml, read only with type coverage, which "
-       "reads of field/ only row_speed, turn_speed and max_accel); speed_governor/ "
+       "reads of field/ only row_speed, turn_speed and max_accel; fleet/: a fleet sharing the field, "
+       "core/planning/fleet_share.h); speed_governor/ "
        "(opt-in, core/planning/speed_governor.h; needs torque_controller/traction_control/enabled) slows any of them "
        "while the wheels slip",
-       concat(ReferenceGeneratorSettings::table(), fieldTable(), pathTable(), coverageTable(), speedGovernorTable()),
+       concat(ReferenceGeneratorSettings::table(), fieldTable(), pathTable(), coverageTable(), fleetShareTable(),
+              speedGovernorTable()),
        {"obstacles", "path/points"}},
       {"coverage_planner",
        "the coverage planner (core/planning/coverage_planner.h: planCoverage(), docs/coverage.md): headlands, swaths "
@@ -161,7 +164,7 @@ const std::vector<CatalogSection>& parameterCatalog() {
       {"run_monitor", "the metric table at the end of a run", infos(RunMonitorSettings::table()), {}},
       {"fleet_monitor",
        "fleet.launch: owns /clock (the slowest robot's), compares the robots' positions by stamp and reports "
-       "encounters closer than safety_distance",
+       "encounters closer than safety_distance; with yield, decides on every decision stamp which robots hold",
        infos(FleetMonitorSettings::table()),
        {}},
       {"pso_tuner",

@@ -6,6 +6,7 @@
 #include "sowing_robot/core/common/validation.h"
 #include "sowing_robot/ros/common/component_params.h"
 #include "sowing_robot/ros/common/urdf_params.h"
+#include "sowing_robot/ros/coverage_route.h"
 #include "sowing_robot/ros/plant_sim/lockstep.h"
 #include "sowing_robot/ros/plant_sim/realtime.h"
 #include "sowing_robot/ros/plant_sim/traction.h"
@@ -76,7 +77,29 @@ PlantSim::PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh) {
     error =
         core::checkMotorsCanMove(motor, robot, settings.disturbance.mass_scale, rolling, traction.traction.draft_force);
   }
+  core::Pose2D start = run.start();
+  if (error.empty() && p.error().empty() && settings.start_at_route) {
+    // Planned from reference_generator's own keys, as it plans: the same start pose (its unknown keys are its own
+    // to refuse, so this reader's are not checked).
+    ros::NodeHandle ref(nh, "reference_generator");
+    ParamReader rp(ref);
+    core::ReferenceGeneratorSettings ref_settings;
+    loadTable(rp, core::ReferenceGeneratorSettings::table(), ref_settings);
+    CoverageRoute route;
+    if (ref_settings.type != core::ReferenceGeneratorSettings::Type::kCoverage)
+      error = pnh.resolveName("start_at_route") + " needs " + ref.resolveName("type") + " coverage";
+    else
+      error = loadCoverageRoute(rp, nh, ref_settings, route);
+    if (error.empty()) error = rp.error();
+    if (!error.empty())
+      error = pnh.resolveName("start_at_route") + ": reference_generator's route cannot be planned: " + error;
+    else
+      start = route.start;
+  }
   requireValid(p, error);
+  if (settings.start_at_route)
+    ROS_INFO("plant_sim: starting at the coverage route's start (%.3f, %.3f, %.3f) (start_at_route)", start.x, start.y,
+             start.theta);
   cfg_.lockstep = run.lockstep;
   cfg_.period_ns = run.periodNs();
   cfg_.duration = run.duration;
@@ -93,7 +116,6 @@ PlantSim::PlantSim(ros::NodeHandle nh, ros::NodeHandle pnh) {
   cfg_.startup_delay = settings.startup_delay;
   cfg_.max_speed = settings.max_speed;
   cfg_.exit_at_end = settings.exit_at_end;
-  const core::Pose2D start = run.start();
   const core::PlantDisturbance& disturbance = settings.disturbance;
 
   SimulatedPlant::Rates rates;

@@ -46,6 +46,7 @@ struct PlantSimSettings {
   std::string wait_for;    ///< space-separated node names (ros/common/ready_roster.h)
   std::string loop_topic;  ///< plant_sim's topic the controllers' feedback comes from: ground_truth | odom
   bool exit_at_end;
+  bool start_at_route;  ///< start where reference_generator's coverage route begins (ros/coverage_route.h)
   PlantDisturbance disturbance;
   std::string validate() const;
   /// wait_for split at white space.
@@ -132,6 +133,8 @@ struct FleetMonitorSettings {
   int robots;
   double safety_distance;
   bool exit_at_end;
+  bool yield;  ///< decide who holds (FleetYield) on every decision stamp and publish the verdicts
+  double yield_distance, yield_hysteresis, decision_period;
   std::string validate() const { return table().checkRanges(*this); }
   static const ParamTable<FleetMonitorSettings>& table();
 };
