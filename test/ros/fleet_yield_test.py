@@ -42,7 +42,7 @@ def fleet(out_dir, *args):
            "field_file:=" + FIELD, "config:=" + OVERLAY, "keep_apart:=false", "duration:=%g" % DURATION,
            "safety_distance:=%g" % SAFETY, "yield_distance:=%g" % YIELD_DISTANCE, "record:=lean",
            "bag_dir:=" + out_dir, "metrics_dir:=" + out_dir] + list(args)
-    return node_process.run_on_master(port, cmd, timeout=400)
+    return node_process.run_on_master(port, cmd, timeout=480)
 
 
 def read_bytes(path):
