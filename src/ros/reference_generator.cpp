@@ -165,11 +165,11 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
     logSettings("reference_generator", core::coverageTable(), coverage);
     logSettings("reference_generator", fieldSpeedsTable(), field);
     ROS_INFO(
-        "reference_generator: %s planned: %zu swath(s) in %d part(s) at heading %.3f rad, %zu headland ring(s), "
-        "route %.1f m (%.1f m tool up) from the start (%.3f, %.3f, %.3f)",
+        "reference_generator: %s planned: %zu swath(s) in %d part(s) at heading %.3f rad, %zu headland ring(s) "
+        "with %zu headland row(s), route %.1f m (%.1f m tool up) from the start (%.3f, %.3f, %.3f)",
         settings.field_file.c_str(), coverage_plan.swaths.size(), coverage_plan.parts, coverage_plan.heading,
-        coverage_plan.headland_rings.size(), coverage_plan.path_length, coverage_plan.turn_length, run.start().x,
-        run.start().y, run.start().theta);
+        coverage_plan.headland_rings.size(), coverage_plan.headland_rows.size(), coverage_plan.path_length,
+        coverage_plan.turn_length, run.start().x, run.start().y, run.start().theta);
   } else {
     std::unique_ptr<core::FieldSource> f;
     try {
@@ -316,7 +316,7 @@ void ReferenceGenerator::publishPlan() {
     plan.reason = s.code == core::AvoidanceStatus::Code::kOk ? s.bounds_note : s.reason;
     plan.within_bounds = s.within_bounds;
     plan.detours = static_cast<std::uint32_t>(s.detours);
-  } else if (!coverage_rows_.empty()) {  // type coverage: the swaths' tool rows; the voids are not obstacles
+  } else if (!coverage_rows_.empty()) {  // type coverage: the swaths' and headland rows; the voids are not obstacles
     for (const core::RowSegment& r : coverage_rows_) {
       plan.row_starts.push_back(point(r.a));
       plan.row_ends.push_back(point(r.b));
