@@ -8,7 +8,8 @@
 // Then the L field sown in-process on one core (core/evaluation/coverage_run.h) with the recommended set-up: the
 // field profile (config/profiles/field.yaml: traction plant on dry soil, motors, layers, fused feedback), rpp+pid with
 // its gains (config/tuned/field/rpp+pid.yaml), from 1 m before the first swath: the wall time (target <= 60 s), the
-// simulated time, the planned row length, the sown share (target >= 98 %) and the area sown; and where the wall time
+// simulated time, the planned row length (the swaths' and the headland rows), the sown share of each (target >= 98 %)
+// and the area sown against the plan's covered area; and where the wall time
 // goes (the same route with the profile's layers and then its fused feedback taken out).
 #include <algorithm>
 #include <chrono>
@@ -54,17 +55,24 @@ void run(const char* name, const FieldBoundary& field, const CoverageParams& par
   std::printf("  heading %.3f rad, %d swaths in %d parts, pattern %s, %zu headland loops\n", plan.heading, f.swaths,
               plan.parts, plan.pattern == RoutePattern::kSkip ? "skip" : "boustrophedon", plan.headland_rings.size());
   std::printf(
-      "  covered %.2f %% of the inner field by the swaths, %.2f %% of the workable field in all; overlap "
+      "  covered %.2f %% of the inner field by the swaths, %.2f %% of the workable field in all (%.0f m^2); overlap "
       "%.2f %%, missed %.2f %%, sown outside %.2f %%\n",
-      100.0 * f.covered_inner_share, 100.0 * f.covered_share, 100.0 * f.overlap_share, 100.0 * f.missed_share,
-      100.0 * f.outside_share);
+      100.0 * f.covered_inner_share, 100.0 * f.covered_share, f.covered_area, 100.0 * f.overlap_share,
+      100.0 * f.missed_share, 100.0 * f.outside_share);
+  double swath_rows = 0.0, headland_rows = 0.0;
+  for (const Swath& s : plan.swaths)
+    for (const RowSegment& r : s.rows) swath_rows += (r.b - r.a).norm();
+  for (const RowSegment& r : plan.headland_rows) headland_rows += (r.b - r.a).norm();
+  std::printf("  rows %.0f m: the swaths' %.0f m, %zu headland rows %.0f m; the rows' area %.0f m^2\n",
+              swath_rows + headland_rows, swath_rows, plan.headland_rows.size(), headland_rows, f.row_area);
   std::printf(
       "  path %.0f m, of it turns (tool up) %.0f m, of those joins (between parts, onto the loops) %.0f m; peak "
       "curvature %.3f 1/m (bound %.3f), peak dkappa/ds %.2f 1/m^2 (bound %.2f), straight joins %d\n",
       f.path_length, f.turn_length, f.join_length, plan.peak_curvature, 1.0 / params.min_turn_radius,
       plan.peak_curvature_rate, params.max_curvature_rate, plan.straight_joins);
   std::printf("  joins across the inner field %d, outside the field %d; route check: %s\n", plan.joins_across,
-              plan.joins_outside, plan.route_error.empty() ? "inside the boundary, out of the voids" : plan.route_error.c_str());
+              plan.joins_outside,
+              plan.route_error.empty() ? "inside the boundary, out of the voids" : plan.route_error.c_str());
 }
 
 using Clock = std::chrono::steady_clock;
@@ -114,8 +122,9 @@ void sowLField(const FieldBoundary& field, CoverageParams p) {
   setup.coverage = p;
   const auto t0 = Clock::now();
   const CoveragePlan plan = planCoverage(field, p);
-  std::printf("L field sown in-process, one core (plan %.0f ms, path %.0f m, %zu swaths):\n", 1e3 * secondsSince(t0),
-              plan.path_length, plan.swaths.size());
+  std::printf("L field sown in-process, one core (plan %.0f ms, path %.0f m, %zu swaths, %zu headland rows):\n",
+              1e3 * secondsSince(t0), plan.path_length, plan.swaths.size(), plan.headland_rows.size());
+  const CoverageFigures f = coverageFigures(field, plan);
   double wall = 0.0, cpu = 0.0;
   const CoverageRunReport r = sow(plan, setup, wall, cpu);
   const double periods = r.sim_time / secondsFromNanos(setup.scenario.control_period_ns);
@@ -123,6 +132,9 @@ void sowLField(const FieldBoundary& field, CoverageParams p) {
       "  field profile, rpp+pid, dry soil: wall %.1f s (target <= 60 s), CPU %.1f s (%.2f us per control "
       "period)\n%s\n",
       wall, cpu, 1e6 * cpu / periods, r.summary().c_str());
+  std::printf("  area sown %.0f m^2 = %.2f %% of the plan's covered %.0f m^2 (%.2f %% of its rows' %.0f m^2)\n",
+              r.area_sown, 100.0 * r.area_sown / f.covered_area, f.covered_area, 100.0 * r.area_sown / f.row_area,
+              f.row_area);
   std::fflush(stdout);
   // Where the time goes: the same route and pair fed the truth (no EKF), then without motors and layers, then on the
   // no-slip plant.

@@ -112,11 +112,11 @@ ReferenceGenerator::ReferenceGenerator(ros::NodeHandle nh, ros::NodeHandle pnh) 
     logSettings("reference_generator", core::coverageTable(), coverage.coverage);
     logSettings("reference_generator", coverageFieldSpeedsTable(), coverage.field);
     ROS_INFO(
-        "reference_generator: %s planned: %zu swath(s) in %d part(s) at heading %.3f rad, %zu headland ring(s), "
-        "route %.1f m (%.1f m tool up); the robot starts at (%.3f, %.3f, %.3f)%s",
+        "reference_generator: %s planned: %zu swath(s) in %d part(s) at heading %.3f rad, %zu headland ring(s) "
+        "with %zu headland row(s), route %.1f m (%.1f m tool up); the robot starts at (%.3f, %.3f, %.3f)%s",
         settings.field_file.c_str(), plan.swaths.size(), plan.parts, plan.heading, plan.headland_rings.size(),
-        plan.path_length, plan.turn_length, coverage.start.x, coverage.start.y, coverage.start.theta,
-        coverage.fleet.robots == 0 ? ", the route's start" : "");
+        plan.headland_rows.size(), plan.path_length, plan.turn_length, coverage.start.x, coverage.start.y,
+        coverage.start.theta, coverage.fleet.robots == 0 ? ", the route's start" : "");
     if (coverage.fleet.robots == 0) {
       source_ = std::move(f);
       coverage_rows_ = plan.rows();
@@ -313,7 +313,7 @@ void ReferenceGenerator::publishPlan() {
     plan.reason = s.code == core::AvoidanceStatus::Code::kOk ? s.bounds_note : s.reason;
     plan.within_bounds = s.within_bounds;
     plan.detours = static_cast<std::uint32_t>(s.detours);
-  } else if (!coverage_rows_.empty()) {  // type coverage: the swaths' tool rows; the voids are not obstacles
+  } else if (!coverage_rows_.empty()) {  // type coverage: the swaths' and headland rows; the voids are not obstacles
     for (const core::RowSegment& r : coverage_rows_) {
       plan.row_starts.push_back(point(r.a));
       plan.row_ends.push_back(point(r.b));

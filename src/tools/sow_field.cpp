@@ -118,14 +118,14 @@ core::CoverageRunSetup setupOf(const Options& o) {
 void printPlan(const core::CoveragePlan& plan, const core::CoverageFigures& f, double ms) {
   std::printf(
       "plan (%.0f ms): field %.0f m^2, workable %.0f m^2; heading %.3f rad, %d swaths in %d parts, %zu headland "
-      "loops; path %.0f m (turns %.0f m)\n",
-      ms, f.field_area, f.workable_area, plan.heading, f.swaths, plan.parts, plan.headland_rings.size(), f.path_length,
-      f.turn_length);
+      "loops with %zu headland rows; path %.0f m (turns %.0f m)\n",
+      ms, f.field_area, f.workable_area, plan.heading, f.swaths, plan.parts, plan.headland_rings.size(),
+      plan.headland_rows.size(), f.path_length, f.turn_length);
   std::printf(
-      "coverage: %.2f %% of the inner field by the swaths, %.2f %% of the workable field in all; overlap "
-      "%.2f %%, missed %.2f %%, outside %.2f %%\n",
-      100.0 * f.covered_inner_share, 100.0 * f.covered_share, 100.0 * f.overlap_share, 100.0 * f.missed_share,
-      100.0 * f.outside_share);
+      "coverage: %.2f %% of the inner field by the swaths, %.2f %% of the workable field in all (%.0f m^2, the rows' "
+      "strips %.0f m^2); overlap %.2f %%, missed %.2f %%, outside %.2f %%\n",
+      100.0 * f.covered_inner_share, 100.0 * f.covered_share, f.covered_area, f.row_area, 100.0 * f.overlap_share,
+      100.0 * f.missed_share, 100.0 * f.outside_share);
 }
 
 /// The seed map of `o` from the run's record; "" or why not.
@@ -145,7 +145,8 @@ int sow(const Options& o, const ff::FieldFile& file) {
     const auto t0 = Clock::now();
     const core::CoveragePlan plan = core::planCoverage(file.boundary, setup.coverage);
     const double plan_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-    printPlan(plan, core::coverageFigures(file.boundary, plan), plan_ms);
+    const core::CoverageFigures figures = core::coverageFigures(file.boundary, plan);
+    printPlan(plan, figures, plan_ms);
     const core::Swath& first = plan.swaths.front();
     const Eigen::Vector2d along = (first.b - first.a).normalized();
     const Eigen::Vector2d behind = first.a - along;
@@ -156,6 +157,9 @@ int sow(const Options& o, const ff::FieldFile& file) {
     const double wall = std::chrono::duration<double>(Clock::now() - t1).count();
     std::printf("sown from (%.2f, %.2f, %.3f) in %.1f s wall:\n%s\n", setup.start.x, setup.start.y, setup.start.theta,
                 wall, r.summary().c_str());
+    std::printf("area sown %.0f m^2 = %.2f %% of the plan's covered %.0f m^2 (%.2f %% of its rows' %.0f m^2)\n",
+                r.area_sown, 100.0 * r.area_sown / figures.covered_area, figures.covered_area,
+                100.0 * r.area_sown / figures.row_area, figures.row_area);
     const std::string e = writeSeedMap(o, r, file.origin);
     if (!e.empty()) {
       std::fprintf(stderr, "sow_field: %s\n", e.c_str());

@@ -3,10 +3,11 @@
 
 The plan on its latched topics in the odom frame: coverage/field (the boundary and the L field's two voids),
 coverage/headlands (headland_passes rings round the boundary and round each void: the voids lie apart from each
-other and the boundary), coverage/swaths (one pair of points per swath, as many as the rows sent to the seed drill on
-`plan`, one row per pass), coverage/route (a nav_msgs/Path from the route's start: the first swath's start, where
-plant_sim places the robot, plant_sim/start_at_route). The robot, in lockstep, follows the route along the first
-swath and the seed drill places seeds on that swath's row."""
+other and the boundary), coverage/swaths (one pair of points per swath), the rows sent to the seed drill on `plan`
+(one per swath, one row per pass, then the headland rings' straight sides, each on its ring), coverage/route (a
+nav_msgs/Path from the route's start: the first swath's start, where plant_sim places the robot,
+plant_sim/start_at_route). The robot, in lockstep, follows the route along the first swath and the seed drill places
+seeds on that swath's row."""
 import math
 import threading
 import time
@@ -24,6 +25,9 @@ import links
 WALL_TIMEOUT = 90.0
 ROW_TOLERANCE = 0.05  # [m] seeds on the row's line (seed_drill/tolerance)
 MIN_SEEDS = 20        # 2 m of row at seed_drill/spacing 0.1 m
+# The L field's headland rows: the straight sides of its rings, per pass the boundary's 6 and the pond's 6 (the
+# power pole's ring is a curve, no row; coverage_planner.h, headlandSide).
+HEADLAND_ROWS_PER_PASS = 12
 
 
 def by_ns(msg):
@@ -114,7 +118,18 @@ class CoverageTopics(unittest.TestCase):
         n_swaths = len(lines.points) // 2
         self.assertGreater(n_swaths, 100, "the 1 ha field at 1 m is more than 100 swaths")
         self.assertEqual(len(lines.points), 2 * n_swaths)
-        self.assertEqual(len(plan.row_starts), n_swaths, "rows on `plan` (seed drill) != swaths")
+        # the rows on `plan` (seed drill): the swaths' in route order, then the headland rows, each on a ring
+        self.assertEqual(len(plan.row_starts), n_swaths + passes * HEADLAND_ROWS_PER_PASS,
+                         "rows on `plan` (seed drill) != swaths + headland sides")
+        self.assertEqual(len(plan.row_ends), len(plan.row_starts))
+        for i in range(n_swaths):
+            self.assertEqual((plan.row_starts[i].x, plan.row_starts[i].y), (lines.points[2 * i].x, lines.points[2 * i].y))
+        rings = headlands.get("headlands", [])
+        for i in range(n_swaths, len(plan.row_starts)):
+            for end in (plan.row_starts[i], plan.row_ends[i]):
+                off = min(distance_to_segment(end, m.points[k], m.points[k + 1])
+                          for m in rings for k in range(len(m.points) - 1))
+                self.assertLess(off, 1e-6, "headland row %d does not lie on a headland ring" % i)
         self.assertEqual(len(plan.obstacle_radii), 0)
         # the route: from its own start, the first swath's start (no approach from run/start)
         p0 = route.poses[0].pose.position

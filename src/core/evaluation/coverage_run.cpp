@@ -62,9 +62,14 @@ CoverageRunReport runCoverage(const CoveragePlan& plan, const CoverageRunSetup& 
 
   CoverageRunReport rep;
   rep.seeds = seedFigures(record.seeds(), record.drill());
-  for (const RowSowing& r : rep.seeds.rows) {
+  const std::size_t swath_rows = plan.swathRows();  // rows() holds the swaths' rows first, then the headland rows
+  for (std::size_t i = 0; i < rep.seeds.rows.size(); ++i) {
+    const RowSowing& r = rep.seeds.rows[i];
     rep.row_length += r.length + r.detour_length;
     rep.sown_length += r.sown + r.detour_sown;
+    if (i < swath_rows) continue;
+    rep.headland_row_length += r.length + r.detour_length;
+    rep.headland_sown_length += r.sown + r.detour_sown;
   }
   rep.sown_share = rep.row_length > 0.0 ? rep.sown_length / rep.row_length : 0.0;
   const double row_width = plan.swaths.empty() || plan.swaths.front().rows.empty()
@@ -89,20 +94,32 @@ CoverageRunReport runCoverage(const CoveragePlan& plan, const CoverageRunSetup& 
   return rep;
 }
 
+double CoverageRunReport::swathShare() const {
+  const double length = row_length - headland_row_length;
+  return length > 0.0 ? (sown_length - headland_sown_length) / length : std::nan("");
+}
+
+double CoverageRunReport::headlandShare() const {
+  return headland_row_length > 0.0 ? headland_sown_length / headland_row_length : std::nan("");
+}
+
 std::string CoverageRunReport::summary() const {
-  char b[900];
+  char b[1100];
   std::snprintf(b, sizeof(b),
                 "rows %.1f m planned, sown %.1f m = %.2f %% (worst row %.2f %%); area sown %.1f m^2\n"
+                "swaths' rows %.1f m, sown %.2f %%; headland rows %.1f m, sown %.2f %%\n"
                 "seeds %zu: quality of feed %.2f %% (multiples %.2f %%, misses %.2f %%), lateral p95 %.1f mm "
                 "(RMS %.1f mm), depth outside the band %.2f %%, seed-map error RMS %.1f mm\n"
                 "time %.1f s simulated (route %.1f s), drive work %.1f kJ, effort %.4g N^2 m^2 s, max slip %.3f, "
                 "hitch raises %d (%.2f m unsown)\n"
                 "end: %s, %.3f m from the route's end%s%s",
-                row_length, sown_length, 100.0 * sown_share, 100.0 * seeds.worst_row_share, area_sown, seeds.seeds,
-                seeds.quality_of_feed, seeds.multiples, seeds.misses, 1e3 * seeds.lateral_p95, 1e3 * seeds.lateral_rms,
-                100.0 * seeds.depth_outside, 1e3 * seeds.map_error_rms, sim_time, route_time, 1e-3 * drive_work, effort,
-                max_slip, hitch_raises, unsown_distance, finished ? "finished" : "NOT finished", route_end_distance,
-                diverged ? ", diverged" : "", no_traction.detected ? (", " + no_traction.text()).c_str() : "");
+                row_length, sown_length, 100.0 * sown_share, 100.0 * seeds.worst_row_share, area_sown,
+                row_length - headland_row_length, 100.0 * swathShare(), headland_row_length, 100.0 * headlandShare(),
+                seeds.seeds, seeds.quality_of_feed, seeds.multiples, seeds.misses, 1e3 * seeds.lateral_p95,
+                1e3 * seeds.lateral_rms, 100.0 * seeds.depth_outside, 1e3 * seeds.map_error_rms, sim_time, route_time,
+                1e-3 * drive_work, effort, max_slip, hitch_raises, unsown_distance,
+                finished ? "finished" : "NOT finished", route_end_distance, diverged ? ", diverged" : "",
+                no_traction.detected ? (", " + no_traction.text()).c_str() : "");
   return b;
 }
 

@@ -48,6 +48,17 @@ CoverageFigures coverageFigures(const FieldBoundary& field, const CoveragePlan& 
   f.overlap_share = union_area > 0.0 ? std::max(0.0, summed - union_area) / union_area : 0.0;
   f.outside_share = union_area > 0.0 ? std::max(0.0, union_area - f.covered_area) / union_area : 0.0;
 
+  // The rows' strips, measured as the covered area is (a difference).
+  const std::vector<RowSegment> rows = plan.rows();
+  if (!rows.empty()) {
+    const std::size_t per_pass = plan.swaths.empty() ? 1 : std::max<std::size_t>(1, plan.swaths.front().rows.size());
+    geo::MultiLine lines;
+    for (const RowSegment& r : rows) lines.push_back(geo::Line{geo::toPoint(r.a), geo::toPoint(r.b)});
+    geo::MultiPolygon rows_left;
+    bg::difference(workable, geo::strip(lines, w / static_cast<double>(per_pass)), rows_left);
+    f.row_area = std::max(0.0, f.workable_area - bg::area(rows_left));
+  }
+
   // The inner field's share under the swaths' strips.
   geo::MultiPolygon inner_field;
   {

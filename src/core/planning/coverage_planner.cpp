@@ -89,6 +89,31 @@ std::string CoverageParams::validate() const {
 std::vector<RowSegment> CoveragePlan::rows() const {
   std::vector<RowSegment> out;
   for (const Swath& s : swaths) out.insert(out.end(), s.rows.begin(), s.rows.end());
+  out.insert(out.end(), headland_rows.begin(), headland_rows.end());
+  return out;
+}
+
+std::size_t CoveragePlan::swathRows() const {
+  std::size_t n = 0;
+  for (const Swath& s : swaths) n += s.rows.size();
+  return n;
+}
+
+bool headlandSide(const Eigen::Vector2d& p, const Eigen::Vector2d& q, const CoverageParams& params) {
+  return (q - p).norm() - params.run_out >= params.workingWidth();
+}
+
+std::vector<RowSegment> headlandSideRows(const Eigen::Vector2d& p, const Eigen::Vector2d& q,
+                                         const CoverageParams& params) {
+  std::vector<RowSegment> out;
+  const double length = (q - p).norm();
+  if (!(length > params.run_out)) return out;
+  const Eigen::Vector2d u = (q - p) / length, left(-u.y(), u.x());
+  const Eigen::Vector2d end = q - params.run_out * u;
+  for (int r = 0; r < params.rows_per_pass; ++r) {
+    const Eigen::Vector2d shift = ((r - 0.5 * (params.rows_per_pass - 1)) * params.row_spacing) * left;
+    out.push_back({p + shift, end + shift});
+  }
   return out;
 }
 
@@ -1102,7 +1127,8 @@ CoveragePlan planCoverage(const FieldBoundary& field, const CoverageParams& para
 
   // The headland passes, the innermost first, each ring a closed loop from its point nearest the route's end,
   // driven the way that turns least onto it; corners rounded so every curve keeps min_turn_radius (10 % spare:
-  // the rounding's uneven chords put the circle through three vertices up to 6 % tighter than the arc).
+  // the rounding's uneven chords put the circle through three vertices up to 6 % tighter than the arc). Its straight
+  // sides are sown as rows (headlandSide), its corners not: there the trailing tool point swings off the ring's line.
   for (int pass = params.headland_passes - 1; pass >= 0; --pass) {
     const double d = (pass + 0.5) * w;
     geo::MultiPolygon region;
@@ -1135,8 +1161,15 @@ CoveragePlan planCoverage(const FieldBoundary& field, const CoverageParams& para
       if (std::fabs(wrapAngle(backward - at.h)) < std::fabs(wrapAngle(forward - at.h)))
         std::reverse(loop.begin() + 1, loop.end());
       joiner.join(at, {loop[0], headingOf(loop[0], loop[1])});
-      for (std::size_t i = 1; i < loop.size(); ++i) route.lineTo(loop[i], true);
-      route.lineTo(loop[0], true);
+      // Tool down on the straight sides, each a row of the plan; up on the corners' chords.
+      for (std::size_t i = 1; i <= loop.size(); ++i) {
+        const Eigen::Vector2d &p = loop[i - 1], &q = loop[i % loop.size()];
+        const bool side = headlandSide(p, q, params);
+        route.lineTo(q, side);
+        if (!side) continue;
+        const std::vector<RowSegment> rows = headlandSideRows(p, q, params);
+        plan.headland_rows.insert(plan.headland_rows.end(), rows.begin(), rows.end());
+      }
       at = {loop[0], headingOf(loop.back(), loop[0])};
       plan.headland_rings.push_back(loop);
       // The ring's own curvature: its corners' circles through three vertices (Menger curvature).
@@ -1183,12 +1216,11 @@ std::string checkRoute(const FieldBoundary& field, const CoveragePath& route) {
   for (std::size_t i = 0; i < field.voids.size() + field.circles.size(); ++i) {
     const bool is_circle = i >= field.voids.size();
     const std::size_t j = is_circle ? i - field.voids.size() : i;
-    const geo::Polygon v =
-        is_circle ? geo::circle({field.circles[j].x, field.circles[j].y}, field.circles[j].radius)
-                  : geo::toPolygon(field.voids[j]);
+    const geo::Polygon v = is_circle ? geo::circle({field.circles[j].x, field.circles[j].y}, field.circles[j].radius)
+                                     : geo::toPolygon(field.voids[j]);
     if (bg::intersects(line, v))
-      return "the route enters " + std::string(is_circle ? "circular void " : "void ") + std::to_string(j) +
-             " after " + firstAt([&v](const geo::Line& seg) { return bg::intersects(seg, v); });
+      return "the route enters " + std::string(is_circle ? "circular void " : "void ") + std::to_string(j) + " after " +
+             firstAt([&v](const geo::Line& seg) { return bg::intersects(seg, v); });
   }
   return "";
 }

@@ -58,12 +58,14 @@ Pose2D endPose(const CoveragePath& path, const Pose2D& fallback) {
   return {b.x(), b.y(), headingOf(a, b)};
 }
 
-/// A headland ring driven as the planner drives it: from its first point round to it, tool down.
-CoveragePath loopPath(const Ring& ring) {
+/// A headland ring driven as the planner drives it: from its first point round to it, tool down on its straight sides
+/// (the plan's headland rows) and up on its corners (headlandSide).
+CoveragePath loopPath(const Ring& ring, const CoverageParams& params) {
   CoveragePath p;
   p.points = ring;
   p.points.push_back(ring.front());
-  p.tool_down.assign(p.points.size() - 1, true);
+  for (std::size_t i = 0; i + 1 < p.points.size(); ++i)
+    p.tool_down.push_back(headlandSide(p.points[i], p.points[i + 1], params));
   return p;
 }
 
@@ -246,7 +248,7 @@ FleetPlan splitCoverage(const CoveragePlan& plan, int robots, const std::vector<
   const int loops = static_cast<int>(plan.headland_rings.size());
   std::vector<double> loop_cost(loops, 0.0);
   for (int j = 0; j < loops; ++j) {
-    const CoveragePath lp = loopPath(plan.headland_rings[j]);
+    const CoveragePath lp = loopPath(plan.headland_rings[j], params);
     if (lp.points.size() < 3) continue;
     const PathPlan t(lp.points,
                      PathStart{{lp.points[0].x(), lp.points[0].y(), headingOf(lp.points[0], lp.points[1])}, 0.0},
@@ -335,7 +337,7 @@ FleetPlan splitCoverage(const CoveragePlan& plan, int robots, const std::vector<
       const Ring& ring = plan.headland_rings[*next];
       if (ring.size() >= 3) {
         append(sh.path, coverageJoin(at, {ring[0].x(), ring[0].y(), headingOf(ring[0], ring[1])}, params));
-        append(sh.path, loopPath(ring));
+        append(sh.path, loopPath(ring, params));
         sh.loops.push_back(*next);
       }
       left.erase(next);

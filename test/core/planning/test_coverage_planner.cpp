@@ -96,7 +96,8 @@ void expectRouteInside(const FieldBoundary& f, const CoveragePlan& plan) {
     Ring c;
     const double r = f.circles[i].radius / std::cos(M_PI / 72.0);
     for (int k = 0; k < 72; ++k)
-      c.push_back({f.circles[i].x + r * std::cos(2.0 * M_PI * k / 72), f.circles[i].y + r * std::sin(2.0 * M_PI * k / 72)});
+      c.push_back(
+          {f.circles[i].x + r * std::cos(2.0 * M_PI * k / 72), f.circles[i].y + r * std::sin(2.0 * M_PI * k / 72)});
     EXPECT_FALSE(bg::intersects(line, geo::toPolygon(c))) << "the route enters circular void " << i;
   }
   EXPECT_EQ(plan.route_error, "");
@@ -139,7 +140,8 @@ TEST(CoveragePlanner, TodaysRectangularFieldIsOneCase) {
       for (const Eigen::Vector2d& q : rotated(rectangle(-room, -0.5 - room, 30.0 + room, 2.5 + room), heading))
         f.outer.push_back(q + Eigen::Vector2d(field.start_x, field.start_y));
       const CoveragePlan plan = planCoverage(f, p);
-      const std::vector<RowSegment> rows = plan.rows();
+      std::vector<RowSegment> rows = plan.rows();
+      rows.resize(plan.swathRows());  // the swaths' rows; the headland rows follow them
       ASSERT_EQ(rows.size(), today.size()) << "heading " << heading << ", rows per pass " << rows_per_pass;
       for (const RowSegment& r : today)
         EXPECT_TRUE(std::any_of(rows.begin(), rows.end(), [&](const RowSegment& q) { return sameLine(q, r, 1e-5); }))
@@ -196,10 +198,11 @@ TEST(CoveragePlanner, TheLFieldsJoinsStayInsideTheField) {
     p.run_out = run_out;
     const CoveragePlan plan = planCoverage(lField(), p);
     SCOPED_TRACE("run_out " + std::to_string(run_out));
-    std::printf("L field, run-out %.2f m: %zu swaths in %d parts, path %.0f m, turns %.0f m, joins %.0f m (%d across "
-                "the inner field)\n",
-                run_out, plan.swaths.size(), plan.parts, plan.path_length, plan.turn_length, plan.join_length,
-                plan.joins_across);
+    std::printf(
+        "L field, run-out %.2f m: %zu swaths in %d parts, path %.0f m, turns %.0f m, joins %.0f m (%d across "
+        "the inner field)\n",
+        run_out, plan.swaths.size(), plan.parts, plan.path_length, plan.turn_length, plan.join_length,
+        plan.joins_across);
     expectRouteInside(lField(), plan);
     EXPECT_EQ(plan.straight_joins, 0);
     EXPECT_GT(plan.parts, 1);
@@ -254,8 +257,8 @@ TEST(CoveragePlanner, ASplittingVoidIsCoveredOnBothSides) {
     if (plan.route.tool_down[i]) continue;
     const auto seg = lineOf({plan.route.points[i], plan.route.points[i + 1]});
     for (const Box& side : sides)
-      EXPECT_FALSE(bg::intersects(seg, side)) << "tool-up segment " << i << " from (" << plan.route.points[i].transpose()
-                                              << ") crosses the swaths";
+      EXPECT_FALSE(bg::intersects(seg, side))
+          << "tool-up segment " << i << " from (" << plan.route.points[i].transpose() << ") crosses the swaths";
   }
 }
 
@@ -415,4 +418,60 @@ TEST(CoveragePlanner, RunOutDrivesEachSwathOnPastItsEnd) {
   CoverageParams bad = p;
   bad.run_out = -0.1;
   EXPECT_THROW(planCoverage(f, bad), std::invalid_argument);
+}
+
+// The headland loops' straight sides are rows of the plan, after the swaths' and in the order they are driven: each on
+// a tool-down segment of the route along a headland ring, from the side's start to run_out short of its end (where the
+// trailing tool point is when the axle turns into the corner). The corners' chords are tool up, and no row; so are the
+// rings round the tree (a 3 m circle: 0.6 m chords).
+TEST(CoveragePlanner, TheHeadlandSidesAreRowsAndTheirCornersAreNot) {
+  const FieldBoundary f = lShapedHectare();
+  CoverageParams p = fieldYamlParams();
+  p.run_out = 0.45;
+  const CoveragePlan plan = planCoverage(f, p);
+  const std::vector<RowSegment> rows = plan.rows();
+  ASSERT_EQ(rows.size(), plan.swathRows() + plan.headland_rows.size());
+  // Sides: the L's six and the pond's four on each of the two passes; not one round the tree.
+  EXPECT_EQ(plan.headland_rows.size(), 2u * (6u + 4u));
+  const CoveragePath& route = plan.route;
+  std::size_t next = 0;  // the headland rows are met along the route in their order
+  double side_length = 0.0, row_length = 0.0, up_on_loops = 0.0;
+  std::size_t first_loop = 0;  // the route's first segment on a headland ring: after the last swath
+  for (std::size_t i = 0; i + 1 < route.points.size(); ++i)
+    if ((route.points[i + 1] - plan.swaths.back().b).norm() < p.run_out + 1e-9) first_loop = i + 1;
+  for (std::size_t i = first_loop; i + 1 < route.points.size(); ++i) {
+    const Eigen::Vector2d &a = route.points[i], &b = route.points[i + 1];
+    if (!route.tool_down[i]) continue;
+    ASSERT_TRUE(headlandSide(a, b, p)) << "tool down off a straight side at route point " << i;
+    ASSERT_LT(next, plan.headland_rows.size());
+    const RowSegment& r = plan.headland_rows[next++];
+    const Eigen::Vector2d u = (b - a).normalized();
+    EXPECT_LT((r.a - a).norm(), 1e-9);
+    EXPECT_LT((r.b - (b - p.run_out * u)).norm(), 1e-9);
+    side_length += (b - a).norm();
+    row_length += (r.b - r.a).norm();
+    // On a headland ring's line: both ends are ring vertices.
+    bool on_ring = false;
+    for (const Ring& ring : plan.headland_rings)
+      for (std::size_t v = 0; v < ring.size(); ++v)
+        on_ring = on_ring || ((ring[v] - a).norm() < 1e-9 && (ring[(v + 1) % ring.size()] - b).norm() < 1e-9);
+    EXPECT_TRUE(on_ring) << "a tool-down headland segment off the rings at route point " << i;
+  }
+  EXPECT_EQ(next, plan.headland_rows.size());
+  // Every ring's sides were driven tool down (one row each), its other edges (corners, curves) tool up.
+  std::size_t sides = 0;
+  for (const Ring& ring : plan.headland_rings)
+    for (std::size_t v = 0; v < ring.size(); ++v) {
+      const bool side = headlandSide(ring[v], ring[(v + 1) % ring.size()], p);
+      sides += side ? 1 : 0;
+      if (!side) up_on_loops += (ring[(v + 1) % ring.size()] - ring[v]).norm();
+    }
+  EXPECT_EQ(sides, plan.headland_rows.size());
+  EXPECT_NEAR(side_length - row_length, p.run_out * plan.headland_rows.size(), 1e-6);
+  // The L's two passes are some 2 x 470 m round (less the corners and the run-outs); the pond's 2 x 60 m or so.
+  EXPECT_GT(row_length, 1000.0);
+  EXPECT_GT(up_on_loops, 0.0);
+  const CoverageFigures fig = coverageFigures(f, plan);
+  EXPECT_GT(fig.row_area, 0.97 * fig.covered_area);
+  EXPECT_LT(fig.row_area, fig.covered_area);
 }

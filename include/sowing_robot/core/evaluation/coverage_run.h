@@ -1,7 +1,8 @@
 // A coverage plan sown in-process: the closed loop (runner.h, with a LoopConfig: the plant, the feedback and the layers
 // of a profile) on the path follower over the plan's route from a start pose (coverage_follower.h), with the seed
-// record (seed_recorder.h: SeedDrill on plan.rows()) kept beside it and judged as the seed figures judge rows
-// (seed_metrics.h, docs/seeds.md). Used by the sow_field command, coverage_bench and test_coverage_run.
+// record (seed_recorder.h: SeedDrill on plan.rows(), the swaths' and the headland rows) kept beside it and judged as
+// the seed figures judge rows (seed_metrics.h, docs/seeds.md). Used by the sow_field command, coverage_bench and
+// test_coverage_run.
 //
 // A field is hours of simulated time at 1 kHz (the 1 ha L field: about 3 h), so nothing is kept per period: the
 // time-domain figures are off (MetricsAccumulator without them), the trace adds to running sums, and the only record
@@ -35,16 +36,20 @@ struct CoverageRunSetup {
 };
 
 struct CoverageRunReport {
-  SeedFigures seeds;                ///< over the plan's rows (sown share, ISO 7256-1, lateral offset, depth, map error)
-  double row_length = 0.0;          ///< the planned rows' length [m]
-  double sown_length = 0.0;         ///< of which sown (the seed figures' rule) [m]
-  double sown_share = 0.0;          ///< sown_length / row_length
-  double area_sown = 0.0;           ///< areaSown over the seed record, a row spacing wide [m^2]
-  double route_time = 0.0;          ///< the follower's planned time from the start pose to the route's end [s]
-  double sim_time = 0.0;            ///< simulated [s]
-  double drive_work = 0.0;          ///< sum of the wheel torques sent x the wheels' rolling rates, positive part [J]
-  double effort = 0.0;              ///< integral of tau_r^2 + tau_l^2 [N^2 m^2 s]
-  double route_end_distance = 0.0;  ///< final axle position to the route's last point [m]
+  SeedFigures seeds;         ///< over the plan's rows (sown share, ISO 7256-1, lateral offset, depth, map error)
+  double row_length = 0.0;   ///< the planned rows' length [m] (the swaths' and the headland rows')
+  double sown_length = 0.0;  ///< of which sown (the seed figures' rule) [m]
+  double sown_share = 0.0;   ///< sown_length / row_length
+  double headland_row_length = 0.0;   ///< of row_length, the headland rows' (CoveragePlan::headland_rows) [m]
+  double headland_sown_length = 0.0;  ///< of sown_length, on the headland rows [m]
+  double swathShare() const;          ///< the swaths' rows' sown share (NaN without any)
+  double headlandShare() const;       ///< the headland rows' sown share (NaN without any)
+  double area_sown = 0.0;             ///< areaSown over the seed record, a row spacing wide [m^2]
+  double route_time = 0.0;            ///< the follower's planned time from the start pose to the route's end [s]
+  double sim_time = 0.0;              ///< simulated [s]
+  double drive_work = 0.0;            ///< sum of the wheel torques sent x the wheels' rolling rates, positive part [J]
+  double effort = 0.0;                ///< integral of tau_r^2 + tau_l^2 [N^2 m^2 s]
+  double route_end_distance = 0.0;    ///< final axle position to the route's last point [m]
   bool finished = false;  ///< the follower's route ended, the axle within 0.3 m of its end, no divergence or stop
   bool diverged = false;
   NoTractionReport no_traction;

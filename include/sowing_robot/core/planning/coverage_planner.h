@@ -14,12 +14,16 @@
 //     headland) by a turn-straight-turn whose turns ramp their curvature as the field's turns do
 //     (|kappa| <= 1/min_turn_radius, |dkappa/ds| <= max_curvature_rate). The headland passes are sown last, as
 //     closed loops along the boundary's offset rings, their corners rounded to at least min_turn_radius.
+//   * Headland rows: each straight side of a headland loop is a row of the plan (RowSegments after the swaths', in
+//     the order driven), tool down along it; its corners (and the curves round circular voids) are driven tool up
+//     and are no row (headlandSide).
 //
 // All polygon work (offsets, differences, clipping, areas, validity) is Boost.Geometry's; the interface keeps to
 // Eigen points. Errors (a self-intersecting boundary or void, a void outside the field, a field narrower than
 // one swath and its headlands, bad parameters) are thrown as std::invalid_argument with one line.
 #pragma once
 
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -78,8 +82,12 @@ struct CoveragePlan {
   std::vector<Ring> inner_field;     ///< the inner field's rings (outer rings and holes)
   std::vector<Ring> headland_rings;  ///< the headland passes' centre lines, in the order they are driven
   std::vector<Swath> swaths;         ///< in route order
-  /// Swaths, turns and headland loops; tool down on the headland loops and on each swath from run_out past its start
-  /// to run_out past its end (the axle's stretch on which the tool point, run_out behind it, is over the row).
+  /// The headland loops' straight sides as tool rows (headlandSide), in the order they are driven, after the swaths:
+  /// rows_per_pass rows per side, centred on it, in the direction it is driven.
+  std::vector<RowSegment> headland_rows;
+  /// Swaths, turns and headland loops; tool down on each swath from run_out past its start to run_out past its end
+  /// (the axle's stretch on which the tool point, run_out behind it, is over the row), and on the headland loops'
+  /// straight sides (headlandSide), up on their corners.
   CoveragePath route;
   double heading = 0.0;                                 ///< the swath heading used [rad], in [0, pi)
   RoutePattern pattern = RoutePattern::kBoustrophedon;  ///< the pattern used (never kAuto)
@@ -100,9 +108,22 @@ struct CoveragePlan {
   int joins_outside = 0;
   /// checkRoute(field, route): "" when no part of the route leaves the boundary or enters a void.
   std::string route_error;
-  /// Every swath's tool rows, in route order.
+  /// Every swath's tool rows, in route order, then the headland rows: the plan's rows (FieldPlan, SeedDrill).
   std::vector<RowSegment> rows() const;
+  /// How many of rows() are the swaths' (the headland rows follow them).
+  std::size_t swathRows() const;
 };
+
+/// True when a headland loop's edge from p to q (driven that way) is a straight side sown as a row: the stretch the
+/// tool point sows on it, from p to run_out short of q (the tool point trails the axle by run_out, and the axle turns
+/// into the next corner at q), is at least one working width long. The corners' chords (rounded to 1.1
+/// min_turn_radius: 9.6 cm at 0.5 m) and those of the rings round circular voids are shorter, and are no row.
+bool headlandSide(const Eigen::Vector2d& p, const Eigen::Vector2d& q, const CoverageParams& params);
+
+/// The rows of a headland side from p to q (headlandSide): rows_per_pass rows from p to run_out short of q, centred on
+/// the side, each row_spacing apart.
+std::vector<RowSegment> headlandSideRows(const Eigen::Vector2d& p, const Eigen::Vector2d& q,
+                                         const CoverageParams& params);
 
 /// "" when the boundary can be planned on, else one line: a ring with too few points or non-finite ones, a
 /// self-intersecting boundary or void (Boost.Geometry's reason), a void (polygon or circle) outside the field.
