@@ -18,6 +18,7 @@
 #include <mutex>
 #include <thread>
 
+#include "sowing_robot/ros/bag/bag_recorder.h"
 #include "sowing_robot/ros/cmd_vel_limiter.h"
 #include "sowing_robot/ros/common/failure_log.h"
 #include "sowing_robot/ros/kinematic_controller.h"
@@ -90,6 +91,10 @@ using RunMonitorNodelet = WrapperNodelet<RunMonitor>;
 using SeedDrillNodelet = WrapperNodelet<SeedDrillNode>;
 using StateEstimatorNodelet = WrapperNodelet<StateEstimator>;
 using CmdVelLimiterNodelet = WrapperNodelet<CmdVelLimiter>;
+// The recorder in the pipeline's manager: the 1 kHz topics it throttles come as pointers on the shared thread
+// instead of over TCP to a process of its own (each message sent, and the recorder woken, per step). It
+// closes the bag when the manager unloads it.
+using RecorderNodelet = WrapperNodelet<BagRecorder>;
 
 /// The plant's run() on a thread of its own: in lockstep it only supervises (the torque callback steps);
 /// in realtime it paces the steps and serves the wheel_torque queue. A run that cannot go on (the state
@@ -104,8 +109,16 @@ class PlantSimNodelet : public nodelet::Nodelet {
 
  private:
   void onInit() override {
+    // Its subscriptions (the plan, and traction_control/state once per step, for the no-traction diagnosis)
+    // go on the shared thread too: on the nodelet's own queue each message would be handed from the manager's
+    // dispatcher thread to a worker, two thread wake-ups per step. None of them blocks; the lockstep torque
+    // callback keeps its own inline queue.
+    shared_ = SharedCallbackThread::acquire();
+    ros::NodeHandle nh = getNodeHandle(), pnh = getPrivateNodeHandle();
+    nh.setCallbackQueue(shared_->queue());
+    pnh.setCallbackQueue(shared_->queue());
     try {
-      impl_ = std::make_unique<PlantSim>(getNodeHandle(), getPrivateNodeHandle());
+      impl_ = std::make_unique<PlantSim>(nh, pnh);
     } catch (const NodeFailure& failure) {
       logFailure(getName(), failure);  // as WrapperNodelet: logged, and the loader unloads it
       throw;
@@ -120,6 +133,7 @@ class PlantSimNodelet : public nodelet::Nodelet {
       if (impl_->exitAtEnd()) ros::shutdown();
     });
   }
+  std::shared_ptr<SharedCallbackThread> shared_;  // before impl_: outlives its subscriptions
   std::unique_ptr<PlantSim> impl_;
   std::thread thread_;
 };
@@ -134,3 +148,4 @@ PLUGINLIB_EXPORT_CLASS(sowing_robot::RunMonitorNodelet, nodelet::Nodelet)
 PLUGINLIB_EXPORT_CLASS(sowing_robot::SeedDrillNodelet, nodelet::Nodelet)
 PLUGINLIB_EXPORT_CLASS(sowing_robot::StateEstimatorNodelet, nodelet::Nodelet)
 PLUGINLIB_EXPORT_CLASS(sowing_robot::CmdVelLimiterNodelet, nodelet::Nodelet)
+PLUGINLIB_EXPORT_CLASS(sowing_robot::RecorderNodelet, nodelet::Nodelet)

@@ -77,6 +77,23 @@ class RecordLean(unittest.TestCase):
                     self.assertThrottled(bag, topic, 3.0)
                     self.assertThrottled(bag, "/ground_truth", 3.0)
 
+    def test_nodelet_recorder(self):
+        """nodelets:=true loads the recorder into the pipeline's manager (sim.launch): in stamp order its lean bag
+        holds the same messages, bit for bit, as the recorder process's of the same run as processes, and two such
+        runs give the same file."""
+        def messages(path):
+            with rosbag.Bag(path) as bag:
+                return [(topic, t.to_nsec(), bytes(raw[1])) for topic, raw, t in bag.read_messages(raw=True)]
+        # record_log:=false: a log line names its node (the manager or the process) and reaches the recorder
+        # through rosout, whenever it comes
+        runs = [self.run_lean(port, 3.0, "record_deterministic:=true", "record_log:=false", "nodelets:=" + form)
+                for port, form in ((11694, "false"), (11695, "true"), (11696, "true"))]
+        processes, nodelets = messages(runs[0]), messages(runs[1])
+        self.assertGreater(len(nodelets), 100)
+        self.assertEqual(nodelets, processes)
+        with open(runs[1], "rb") as a, open(runs[2], "rb") as b:
+            self.assertTrue(a.read() == b.read(), "two nodelet runs' lean bags differ")
+
 
 if __name__ == "__main__":
     rostest.rosrun("sowing_robot", "record_lean_test", RecordLean)
