@@ -253,7 +253,7 @@ py::dict runEstimatedPy(const std::string& controller, const py::object& params,
   d["governor_min_rate"] = r.governor_min_rate;
   if (trace) d["trace"] = columns.toDict();
   d["seeds"] = seedsDict(seeds.seeds());
-  d["seed_figures"] = seedFiguresDict(seedFigures(seeds.seeds(), seeds.drill()));
+  d["seed_figures"] = seedFiguresDict(seedFigures(seeds.seeds(), seeds.drill(), &seeds.passes()));
   return d;
 }
 

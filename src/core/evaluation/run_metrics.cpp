@@ -151,6 +151,23 @@ std::vector<RunMetric> buildMetrics() {
   m->report_table = m->compared = true;
   m = add("map_error_p95", "m", "seed-map error p95", "p95 of |believed - true seed position|",
           &SeedFigures::map_error_p95);
+  // Where the unsown length lies and why (seed_metrics.h): summed over the rows, outside obstacle stretches.
+  m = add("unsown_row_start", "m", "unsown at row starts",
+          "unsown row before each row's first seed (a seedless row: all)", &SeedFigures::unsown_start);
+  m->report_table = true;
+  m = add("unsown_row_end", "m", "unsown at row ends", "unsown row after each row's last seed",
+          &SeedFigures::unsown_end);
+  m->report_table = true;
+  m = add("unsown_mid_row", "m", "unsown mid-row", "unsown row between seeds", &SeedFigures::unsown_mid);
+  m->report_table = true;
+  m = add("unsown_held_up", "m", "unsown, hitch up",
+          "unsown row the tool point passed with the hitch holding the drill up", &SeedFigures::unsown_held_up);
+  m = add("unsown_not_engaged", "m", "unsown, not engaged",
+          "unsown row the tool point passed with the drill asked for but not yet lowered (engage_distance)",
+          &SeedFigures::unsown_not_engaged);
+  m = add("unsown_not_asked", "m", "unsown, not asked",
+          "unsown row the tool point passed with the plan not asking for the drill (approach, turn)",
+          &SeedFigures::unsown_not_asked);
   m = add("success", "bool", "success",
           "not diverged, no contact, finished, and the scenario's rule: sown (the seed record's figures within the "
           "scenario's bounds) or tracking (|cross-track| below the threshold from settle_time on)",

@@ -43,6 +43,29 @@ double overlap(const std::vector<Interval>& a, const std::vector<Interval>& b) {
   return sum;
 }
 
+/// a less the stretches of b (both merged).
+std::vector<Interval> subtract(const std::vector<Interval>& a, const std::vector<Interval>& b) {
+  std::vector<Interval> out;
+  for (Interval x : a) {
+    for (const Interval& y : b) {
+      if (y.second <= x.first || y.first >= x.second) continue;
+      if (y.first > x.first) out.push_back({x.first, y.first});
+      x.first = std::max(x.first, y.second);
+      if (!(x.second > x.first)) break;
+    }
+    if (x.second > x.first) out.push_back(x);
+  }
+  return out;
+}
+
+/// The merged stretches of `row` the tool point passed over in `state`.
+std::vector<Interval> passedIn(const std::vector<RowPass>& passes, std::size_t row, DrillState state, double length) {
+  std::vector<Interval> v;
+  for (const RowPass& p : passes)
+    if (p.row == static_cast<int>(row) && p.state == state) v.push_back({p.from, p.to});
+  return mergeIntervals(std::move(v), length);
+}
+
 /// The stretches of row r (along-row coordinate in [0, length]) that an obstacle blocks (SeedDrill::blockedRadius).
 std::vector<Interval> obstacleStretches(const RowSegment& r, const SeedDrill& plan) {
   const Eigen::Vector2d d = r.b - r.a;
@@ -98,9 +121,15 @@ SeedFigures::SeedFigures()
       lateral_max(kNaN),
       depth_outside(kNaN),
       map_error_rms(kNaN),
-      map_error_p95(kNaN) {}
+      map_error_p95(kNaN),
+      unsown_start(kNaN),
+      unsown_end(kNaN),
+      unsown_mid(kNaN),
+      unsown_held_up(kNaN),
+      unsown_not_engaged(kNaN),
+      unsown_not_asked(kNaN) {}
 
-SeedFigures seedFigures(const std::vector<Seed>& seeds, const SeedDrill& plan) {
+SeedFigures seedFigures(const std::vector<Seed>& seeds, const SeedDrill& plan, const std::vector<RowPass>* passes) {
   SeedFigures f;
   f.seeds = seeds.size();
   const double spacing = plan.params().spacing;
@@ -119,6 +148,7 @@ SeedFigures seedFigures(const std::vector<Seed>& seeds, const SeedDrill& plan) {
     if (!s.detour) lateral.push_back(std::fabs(u.x() * (s.truth - r.a).y() - u.y() * (s.truth - r.a).x()));
   }
   double length = 0.0, sown = 0.0, detour_length = 0.0, detour_sown = 0.0;
+  double unsown_start = 0.0, unsown_end = 0.0, unsown_mid = 0.0, held_up = 0.0, not_engaged = 0.0, not_asked = 0.0;
   std::size_t spacings = 0, multiples = 0, misses = 0;
   std::vector<double> accepted;
   for (std::size_t i = 0; i < rows.size(); ++i) {
@@ -137,6 +167,23 @@ SeedFigures seedFigures(const std::vector<Seed>& seeds, const SeedDrill& plan) {
     rs.length = row_length - rs.detour_length;
     rs.detour_sown = overlap(covered, detours);
     rs.sown = totalLength(covered) - rs.detour_sown;
+    // Where the unsown length lies: before the first seed's stretch, after the last one's, between.
+    const std::vector<Interval> unsown = subtract(subtract({{0.0, row_length}}, covered), detours);
+    const double first = covered.empty() ? row_length : covered.front().first;
+    const double last = covered.empty() ? row_length : covered.back().second;
+    rs.unsown_start = overlap(unsown, {{0.0, first}});
+    rs.unsown_end = overlap(unsown, {{last, row_length}});
+    unsown_start += rs.unsown_start;
+    unsown_end += rs.unsown_end;
+    unsown_mid += std::max(0.0, totalLength(unsown) - rs.unsown_start - rs.unsown_end);
+    if (passes != nullptr) {  // why, in this order: the hitch, the engage rule, the plan
+      const std::vector<Interval> held = passedIn(*passes, i, DrillState::held_up, row_length);
+      const std::vector<Interval> waiting = passedIn(*passes, i, DrillState::not_engaged, row_length);
+      held_up += overlap(unsown, held);
+      const std::vector<Interval> rest = subtract(unsown, held);
+      not_engaged += overlap(rest, waiting);
+      not_asked += overlap(subtract(rest, waiting), passedIn(*passes, i, DrillState::not_asked, row_length));
+    }
     f.rows.push_back(rs);
     length += rs.length;
     sown += rs.sown;
@@ -160,6 +207,14 @@ SeedFigures seedFigures(const std::vector<Seed>& seeds, const SeedDrill& plan) {
     f.worst_row_share = 1.0;
     for (const RowSowing& r : f.rows) f.worst_row_share = std::min(f.worst_row_share, r.share());
     if (detour_length > 0.0) f.detour_sown_share = detour_sown / detour_length;
+    f.unsown_start = unsown_start;
+    f.unsown_end = unsown_end;
+    f.unsown_mid = unsown_mid;
+    if (passes != nullptr) {
+      f.unsown_held_up = held_up;
+      f.unsown_not_engaged = not_engaged;
+      f.unsown_not_asked = not_asked;
+    }
   }
   if (spacings > 0) {
     f.multiples = 100.0 * static_cast<double>(multiples) / static_cast<double>(spacings);

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "sowing_robot/core/evaluation/seed_metrics.h"
+#include "sowing_robot/core/simulation/seed_recorder.h"
 
 using namespace sowing_robot::core;
 
@@ -181,4 +182,67 @@ TEST(SeedMetrics, SeedsFromTheDrillItselfSowTheRow) {
   EXPECT_NEAR(f.quality_of_feed, 100.0, 1e-9);
   EXPECT_EQ(seeds.front().row, 0);
   EXPECT_DOUBLE_EQ(seeds.back().t + 5e-4, seeds.back().truth.x());
+}
+
+TEST(SeedMetrics, UnsownLengthIsLocatedAtTheRowsStartEndAndBetweenSeeds) {
+  const SeedDrill d = plan();
+  std::vector<Seed> seeds;
+  sow(seeds, d, 1.0, 4.05, 0.1);  // 1.0 .. 4.0
+  sow(seeds, d, 7.0, 9.05, 0.1);  // 7.0 .. 9.0
+  const SeedFigures f = seedFigures(seeds, d);
+  // Sown [0.95, 4.05] and [6.95, 9.05].
+  EXPECT_NEAR(f.unsown_start, 0.95, 1e-9);
+  EXPECT_NEAR(f.unsown_end, 0.95, 1e-9);
+  EXPECT_NEAR(f.unsown_mid, 2.9, 1e-9);
+  EXPECT_NEAR(f.rows[0].unsown_start, 0.95, 1e-9);
+  EXPECT_NEAR(f.rows[0].unsown_end, 0.95, 1e-9);
+  EXPECT_TRUE(std::isnan(f.unsown_held_up));  // no passes: the causes are not known
+  EXPECT_TRUE(std::isnan(f.unsown_not_engaged));
+  EXPECT_TRUE(std::isnan(f.unsown_not_asked));
+  // A row without a seed is unsown at its start, all of it.
+  EXPECT_NEAR(seedFigures({}, d).unsown_start, 10.0, 1e-9);
+}
+
+TEST(SeedMetrics, UnsownLengthIsPutDownToTheDrillsStateWhereTheToolPointPassed) {
+  const SeedDrill d = plan();
+  std::vector<Seed> seeds;
+  sow(seeds, d, 1.0, 4.05, 0.1);
+  sow(seeds, d, 7.0, 9.05, 0.1);
+  const std::vector<RowPass> passes{{0, DrillState::not_asked, 0.0, 0.5},    {0, DrillState::not_engaged, 0.5, 0.95},
+                                    {0, DrillState::down, 0.95, 4.05},       {0, DrillState::held_up, 4.05, 6.0},
+                                    {0, DrillState::not_engaged, 6.0, 6.95}, {0, DrillState::down, 6.95, 9.5}};
+  const SeedFigures f = seedFigures(seeds, d, &passes);
+  EXPECT_NEAR(f.unsown_held_up, 1.95, 1e-9);
+  EXPECT_NEAR(f.unsown_not_engaged, 0.45 + 0.95, 1e-9);
+  EXPECT_NEAR(f.unsown_not_asked, 0.5, 1e-9);
+  // The rest: passed with the drill down [9.05, 9.5] and never passed [9.5, 10].
+  EXPECT_NEAR(
+      f.unsown_start + f.unsown_end + f.unsown_mid - f.unsown_held_up - f.unsown_not_engaged - f.unsown_not_asked, 0.95,
+      1e-9);
+  // The hitch comes first where passes of several states overlap.
+  const std::vector<RowPass> both{{0, DrillState::not_engaged, 4.0, 7.0}, {0, DrillState::held_up, 4.05, 6.0}};
+  const SeedFigures g = seedFigures(seeds, d, &both);
+  EXPECT_NEAR(g.unsown_held_up, 1.95, 1e-9);
+  EXPECT_NEAR(g.unsown_not_engaged, 0.95, 1e-9);
+}
+
+TEST(SeedMetrics, TheRecordersPassesShowTheDrillWaitingForTheRowsLine) {
+  // The tool point (the robot's, with the tool at its axle) 2 cm beside the row until x = 2, then on its line; the
+  // plan asks for the drill from x = 0.5. The drill is lowered only at x = 2 (engage_distance 1 cm).
+  SeedRecorder record(plan(), Eigen::Vector2d::Zero());
+  State x = State::Zero();
+  Reference ref;
+  for (int i = -1000; i <= 11000; ++i) {
+    x[X] = i * 1e-3 + 5e-4;
+    x[Y] = x[X] < 2.0 ? 3.02 : 3.0;
+    ref.tool_down = x[X] >= 0.5;
+    record.add(LoopSample{i * 1e-3, &x, &ref, nullptr, nullptr, 0.0, 0.0, 0.0, 0.0, 0.0});
+  }
+  const SeedFigures f = seedFigures(record.seeds(), record.drill(), &record.passes());
+  // The first seed a spacing after the drill is lowered, less the tool point's 2 cm step onto the line (travel).
+  EXPECT_NEAR(f.unsown_start, 2.03, 2e-3);
+  EXPECT_NEAR(f.unsown_not_asked, 0.5, 2e-3);
+  EXPECT_NEAR(f.unsown_not_engaged, 1.5, 2e-3);
+  EXPECT_NEAR(f.unsown_held_up, 0.0, 1e-12);
+  EXPECT_NEAR(f.unsown_mid, 0.0, 1e-9);
 }

@@ -125,7 +125,7 @@ class RowMeter {
       row_.failure = "contact";
     }
     if (seeds_) {
-      row_.seed_figures = seedFigures(seeds_->seeds(), seeds_->drill());
+      row_.seed_figures = seedFigures(seeds_->seeds(), seeds_->drill(), &seeds_->passes());
       if (extras_.keep_seeds) row_.seed_record = seeds_->takeSeeds();
     }
     if (row_.failure.empty()) {

@@ -31,6 +31,9 @@ struct RowSowing {
   double sown = 0.0;           ///< of which sown
   double detour_length = 0.0;  ///< the row's length inside obstacle stretches
   double detour_sown = 0.0;    ///< of which sown (by seeds projected onto it)
+  /// Of the unsown length outside obstacle stretches: before the first seed's stretch (the whole row without a
+  /// seed) and after the last seed's; the rest lies between seeds (mid-row).
+  double unsown_start = 0.0, unsown_end = 0.0;
   double share() const { return length > 0.0 ? sown / length : 1.0; }
 };
 
@@ -45,14 +48,24 @@ struct SeedFigures {
   double lateral_rms, lateral_p95, lateral_max;          ///< seeds outside detour zones, from their row's line [m]
   double depth_outside;                                  ///< share of the seeds outside [depth_min, depth_max]
   double map_error_rms, map_error_p95;                   ///< |believed - true position| [m]
+  /// Where the rows' unsown length lies, summed over the rows, outside obstacle stretches [m]: before each row's
+  /// first seed (row start), after its last (row end), between seeds (mid-row). NaN without rows.
+  double unsown_start, unsown_end, unsown_mid;
+  /// Why, where the tool point's passes are known (the seed recorder's RowPass; NaN without): unsown length the tool
+  /// point passed over with the drill held up by the hitch; else asked for but not yet engaged (engage_distance);
+  /// else not asked for by the plan [m]. The rest was passed with the drill down (the spacing before a lowered
+  /// drill's first seed) or never passed over.
+  double unsown_held_up, unsown_not_engaged, unsown_not_asked;
   SeedFigures();
 };
 
 /// Consecutive seeds at most this many spacings apart sow the stretch between them.
 constexpr double kSownGap = 1.5;
 
-/// The figures of `seeds` sown against `plan` (its rows, obstacles, spacing and depth band).
-SeedFigures seedFigures(const std::vector<Seed>& seeds, const SeedDrill& plan);
+/// The figures of `seeds` sown against `plan` (its rows, obstacles, spacing and depth band); `passes` (the seed
+/// recorder's, optional) puts the unsown length down to the drill's state.
+SeedFigures seedFigures(const std::vector<Seed>& seeds, const SeedDrill& plan,
+                        const std::vector<RowPass>* passes = nullptr);
 
 }  // namespace core
 }  // namespace sowing_robot

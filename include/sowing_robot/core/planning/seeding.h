@@ -51,6 +51,19 @@ struct Seed {
   bool detour = false;                                 ///< in an obstacle's detour zone (SeedDrill::inDetour)
 };
 
+/// The drill's state where the tool point passed over a row: what a row's unsown stretches are put down to
+/// (seedFigures). held_up: the hitch held the drill up; not_engaged: the plan asked for it but the drill was not yet
+/// lowered (the tool point not within engage_distance of the row's line since it was last lifted); not_asked: the
+/// plan did not ask for it (the approach, a headland turn).
+enum class DrillState { down, held_up, not_engaged, not_asked };
+
+/// A stretch of a row the tool point passed over in one drill state, along the row from its start [m].
+struct RowPass {
+  int row = -1;
+  DrillState state = DrillState::down;
+  double from = 0.0, to = 0.0;
+};
+
 /// Cross-track figures of a set of seeds [m].
 struct SeedStats {
   std::size_t count = 0;
@@ -112,6 +125,8 @@ class SeedDrill {
   const SeedStats& detours() const { return detour_stats_; }  ///< seeds in detour zones
   std::string report() const;
   std::size_t rejected() const { return rejected_; }
+  /// The drill is down (lowered by update() and not lifted since).
+  bool lowered() const { return lowered_; }
 
  private:
   void score(SeedStats& s, double& sum_sq, std::size_t& over, double e);

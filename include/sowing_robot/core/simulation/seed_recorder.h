@@ -7,6 +7,7 @@
 // Used by the benchmark's rows (RowMeter), hence the tuner, and by the Python module: one record, one rule.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
 #include <vector>
@@ -43,6 +44,9 @@ class SeedRecorder {
   }
 
   const std::vector<Seed>& seeds() const { return seeds_; }
+  /// Where the tool point passed over the rows and in which drill state (consecutive periods merged): what the
+  /// seed figures put the unsown stretches down to.
+  const std::vector<RowPass>& passes() const { return passes_; }
   std::vector<Seed> takeSeeds() { return std::move(seeds_); }
   const SeedDrill& drill() const { return drill_; }
 
@@ -55,12 +59,46 @@ class SeedRecorder {
             double depth) {
     Seed seed;
     if (drill_.drop(t, truth, believed, tool_down, held_up, depth, seed)) seeds_.push_back(seed);
+    pass(truth, tool_down, held_up);
+  }
+  /// The tool point's pass over its nearest row, between the row's ends, in the drill's state after this period.
+  void pass(const Eigen::Vector2d& p, bool tool_down, bool held_up) {
+    const int row = p.allFinite() ? drill_.nearestRow(p) : -1;
+    if (row < 0) {
+      passing_ = false;
+      return;
+    }
+    const RowSegment& r = drill_.rows()[static_cast<std::size_t>(row)];
+    const double length = (r.b - r.a).norm();
+    const double along = length > 0.0 ? (p - r.a).dot(r.b - r.a) / length : 0.0;
+    if (!(along > 0.0 && along < length)) {
+      passing_ = false;
+      return;
+    }
+    const DrillState state = held_up            ? DrillState::held_up
+                             : drill_.lowered() ? DrillState::down
+                             : tool_down        ? DrillState::not_engaged
+                                                : DrillState::not_asked;
+    const bool same_row = passing_ && passes_.back().row == row;
+    if (same_row && passes_.back().state == state) {
+      passes_.back().from = std::min(passes_.back().from, along);
+      passes_.back().to = std::max(passes_.back().to, along);
+    } else {  // from the last period's point on, so that consecutive passes leave no gap between them
+      const double from = same_row ? std::min(last_along_, along) : along;
+      const double to = same_row ? std::max(last_along_, along) : along;
+      passes_.push_back({row, state, from, to});
+    }
+    passing_ = true;
+    last_along_ = along;
   }
 
   SeedDrill drill_;
   Eigen::Vector2d tool_;
   double depth_;
   std::vector<Seed> seeds_;
+  std::vector<RowPass> passes_;
+  bool passing_ = false;  // the last period's tool point was over a row (passes_.back())
+  double last_along_ = 0.0;
 };
 
 }  // namespace core
