@@ -67,7 +67,7 @@ class SensorSuite {
   /// The gyro's last reading [rad/s].
   double yawRate() const { return yaw_rate_; }
   /// The fixes whose latency has passed by t (each once).
-  std::vector<FixMeasurement> dueFixes(double t) { return fix_.due(t); }
+  const std::vector<FixMeasurement>& dueFixes(double t) { return fix_.due(t); }
 
  private:
   static Pose2D pose(const State& s) { return {s[X], s[Y], s[THETA]}; }
