@@ -85,6 +85,7 @@ const char* fixOutcomeName(FixOutcome o) {
 Ekf::Ekf(const EkfParams& params, double half_track) : params_(params), half_track_(half_track) {
   const std::string error = params.validate();
   if (!error.empty()) throw std::invalid_argument(error);
+  history_.set_capacity(static_cast<std::size_t>(params.history_length));
   if (params.slip.detect) detector_.emplace(params.slip, half_track);  // throws for a bad half track
 }
 
@@ -213,6 +214,17 @@ void Ekf::reanchor(const EkfFix& fix, Vector& mean, Matrix& cov) {
   cov.topLeftCorner<2, 2>() = fix.covariance;
 }
 
+void Ekf::append(const Entry& e) {
+  if (!history_.full()) {
+    history_.push_back(e);
+    return;
+  }
+  // The oldest entry becomes the newest (constant time on a full ring) and is overwritten: its fixes' vector
+  // keeps its storage, so a step allocates nothing.
+  history_.rotate(history_.begin() + 1);
+  history_.back() = e;
+}
+
 bool Ekf::predict(double t, const EkfStepInput& in) {
   if (history_.empty() || !std::isfinite(t) || !(t > time())) return false;
   if (!allFinite(in.distance, in.dtheta, in.rate, in.rate_variance) || !finiteMatrix(in.covariance)) return false;
@@ -225,8 +237,7 @@ bool Ekf::predict(double t, const EkfStepInput& in) {
   propagate(params_, t - time(), e.input, e.mean, e.cov);
   pinBias(e.mean, e.cov);
   if (!e.mean.allFinite() || !e.cov.allFinite()) return false;
-  history_.push_back(std::move(e));
-  while (history_.size() > static_cast<std::size_t>(params_.history_length)) history_.pop_front();
+  append(e);
   return true;
 }
 
@@ -338,8 +349,7 @@ bool Ekf::predictSlipAware(double t, const EkfStepInput& in) {
   if (regained & SLIP_LEFT) e.inflation(2) += open;
   stepSlipAware(last, e);
   if (!e.smean.allFinite() || !e.scov.allFinite()) return false;
-  history_.push_back(std::move(e));
-  while (history_.size() > static_cast<std::size_t>(params_.history_length)) history_.pop_front();
+  append(e);
   if (onset != SLIP_NONE) {
     // Found with the averages' delay: the wheel broke loose kSlipLookback windows before.
     std::size_t k = history_.size() - 1;
@@ -440,13 +450,13 @@ void FixQueue::push(const EkfFix& fix) {
   fixes_.insert(it, fix);
 }
 
-std::vector<EkfFix> FixQueue::due(double t) {
-  std::vector<EkfFix> out;
+const std::vector<EkfFix>& FixQueue::due(double t) {
+  due_.clear();  // its storage kept: no allocation per call
   while (!fixes_.empty() && fixes_.front().stamp + delay_ <= t + kStampTolerance) {
-    out.push_back(fixes_.front());
+    due_.push_back(fixes_.front());
     fixes_.pop_front();
   }
-  return out;
+  return due_;
 }
 
 }  // namespace core

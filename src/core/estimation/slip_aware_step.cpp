@@ -20,32 +20,103 @@ using Rows = Eigen::Matrix<double, Eigen::Dynamic, 10, Eigen::RowMajor, 3, 10>;
 using Column = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 3, 1>;
 using Square = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 3, 3>;
 
+/// S^-1 as Eigen inverts a matrix of run-time size (LU with partial pivoting), on the fixed size: the same
+/// algorithm, so the same result to the bit, without the blocked triangular solves a run-time size takes.
+template <int N>
+Square inverseOfSize(const Square& s) {
+  return Eigen::PartialPivLU<Eigen::Matrix<double, N, N>>(Eigen::Matrix<double, N, N>(s)).inverse();
+}
+
+Square inverse(const Square& s) {
+  switch (s.rows()) {
+    case 1: return inverseOfSize<1>(s);
+    case 2: return inverseOfSize<2>(s);
+    default: return inverseOfSize<3>(s);
+  }
+}
+
 /// One exact Kalman update of the augmented vector by the linear measurements z = H a + e, e ~ N(0, R),
 /// with the optimal gain: P - K S K^T, symmetrised (the cheaper form; the fix update, whose gain may be
 /// a consider gain, keeps Joseph's).
+/// P H^T and K (P H^T)^T are written out: Eigen sends these sizes to its blocked matrix product, whose
+/// packing and dispatch cost more than the arithmetic. Each element is summed as that product sums it
+/// (from 0.0, over the inner index in order, no FMA), so the results are the same to the bit.
 void kalmanUpdate(Vector10& a, Matrix10& p, const Rows& h, const Column& z, const Square& r) {
-  const Eigen::Matrix<double, 10, Eigen::Dynamic, 0, 10, 3> ph = p * h.transpose();
+  const Eigen::Index n = h.rows();
+  Eigen::Matrix<double, 10, Eigen::Dynamic, 0, 10, 3> ph(10, n);
+  for (Eigen::Index j = 0; j < n; ++j) {
+    Vector10 sum = Vector10::Zero();
+    for (int m = 0; m < 10; ++m) sum += p.col(m) * h(j, m);
+    ph.col(j) = sum;
+  }
   const Square s = h * ph + r;
-  const Eigen::Matrix<double, 10, Eigen::Dynamic, 0, 10, 3> k = ph * s.inverse();
+  const Eigen::Matrix<double, 10, Eigen::Dynamic, 0, 10, 3> k = ph * inverse(s);
   a += k * (z - h * a);
-  p -= k * ph.transpose();
+  for (int j = 0; j < 10; ++j) {
+    Vector10 sum = Vector10::Zero();
+    for (Eigen::Index m = 0; m < n; ++m) sum += k.col(m) * ph(j, m);
+    p.col(j) -= sum;
+  }
   p = 0.5 * (p + p.transpose()).eval();
+}
+
+/// cov := F pa F^T for F = slipAwareJacobian: its structure written out (the identity but for the rows and
+/// columns of x, y and theta), each element summed as Eigen's matrix product sums it (from 0.0, over the
+/// inner index in order, leaving out F's zeros, which add nothing to a sum started at 0.0), so the result
+/// is the same to the bit.
+void propagateCovariance(const Matrix10& pa, const Eigen::Matrix<double, 7, 10>& f, SlipMatrix& cov) {
+  using Row10 = Eigen::Matrix<double, 1, 10>;
+  const Row10 fx = f.row(Ekf::X), fy = f.row(Ekf::Y);
+  const Row10 zero = Row10::Zero();
+  Eigen::Matrix<double, 7, 10> g;  // F pa
+  g.row(Ekf::X) = (((((zero + pa.row(Ekf::X)) + fx(Ekf::THETA) * pa.row(Ekf::THETA)) + fx(kSpeed) * pa.row(kSpeed)) +
+                    fx(DW) * pa.row(DW)) +
+                   fx(NU) * pa.row(NU)) +
+                  fx(ND) * pa.row(ND);
+  g.row(Ekf::Y) = (((((zero + pa.row(Ekf::Y)) + fy(Ekf::THETA) * pa.row(Ekf::THETA)) + fy(kSpeed) * pa.row(kSpeed)) +
+                    fy(DW) * pa.row(DW)) +
+                   fy(NU) * pa.row(NU)) +
+                  fy(ND) * pa.row(ND);
+  g.row(Ekf::THETA) = ((zero + pa.row(Ekf::THETA)) + pa.row(DW)) + pa.row(ND);
+  for (int i = Ekf::BIAS; i < 7; ++i) g.row(i) = zero + pa.row(i);
+  const SlipVector z7 = SlipVector::Zero();
+  cov.col(Ekf::X) = (((((z7 + g.col(Ekf::X)) + g.col(Ekf::THETA) * fx(Ekf::THETA)) + g.col(kSpeed) * fx(kSpeed)) +
+                      g.col(DW) * fx(DW)) +
+                     g.col(NU) * fx(NU)) +
+                    g.col(ND) * fx(ND);
+  cov.col(Ekf::Y) = (((((z7 + g.col(Ekf::Y)) + g.col(Ekf::THETA) * fy(Ekf::THETA)) + g.col(kSpeed) * fy(kSpeed)) +
+                      g.col(DW) * fy(DW)) +
+                     g.col(NU) * fy(NU)) +
+                    g.col(ND) * fy(ND);
+  cov.col(Ekf::THETA) = ((z7 + g.col(Ekf::THETA)) + g.col(DW)) + g.col(ND);
+  for (int j = Ekf::BIAS; j < 7; ++j) cov.col(j) = z7 + g.col(j);
 }
 
 }  // namespace
 
-SlipVector slipAwareMotion(const Vector10& a, double dt) {
+namespace {
+
+/// What slipAwareMotion and slipAwareJacobian share: the step's travel u, heading change d, midpoint heading
+/// and its sine and cosine (computed once per step).
+struct MotionTerms {
+  double u, d, sin_mid, cos_mid;
+};
+
+MotionTerms motionTerms(const Vector10& a, double dt) {
   const double u = a(kSpeed) * dt + a(NU), d = a(DW) + a(ND), mid = a(Ekf::THETA) + 0.5 * d;
+  return {u, d, std::sin(mid), std::cos(mid)};
+}
+
+SlipVector motionOf(const Vector10& a, const MotionTerms& m) {
   SlipVector s = a.head<7>();
-  s(Ekf::X) += u * std::cos(mid);
-  s(Ekf::Y) += u * std::sin(mid);
-  s(Ekf::THETA) = wrapAngle(a(Ekf::THETA) + d);
+  s(Ekf::X) += m.u * m.cos_mid;
+  s(Ekf::Y) += m.u * m.sin_mid;
+  s(Ekf::THETA) = wrapAngle(a(Ekf::THETA) + m.d);
   return s;
 }
 
-Eigen::Matrix<double, 7, 10> slipAwareJacobian(const Vector10& a, double dt) {
-  const double u = a(kSpeed) * dt + a(NU), d = a(DW) + a(ND), mid = a(Ekf::THETA) + 0.5 * d;
-  const double s = std::sin(mid), c = std::cos(mid);
+Eigen::Matrix<double, 7, 10> jacobianOf(const MotionTerms& m, double dt) {
+  const double u = m.u, s = m.sin_mid, c = m.cos_mid;
   Eigen::Matrix<double, 7, 10> f = Eigen::Matrix<double, 7, 10>::Zero();
   f.leftCols<7>().setIdentity();
   f(Ekf::X, Ekf::THETA) = -u * s;
@@ -58,6 +129,14 @@ Eigen::Matrix<double, 7, 10> slipAwareJacobian(const Vector10& a, double dt) {
   f(Ekf::Y, NU) = s;
   f(Ekf::THETA, DW) = f(Ekf::THETA, ND) = 1.0;
   return f;
+}
+
+}  // namespace
+
+SlipVector slipAwareMotion(const Vector10& a, double dt) { return motionOf(a, motionTerms(a, dt)); }
+
+Eigen::Matrix<double, 7, 10> slipAwareJacobian(const Vector10& a, double dt) {
+  return jacobianOf(motionTerms(a, dt), dt);
 }
 
 void slipAwarePropagate(const EkfParams& p, double L, double dt, const EkfStepInput& in, unsigned loose,
@@ -105,9 +184,9 @@ void slipAwarePropagate(const EkfParams& p, double L, double dt, const EkfStepIn
     }
     kalmanUpdate(a, pa, h, z, r);
   }
-  const Eigen::Matrix<double, 7, 10> f = slipAwareJacobian(a, dt);
-  mean = slipAwareMotion(a, dt);
-  cov = f * pa * f.transpose();
+  const MotionTerms terms = motionTerms(a, dt);
+  mean = motionOf(a, terms);
+  propagateCovariance(pa, jacobianOf(terms, dt), cov);
   if (p.estimate_bias) cov(Ekf::BIAS, Ekf::BIAS) += p.bias_walk * p.bias_walk * dt;
   cov(kSpeed, kSpeed) += sp.speed_walk * sp.speed_walk * dt;
   // A large slip changes fast (a spinning wheel is out of the soil's grip): the slip's walk grows with it.

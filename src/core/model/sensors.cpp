@@ -1,5 +1,6 @@
 #include "sowing_robot/core/model/sensors.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -110,6 +111,7 @@ void EncoderOdometry::reset(const Pose2D& pose, double phi_r, double phi_l) {
   count_r_ = read(phi_r);
   count_l_ = read(phi_l);
   window_.clear();
+  if (window_.full()) window_.set_capacity(16);
   window_.push_back({count_r_, count_l_, 0.0});
   window_time_ = 0.0;
   out_ = Odometry2D{};
@@ -146,6 +148,7 @@ Odometry2D EncoderOdometry::update(double phi_r, double phi_l, double dt) {
   p.theta = wrapAngle(p.theta + dth);
 
   // Velocities over the window: keep the oldest reading at least velocity_window before this one.
+  if (window_.full()) window_.set_capacity(std::max<std::size_t>(16, 2 * window_.capacity()));
   window_.push_back({r, l, dt});
   window_time_ += dt;
   while (window_.size() > 2 && window_time_ - window_[1].dt >= params_.encoder.velocity_window - kTimeTolerance) {
@@ -227,13 +230,13 @@ bool PositionFixSensor::sample(double t, const Pose2D& truth) {
   return true;
 }
 
-std::vector<FixMeasurement> PositionFixSensor::due(double t) {
-  std::vector<FixMeasurement> out;
+const std::vector<FixMeasurement>& PositionFixSensor::due(double t) {
+  due_.clear();  // its storage kept
   while (!pending_.empty() && pending_.front().stamp + params_.fix.latency <= t + kTimeTolerance) {
-    out.push_back(pending_.front());
+    due_.push_back(pending_.front());
     pending_.pop_front();
   }
-  return out;
+  return due_;
 }
 
 }  // namespace core

@@ -54,8 +54,8 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <boost/circular_buffer.hpp>
 #include <cstddef>
-#include <deque>
 #include <optional>
 #include <string>
 #include <vector>
@@ -234,6 +234,8 @@ class Ekf {
     Eigen::Vector3d inflation = Eigen::Vector3d::Zero();
   };
   void pinBias(Vector& mean, Matrix& cov) const;
+  /// e as the newest entry (the oldest dropped when history_length are kept).
+  void append(const Entry& e);
   // The slip-aware filter's pieces.
   bool predictSlipAware(double t, const EkfStepInput& in);
   FixOutcome fuseSlipAware(const EkfFix& fix, std::size_t k);
@@ -252,7 +254,9 @@ class Ekf {
   unsigned slippingAt(const Entry& e) const;
 
   EkfParams params_;
-  std::deque<Entry> history_;
+  // The last history_length entries, oldest first; a ring of that capacity allocated once (a new entry
+  // takes the oldest one's place), not a block per step.
+  boost::circular_buffer<Entry> history_;
   FixCounts counts_;
   int gated_in_a_row_ = 0;  // for fix/reanchor_after
   bool slipping_ = false;   // slip/inflation in force
@@ -265,18 +269,20 @@ class Ekf {
 /// includes depends on the stamps only, not on the order in which the fix and the odometry arrived.
 class FixQueue {
  public:
-  explicit FixQueue(double delay, std::size_t capacity = 64) : delay_(delay), capacity_(capacity) {}
+  explicit FixQueue(double delay, std::size_t capacity = 64) : delay_(delay), capacity_(capacity), fixes_(capacity) {}
   /// Keeps the fix (the oldest goes when full: counted in dropped()).
   void push(const EkfFix& fix);
-  /// The fixes with stamp + delay <= t (1 us tolerance), oldest stamp first, removed from the queue.
-  std::vector<EkfFix> due(double t);
+  /// The fixes with stamp + delay <= t (1 us tolerance), oldest stamp first, removed from the queue. The
+  /// vector is the queue's own, valid until the next call (reused: no allocation per call).
+  const std::vector<EkfFix>& due(double t);
   std::size_t size() const { return fixes_.size(); }
   long dropped() const { return dropped_; }
 
  private:
   double delay_;
   std::size_t capacity_;
-  std::deque<EkfFix> fixes_;
+  boost::circular_buffer<EkfFix> fixes_;  // allocated once at capacity_
+  std::vector<EkfFix> due_;               // due()'s result
   long dropped_ = 0;
 };
 

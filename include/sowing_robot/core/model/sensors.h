@@ -39,6 +39,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <boost/circular_buffer.hpp>
 #include <cstdint>
 #include <deque>
 #include <random>
@@ -139,7 +140,9 @@ class EncoderOdometry {
     std::int64_t r, l;
     double dt;
   };
-  std::deque<Past> window_;   // the counts of the readings within velocity_window, oldest first
+  // The counts of the readings within velocity_window, oldest first: a ring, grown when full (a step
+  // allocates nothing once it holds a window's readings).
+  boost::circular_buffer<Past> window_;
   double window_time_ = 0.0;  // sum of window_'s dt after its first entry
   Odometry2D out_;
 };
@@ -205,8 +208,9 @@ class PositionFixSensor {
   /// The true pose at time t (call every step, t increasing): takes a measurement when one is due.
   /// Returns true when it did (also inside a dropout, where the measurement is then lost).
   bool sample(double t, const Pose2D& truth);
-  /// The measurements delivered by time t (stamp + latency <= t), oldest first; each is returned once.
-  std::vector<FixMeasurement> due(double t);
+  /// The measurements delivered by time t (stamp + latency <= t), oldest first; each is returned once. The
+  /// vector is the sensor's own, valid until the next call (reused: no allocation per call).
+  const std::vector<FixMeasurement>& due(double t);
   /// A stamp inside the dropout window.
   bool inDropout(double stamp) const { return schedule_.inDropout(stamp); }
   std::size_t pending() const { return pending_.size(); }
@@ -224,6 +228,7 @@ class PositionFixSensor {
   std::mt19937_64 rng_;
   std::normal_distribution<double> normal_{0.0, 1.0};
   std::deque<FixMeasurement> pending_;
+  std::vector<FixMeasurement> due_;  // due()'s result
 };
 
 /// The sensors the plant carries, in the order SensorSuite starts and reads them.

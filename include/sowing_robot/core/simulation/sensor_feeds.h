@@ -73,7 +73,7 @@ class SensorSuite {
   /// The gyro's last reading [rad/s].
   double yawRate() const { return sensor<YawRateSensor>().last(); }
   /// The fixes whose latency has passed by t (each once).
-  std::vector<FixMeasurement> dueFixes(double t) { return sensor<PositionFixSensor>().due(t); }
+  const std::vector<FixMeasurement>& dueFixes(double t) { return sensor<PositionFixSensor>().due(t); }
 
  private:
   /// A sensor built from the parameters and the nominal robot when it takes both, else from the parameters.
