@@ -184,7 +184,7 @@ TEST(ScenarioSets, TheTunerRefusesATestScenario) {
       dir.write("tune.yaml",
                 "pso_tuner: {particles: 2, iterations: 0, controller: kanayama+atsmc}\nrobust:\n  training:\n"
                 "    - {scenario: " +
-                    kSuite + "/test/test_beet_marl.yaml, runs: 1, base_seed: 1}\n");
+                    kSuite + "/test/test_polder_clay.yaml, runs: 1, base_seed: 1}\n");
   try {
     scenario_file::loadTuneConfig(config, "", kSource);
     ADD_FAILURE() << "a test scenario was accepted for training";
