@@ -66,13 +66,10 @@ void run(const char* name, const FieldBoundary& field, const CoverageParams& par
   std::printf("  rows %.0f m: the swaths' %.0f m, %zu headland rows %.0f m; the rows' area %.0f m^2\n",
               swath_rows + headland_rows, swath_rows, plan.headland_rows.size(), headland_rows, f.row_area);
   std::printf(
-      "  path %.0f m, of it turns (tool up) %.0f m, of those joins (between parts, onto the loops) %.0f m; peak "
-      "curvature %.3f 1/m (bound %.3f), peak dkappa/ds %.2f 1/m^2 (bound %.2f), straight joins %d\n",
-      f.path_length, f.turn_length, f.join_length, plan.peak_curvature, 1.0 / params.min_turn_radius,
-      plan.peak_curvature_rate, params.max_curvature_rate, plan.straight_joins);
-  std::printf("  joins across the inner field %d, outside the field %d; route check: %s\n", plan.joins_across,
-              plan.joins_outside,
-              plan.route_error.empty() ? "inside the boundary, out of the voids" : plan.route_error.c_str());
+      "  path %.0f m, of it turns (tool up) %.0f m; peak curvature %.3f 1/m (bound %.3f), peak dkappa/ds "
+      "%.2f 1/m^2 (bound %.2f), straight joins %d\n",
+      f.path_length, f.turn_length, plan.peak_curvature, 1.0 / params.min_turn_radius, plan.peak_curvature_rate,
+      params.max_curvature_rate, plan.straight_joins);
 }
 
 using Clock = std::chrono::steady_clock;

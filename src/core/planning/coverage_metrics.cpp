@@ -82,7 +82,6 @@ CoverageFigures coverageFigures(const FieldBoundary& field, const CoveragePlan& 
   f.swaths = static_cast<int>(plan.swaths.size());
   f.path_length = plan.path_length;
   f.turn_length = plan.turn_length;
-  f.join_length = plan.join_length;
   return f;
 }
 

@@ -8,10 +8,8 @@
 #include <array>
 #include <cmath>
 #include <cstdlib>
-#include <functional>
 #include <limits>
 #include <map>
-#include <memory>
 #include <stdexcept>
 #include <utility>
 
@@ -276,40 +274,7 @@ class RouteBuilder {
     path.points = {p};
     path.tool_down.clear();
   }
-
-  /// The route so far, to be returned to when a tried join is not taken.
-  struct Mark {
-    std::size_t points = 0;
-    double length = 0.0, up_length = 0.0, peak_kappa = 0.0, peak_rate = 0.0;
-    int straight_joins = 0;
-  };
-  Mark mark() const { return {path.points.size(), length, up_length, peak_kappa, peak_rate, straight_joins}; }
-  void rollback(const Mark& m) {
-    path.points.resize(m.points);
-    path.tool_down.resize(m.points - 1);
-    length = m.length;
-    up_length = m.up_length;
-    peak_kappa = m.peak_kappa;
-    peak_rate = m.peak_rate;
-    straight_joins = m.straight_joins;
-  }
   const Eigen::Vector2d& last() const { return path.points.back(); }
-  /// Tool-up points driven before (a join tried and kept): appended with their length and the peaks they reached.
-  void appendUp(const std::vector<Eigen::Vector2d>& pts, double len, double kappa, double rate) {
-    for (const Eigen::Vector2d& p : pts) {
-      path.points.push_back(p);
-      path.tool_down.push_back(false);
-    }
-    length += len;
-    up_length += len;
-    peak_kappa = std::max(peak_kappa, kappa);
-    peak_rate = std::max(peak_rate, rate);
-  }
-  /// For a tried piece only (rolled back after): the route jumps to p, no length counted.
-  void jumpTo(const Eigen::Vector2d& p) {
-    path.points.push_back(p);
-    path.tool_down.push_back(false);
-  }
   void lineTo(const Eigen::Vector2d& p, bool tool) {
     const double d = (p - last()).norm();
     if (d < 1e-9) return;
@@ -450,31 +415,20 @@ class RouteBuilder {
           const double phi = 2.0 * M_PI * i / kTable;
           const double f = residual(phi, false, st, len, phi2);
           if ((prev_f <= 0.0) != (f <= 0.0) && st > -1.0) {
-            // Regula falsi (Illinois) on the exact residual within the table's step, which brackets the root: a few
-            // exact evaluations where bisection took forty (each integrates both turns). A sign change across phi2's
-            // wrap is not a root (checked below).
+            // Bisection on the exact residual; a sign change across phi2's wrap is not a root (checked below).
             double lo = prev_phi, hi = phi;
-            double flo = residual(lo, true, st, len, phi2), fhi = residual(hi, true, st, len, phi2);
-            double phi1 = 0.5 * (lo + hi);
-            int side = 0;
-            for (int it = 0; it < 60 && hi - lo > 1e-12; ++it) {
-              const bool bracketed = (flo <= 0.0) != (fhi <= 0.0) && flo != fhi;
-              phi1 = bracketed ? (lo * fhi - hi * flo) / (fhi - flo) : 0.5 * (lo + hi);
-              if (!(phi1 > lo && phi1 < hi)) phi1 = 0.5 * (lo + hi);
-              const double fm = residual(phi1, true, st, len, phi2);
-              if (std::fabs(fm) < 1e-12) break;
+            double flo = residual(lo, true, st, len, phi2);
+            for (int it = 0; it < 40; ++it) {
+              const double mid = 0.5 * (lo + hi);
+              const double fm = residual(mid, true, st, len, phi2);
               if ((fm <= 0.0) == (flo <= 0.0)) {
-                lo = phi1;
+                lo = mid;
                 flo = fm;
-                if (side == -1) fhi *= 0.5;
-                side = -1;
               } else {
-                hi = phi1;
-                fhi = fm;
-                if (side == 1) flo *= 0.5;
-                side = 1;
+                hi = mid;
               }
             }
+            const double phi1 = 0.5 * (lo + hi);
             const double fr = residual(phi1, true, st, len, phi2);
             if (std::fabs(fr) < 1e-6 && st >= -1e-9 && len < best.length) {
               best.phi1 = phi1;
@@ -664,309 +618,6 @@ std::vector<Ring> ringsOf(const geo::MultiPolygon& mp) {
   return out;
 }
 
-/// A headland ring to drive along: its points (closed, no repeat) and their arc lengths.
-class TravelRing {
- public:
-  explicit TravelRing(Ring r) : pts_(std::move(r)) {
-    cum_.push_back(0.0);
-    for (std::size_t i = 0; i < pts_.size(); ++i) cum_.push_back(cum_.back() + (next(i) - pts_[i]).norm());
-  }
-  const Ring& points() const { return pts_; }
-  double perimeter() const { return cum_.back(); }
-  double arcOf(std::size_t i) const { return cum_[i]; }
-  double wrap(double s) const {
-    s = std::fmod(s, perimeter());
-    return s < 0.0 ? s + perimeter() : s;
-  }
-  /// The ring's point nearest p: its arc length and distance.
-  void project(const Eigen::Vector2d& p, double& s, double& dist) const {
-    dist = std::numeric_limits<double>::infinity();
-    for (std::size_t i = 0; i < pts_.size(); ++i) {
-      const Eigen::Vector2d d = next(i) - pts_[i];
-      const double len2 = d.squaredNorm();
-      const double t = len2 > 0.0 ? std::clamp((p - pts_[i]).dot(d) / len2, 0.0, 1.0) : 0.0;
-      const double e = (pts_[i] + t * d - p).norm();
-      if (e < dist) {
-        dist = e;
-        s = cum_[i] + t * std::sqrt(len2);
-      }
-    }
-  }
-  /// The pose at arc length s, heading along the ring (sigma 1) or against it (-1).
-  Pose at(double s, int sigma) const {
-    s = wrap(s);
-    const std::size_t i = segment(s);
-    const Eigen::Vector2d d = next(i) - pts_[i];
-    const double len = d.norm();
-    const Eigen::Vector2d p = len > 0.0 ? Eigen::Vector2d(pts_[i] + (s - cum_[i]) / len * d) : pts_[i];
-    return {p, std::atan2(d.y(), d.x()) + (sigma > 0 ? 0.0 : M_PI)};
-  }
-  /// Tool up along the ring from arc length s0 (the route is there) for len, the way sigma says.
-  void drive(RouteBuilder& route, double s0, double len, int sigma) const {
-    const std::size_t n = pts_.size();
-    const double a0 = wrap(s0);
-    const std::size_t i = segment(a0);
-    std::size_t j = sigma > 0 ? (i + 1) % n : i;
-    double to_vertex = sigma > 0 ? cum_[i + 1] - a0 : a0 - cum_[i];
-    while (to_vertex < len - 1e-9) {
-      route.lineTo(pts_[j], false);
-      const std::size_t k = sigma > 0 ? (j + 1) % n : (j + n - 1) % n;
-      to_vertex += (pts_[k] - pts_[j]).norm();
-      j = k;
-    }
-    route.lineTo(at(s0 + sigma * len, sigma).p, false);
-  }
-
- private:
-  const Eigen::Vector2d& next(std::size_t i) const { return pts_[(i + 1) % pts_.size()]; }
-  std::size_t segment(double s) const {
-    const auto it = std::upper_bound(cum_.begin(), cum_.end(), s);
-    const std::ptrdiff_t i = (it - cum_.begin()) - 1;
-    return static_cast<std::size_t>(std::clamp<std::ptrdiff_t>(i, 0, static_cast<std::ptrdiff_t>(pts_.size()) - 1));
-  }
-  Ring pts_;
-  std::vector<double> cum_;
-};
-
-/// The tool-up joins between parts and onto the headland loops, planned inside the field (docs/coverage.md, "Joins"):
-/// the direct turn-straight-turn when it stays in the headland band, else the shortest way along a headland ring both
-/// ends lie by (onto it, along it, off it) that stays in the band; where there is none (the ends by rings that do not
-/// meet, as round a void apart from the boundary), the way that crosses the inner field least (along the rings to
-/// their closest points and across there, or direct), inside the boundary and out of the voids; else the direct
-/// join, counted in `outside`.
-class FieldJoiner {
- public:
-  FieldJoiner(RouteBuilder& route, std::vector<std::vector<TravelRing>> families, geo::MultiPolygon band,
-              geo::MultiPolygon workable, double reach, double step)
-      : route_(route),
-        families_(std::move(families)),
-        band_(std::move(band)),
-        workable_(std::move(workable)),
-        reach_(reach),
-        step_(step) {}
-
-  double length = 0.0;  ///< of all joins [m]
-  int across = 0;       ///< joins that cross the inner field for want of a headland way
-  int outside = 0;      ///< joins that found no way inside the field
-
-  /// Tool up from a (the route's end) to b.
-  void join(const Pose& a, const Pose& b) {
-    const double before = route_.length;
-    joinImpl(a, b);
-    length += route_.length - before;
-  }
-
- private:
-  /// A turn-straight-turn tried: whether it holds, its points after its start, its length and the peaks so far.
-  struct Piece {
-    bool ok = false;
-    std::vector<Eigen::Vector2d> points;
-    double length = 0.0, peak_kappa = 0.0, peak_rate = 0.0;
-  };
-  /// A way tried: its cost and how to drive it.
-  struct Way {
-    double cost = std::numeric_limits<double>::infinity();
-    std::function<void()> drive;
-  };
-  static constexpr double kInf = std::numeric_limits<double>::infinity();
-
-  /// Whether the route from point index `from` on lies within `region`.
-  bool within(std::size_t from, const geo::MultiPolygon& region) const {
-    geo::Line l;
-    for (std::size_t i = from; i < route_.path.points.size(); ++i) l.push_back(geo::toPoint(route_.path.points[i]));
-    return l.size() < 2 || bg::within(l, region);
-  }
-
-  /// The turn-straight-turn from a to b (as the route's own joins), kept when it lies inside region; the route is
-  /// left as it was.
-  Piece tst(const Pose& a, const Pose& b, const geo::MultiPolygon& region) {
-    const RouteBuilder::Mark m = route_.mark();
-    route_.jumpTo(a.p);
-    const int straight = route_.straight_joins;
-    route_.connect(a, b);
-    Piece p;
-    p.ok = route_.straight_joins == straight && within(m.points, region);
-    if (p.ok) {
-      p.points.assign(route_.path.points.begin() + static_cast<std::ptrdiff_t>(m.points) + 1, route_.path.points.end());
-      p.length = route_.length - m.length;
-      p.peak_kappa = route_.peak_kappa;
-      p.peak_rate = route_.peak_rate;
-    }
-    route_.rollback(m);
-    return p;
-  }
-  void append(const Piece& p) { route_.appendUp(p.points, p.length, p.peak_kappa, p.peak_rate); }
-
-  void consider(Way& best, double cost, std::function<void()> drive) {
-    if (cost < best.cost) best = {cost, std::move(drive)};
-  }
-
-  /// Onto ring r from pose a, the nearest of a few steps ahead of s_a (sigma's way) that stays inside region: the
-  /// arc length where it meets the ring (unwrapped from s_a), NaN when none does.
-  double onto(const TravelRing& r, const Pose& a, double s_a, int sigma, const geo::MultiPolygon& region,
-              Piece& piece) {
-    for (const double k : {1.0, 2.0, 4.0, 8.0}) {
-      const double s = s_a + sigma * k * step_;
-      piece = tst(a, r.at(s, sigma), region);
-      if (piece.ok) return s;  // the nearest that fits: farther ones only add ramp
-    }
-    return std::numeric_limits<double>::quiet_NaN();
-  }
-  /// Off ring r onto pose b, from the nearest of a few steps before s_b: as onto.
-  double offOf(const TravelRing& r, const Pose& b, double s_b, int sigma, const geo::MultiPolygon& region,
-               Piece& piece) {
-    for (const double k : {1.0, 2.0, 4.0, 8.0}) {
-      const double s = s_b - sigma * k * step_;
-      piece = tst(r.at(s, sigma), b, region);
-      if (piece.ok) return s;
-    }
-    return std::numeric_limits<double>::quiet_NaN();
-  }
-
-  /// Along ring r from pose a onto pose b, both ways round, the ramps inside region and weighed `ramp_weight` per
-  /// metre on top of their length (they may cross the inner field). The ring itself keeps at least half a working
-  /// width off the boundary and the voids and half the headland off the inner field.
-  void alongRing(Way& best, const TravelRing& r, const Pose& a, double s_a, const Pose& b, double s_b,
-                 const geo::MultiPolygon& region, double ramp_weight) {
-    for (const int sigma : {1, -1}) {
-      Piece on, off;
-      const double s_on = onto(r, a, s_a, sigma, region, on);
-      if (std::isnan(s_on)) continue;
-      const double s_off = offOf(r, b, s_b, sigma, region, off);
-      if (std::isnan(s_off)) continue;
-      // The ring between them, sigma's way; ramps that pass each other leave the join to the direct way.
-      const double span = r.wrap(sigma * (s_b - s_a));
-      const double ramps = sigma * (s_on - s_a) + sigma * (s_b - s_off);
-      if (ramps > span) continue;
-      const double len_arc = span - ramps;
-      const double ramp_len = on.length + off.length;
-      consider(best, ramp_len + len_arc + ramp_weight * ramp_len, [this, &r, on, off, s_on, len_arc, sigma] {
-        append(on);
-        r.drive(route_, s_on, len_arc, sigma);
-        append(off);
-      });
-    }
-  }
-
-  /// Along ring ra from a to its point closest to ring rb, across to it, along rb onto b; `across_weight` per metre
-  /// across on top of the length.
-  void crossRings(Way& best, const Pose& a, double s_a, const TravelRing& ra, const Pose& b, double s_b,
-                  const TravelRing& rb, double across_weight) {
-    // The rings' closest points: every vertex of each projected onto the other.
-    double gap = kInf, s1 = 0.0, s2 = 0.0;
-    for (std::size_t i = 0; i < ra.points().size(); ++i) {
-      double s, d;
-      rb.project(ra.points()[i], s, d);
-      if (d < gap) {
-        gap = d;
-        s1 = ra.arcOf(i);
-        s2 = s;
-      }
-    }
-    for (std::size_t j = 0; j < rb.points().size(); ++j) {
-      double s, d;
-      ra.project(rb.points()[j], s, d);
-      if (d < gap) {
-        gap = d;
-        s1 = s;
-        s2 = rb.arcOf(j);
-      }
-    }
-    Piece offs[2];
-    double s_offs[2];
-    for (int i = 0; i < 2; ++i) s_offs[i] = offOf(rb, b, s_b, i == 0 ? 1 : -1, band_, offs[i]);
-    for (const int sa : {1, -1}) {
-      Piece on;
-      const double s_on = onto(ra, a, s_a, sa, band_, on);
-      if (std::isnan(s_on)) continue;
-      const double len_a = ra.wrap(sa * (s1 - s_on));
-      for (int i = 0; i < 2; ++i) {
-        const int sb = i == 0 ? 1 : -1;
-        if (std::isnan(s_offs[i])) continue;
-        const Piece cross = tst(ra.at(s1, sa), rb.at(s2, sb), workable_);
-        if (!cross.ok) continue;
-        const double len_b = rb.wrap(sb * (s_offs[i] - s2));
-        const Piece& off = offs[i];
-        consider(best, on.length + len_a + cross.length + len_b + off.length + across_weight * cross.length,
-                 [this, &ra, &rb, on, cross, off, s_on, len_a, sa, s2, len_b, sb] {
-                   append(on);
-                   ra.drive(route_, s_on, len_a, sa);
-                   append(cross);
-                   rb.drive(route_, s2, len_b, sb);
-                   append(off);
-                 });
-      }
-    }
-  }
-
-  /// The ring of `rings` nearest p within reach, or -1.
-  int nearestRing(const std::vector<TravelRing>& rings, const Eigen::Vector2d& p, double& s) const {
-    int best = -1;
-    double best_d = reach_;
-    for (std::size_t i = 0; i < rings.size(); ++i) {
-      double si, d;
-      rings[i].project(p, si, d);
-      if (d <= best_d) {
-        best_d = d;
-        best = static_cast<int>(i);
-        s = si;
-      }
-    }
-    return best;
-  }
-
-  void joinImpl(const Pose& a, const Pose& b) {
-    if ((b.p - a.p).norm() < 1e-9 && std::fabs(wrapAngle(b.h - a.h)) < 1e-6) return;
-    Way best;
-    // Through the headland band: direct when it stays there (the shortest way), else along a ring both ends lie by,
-    // the rings of the preferred offset first.
-    // (Not tried as a U-turn wider than the headland: it would cross the part it turns round, and its integration
-    // costs as much as the rest of the join.)
-    const Eigen::Vector2d local = rotate(b.p - a.p, -a.h);
-    const bool wide_u = std::fabs(wrapAngle(b.h - a.h - M_PI)) < 1e-6 && std::fabs(local.y()) > 2.0 * reach_;
-    if (!wide_u) {
-      const Piece direct = tst(a, b, band_);
-      if (direct.ok) consider(best, direct.length, [this, direct] { append(direct); });
-    }
-    for (const std::vector<TravelRing>& rings : families_) {
-      if (std::isfinite(best.cost)) break;
-      for (const TravelRing& r : rings) {
-        double s_a, d_a, s_b, d_b;
-        r.project(a.p, s_a, d_a);
-        r.project(b.p, s_b, d_b);
-        if (d_a <= reach_ && d_b <= reach_) alongRing(best, r, a, s_a, b, s_b, band_, 0.0);
-      }
-    }
-    if (!std::isfinite(best.cost)) {
-      // No headland way: across the inner field where it is narrowest, inside the boundary and out of the voids. A
-      // metre across it weighs as kAcross metres along the headland.
-      constexpr double kAcross = 5.0;
-      const Piece across_direct = tst(a, b, workable_);
-      if (across_direct.ok)
-        consider(best, (1.0 + kAcross) * across_direct.length, [this, across_direct] { append(across_direct); });
-      for (const std::vector<TravelRing>& rings : families_) {
-        double s_a = 0.0, s_b = 0.0;
-        const int ra = nearestRing(rings, a.p, s_a), rb = nearestRing(rings, b.p, s_b);
-        if (ra >= 0 && ra == rb) alongRing(best, rings[ra], a, s_a, b, s_b, workable_, kAcross);
-        if (ra >= 0 && rb >= 0 && ra != rb) crossRings(best, a, s_a, rings[ra], b, s_b, rings[rb], kAcross);
-        if (std::isfinite(best.cost)) break;
-      }
-      if (std::isfinite(best.cost)) ++across;
-    }
-    if (!std::isfinite(best.cost)) {
-      ++outside;
-      route_.connect(a, b);
-      return;
-    }
-    best.drive();
-  }
-
-  RouteBuilder& route_;
-  std::vector<std::vector<TravelRing>> families_;  // the rings at each offset tried, the preferred first
-  geo::MultiPolygon band_, workable_;
-  double reach_, step_;
-};
-
 }  // namespace
 
 CoveragePlan planCoverage(const FieldBoundary& field, const CoverageParams& params) {
@@ -1049,25 +700,6 @@ CoveragePlan planCoverage(const FieldBoundary& field, const CoverageParams& para
   plan.parts = static_cast<int>(parts.size());
   std::vector<bool> done(parts.size(), false);
   RouteBuilder route(params);
-  // The joins between parts and onto the headland loops keep to the headland band (the workable field outside the
-  // inner field, whose edge the swaths' ends lie on) along its middle ring, its corners rounded as the loops'.
-  const double rho = 1.1 * params.min_turn_radius;
-  const geo::MultiPolygon workable = geo::workable(field);
-  // Along the band's middle first (room to turn on both sides), else along the outermost pass, which still gets
-  // through where a void near the boundary pinches the middle ring off.
-  std::vector<std::vector<TravelRing>> travel;
-  for (const double d : {0.5 * k * w, 0.5 * w}) {
-    if (params.headland_passes == 0 || (!travel.empty() && d >= 0.5 * k * w)) continue;
-    geo::MultiPolygon ring_region;
-    bg::difference(geo::offset(outer, -d), geo::offset(voids, d), ring_region);
-    travel.emplace_back();
-    for (Ring& r : ringsOf(rounded(ring_region, rho)))
-      if (r.size() >= 3) travel.back().emplace_back(std::move(r));
-  }
-  geo::MultiPolygon band;
-  bg::difference(workable, geo::offset(inner, -1e-3 * w), band);
-  FieldJoiner joiner(route, std::move(travel), std::move(band), workable, (k + 0.5) * w + params.run_out,
-                     2.0 * params.min_turn_radius);
   bool started = false;
   Pose at;
   for (std::size_t visited = 0; visited < parts.size(); ++visited) {
@@ -1100,7 +732,6 @@ CoveragePlan planCoverage(const FieldBoundary& field, const CoverageParams& para
     const Part& pc = parts[best];
     const int m = static_cast<int>(pc.segs.size());
     int dir = best_dir;
-    bool first_of_part = true;
     for (const int o : lineOrder(m, plan.pattern)) {
       const int li = best_mirror ? m - 1 - o : o;
       const Swath s = makeSwath(lines, pc.first_line + li, pc.segs[li], dir, best, params);
@@ -1108,12 +739,9 @@ CoveragePlan planCoverage(const FieldBoundary& field, const CoverageParams& para
       if (!started) {
         route.start(s.a);
         started = true;
-      } else if (first_of_part) {
-        joiner.join(at, entry);
       } else {
         route.connect(at, entry);
       }
-      first_of_part = false;
       // The tool point trails the axle by run_out: it enters the row run_out after the swath's start and reaches its
       // end run_out past it, in the headland (k working widths of room).
       const Eigen::Vector2d on = params.run_out * unitVector(entry.h);
@@ -1129,6 +757,7 @@ CoveragePlan planCoverage(const FieldBoundary& field, const CoverageParams& para
   // driven the way that turns least onto it; corners rounded so every curve keeps min_turn_radius (10 % spare:
   // the rounding's uneven chords put the circle through three vertices up to 6 % tighter than the arc). Its straight
   // sides are sown as rows (headlandSide), its corners not: there the trailing tool point swings off the ring's line.
+  const double rho = 1.1 * params.min_turn_radius;
   for (int pass = params.headland_passes - 1; pass >= 0; --pass) {
     const double d = (pass + 0.5) * w;
     geo::MultiPolygon region;
@@ -1160,7 +789,7 @@ CoveragePlan planCoverage(const FieldBoundary& field, const CoverageParams& para
       const double forward = headingOf(loop[0], loop[1]), backward = headingOf(loop[0], loop.back());
       if (std::fabs(wrapAngle(backward - at.h)) < std::fabs(wrapAngle(forward - at.h)))
         std::reverse(loop.begin() + 1, loop.end());
-      joiner.join(at, {loop[0], headingOf(loop[0], loop[1])});
+      route.connect(at, {loop[0], headingOf(loop[0], loop[1])});
       // Tool down on the straight sides, each a row of the plan; up on the corners' chords.
       for (std::size_t i = 1; i <= loop.size(); ++i) {
         const Eigen::Vector2d &p = loop[i - 1], &q = loop[i % loop.size()];
@@ -1190,39 +819,7 @@ CoveragePlan planCoverage(const FieldBoundary& field, const CoverageParams& para
   plan.peak_curvature = route.peak_kappa;
   plan.peak_curvature_rate = route.peak_rate;
   plan.straight_joins = route.straight_joins;
-  plan.join_length = joiner.length;
-  plan.joins_across = joiner.across;
-  plan.joins_outside = joiner.outside;
-  plan.route_error = checkRoute(field, plan.route);
   return plan;
-}
-
-std::string checkRoute(const FieldBoundary& field, const CoveragePath& route) {
-  if (route.points.size() < 2) return "";
-  geo::Line line;
-  for (const Eigen::Vector2d& p : route.points) line.push_back(geo::toPoint(p));
-  // The first segment at fault, for the message (the whole line is tested first: one pass for a good route).
-  auto firstAt = [&route](const auto& bad) {
-    for (std::size_t i = 0; i + 1 < route.points.size(); ++i) {
-      geo::Line seg{geo::toPoint(route.points[i]), geo::toPoint(route.points[i + 1])};
-      if (bad(seg)) return "(" + formatNumber(route.points[i].x()) + ", " + formatNumber(route.points[i].y()) + ")";
-    }
-    return std::string("?");
-  };
-  const geo::Polygon outer = geo::outerPolygon(field);
-  if (!bg::within(line, outer))
-    return "the route leaves the field boundary after " +
-           firstAt([&outer](const geo::Line& seg) { return !bg::within(seg, outer); });
-  for (std::size_t i = 0; i < field.voids.size() + field.circles.size(); ++i) {
-    const bool is_circle = i >= field.voids.size();
-    const std::size_t j = is_circle ? i - field.voids.size() : i;
-    const geo::Polygon v = is_circle ? geo::circle({field.circles[j].x, field.circles[j].y}, field.circles[j].radius)
-                                     : geo::toPolygon(field.voids[j]);
-    if (bg::intersects(line, v))
-      return "the route enters " + std::string(is_circle ? "circular void " : "void ") + std::to_string(j) + " after " +
-             firstAt([&v](const geo::Line& seg) { return bg::intersects(seg, v); });
-  }
-  return "";
 }
 
 CoveragePath coverageFrom(const CoveragePlan& plan, const Pose2D& start, const CoverageParams& params) {

@@ -9,7 +9,6 @@
 #include <string>
 #include <vector>
 
-#include "sowing_robot/core/common/boost_geometry.h"
 #include "sowing_robot/core/planning/coverage_follower.h"
 #include "sowing_robot/core/planning/coverage_metrics.h"
 #include "sowing_robot/core/planning/coverage_planner.h"
@@ -64,44 +63,6 @@ double peakPointCurvature(const std::vector<Eigen::Vector2d>& pts) {
     if (denom > 0.0) peak = std::max(peak, 2.0 * std::fabs(a.x() * b.y() - a.y() * b.x()) / denom);
   }
   return peak;
-}
-
-/// config/fields/l_field_local.yaml: the L field of l_field.geojson (the rviz picture's) in its local frame; its west
-/// edge leans out to x = -0.6 m.
-FieldBoundary lField() {
-  FieldBoundary f;
-  f.outer = {{0, 0}, {121.3, 1.2}, {120.4, 55.8}, {61.0, 56.5}, {59.8, 110.2}, {-0.6, 109.4}};
-  f.voids = {{{20, 24}, {31, 21}, {39, 27}, {37, 37}, {27, 40}, {19, 34}}};
-  f.circles = {Obstacle{95.0, 30.0, 1.2}};
-  return f;
-}
-
-/// The route's points as a Boost linestring.
-namespace bg = boost::geometry;
-bg::model::linestring<sowing_robot::core::geo::Point> lineOf(const std::vector<Eigen::Vector2d>& pts) {
-  bg::model::linestring<sowing_robot::core::geo::Point> l;
-  for (const Eigen::Vector2d& p : pts) l.push_back(sowing_robot::core::geo::toPoint(p));
-  return l;
-}
-
-/// Whether the whole route lies within the outer boundary and meets no void (Boost.Geometry's within and intersects;
-/// circles as 72-gons just outside the circle, so that a route that only grazes the planner's 36-gon still fails).
-void expectRouteInside(const FieldBoundary& f, const CoveragePlan& plan) {
-  namespace geo = sowing_robot::core::geo;
-  const auto line = lineOf(plan.route.points);
-  EXPECT_TRUE(bg::within(line, geo::toPolygon(f.outer))) << "the route leaves the field boundary";
-  for (std::size_t i = 0; i < f.voids.size(); ++i)
-    EXPECT_FALSE(bg::intersects(line, geo::toPolygon(f.voids[i]))) << "the route enters void " << i;
-  for (std::size_t i = 0; i < f.circles.size(); ++i) {
-    Ring c;
-    const double r = f.circles[i].radius / std::cos(M_PI / 72.0);
-    for (int k = 0; k < 72; ++k)
-      c.push_back(
-          {f.circles[i].x + r * std::cos(2.0 * M_PI * k / 72), f.circles[i].y + r * std::sin(2.0 * M_PI * k / 72)});
-    EXPECT_FALSE(bg::intersects(line, geo::toPolygon(c))) << "the route enters circular void " << i;
-  }
-  EXPECT_EQ(plan.route_error, "");
-  EXPECT_EQ(plan.joins_outside, 0);
 }
 
 std::string errorOf(const FieldBoundary& f, const CoverageParams& p) {
@@ -185,44 +146,6 @@ TEST(CoveragePlanner, LShapedHectareWithTwoVoidsIsCoveredWithinItsTurnBounds) {
   EXPECT_EQ(plan.headland_rings.size(), 2u * 3u);  // two passes round the boundary, the pond and the tree
   // Auto heading: along the long edges (the fewest swaths).
   EXPECT_NEAR(std::fmod(plan.heading, M_PI / 2.0), 0.0, 1e-9);
-  expectRouteInside(f, plan);
-}
-
-// The L field of the rviz picture (l_field.geojson's local frame), with and without the tool's run-out: every join
-// between its parts and onto its headland loops stays inside the boundary and out of the pond and the pole, within
-// the turn bounds. The pond's and the pole's headland rings do not meet the boundary's, so the joins onto their
-// loops cross the inner field (joins_across), and only those.
-TEST(CoveragePlanner, TheLFieldsJoinsStayInsideTheField) {
-  for (const double run_out : {0.0, 0.45}) {
-    CoverageParams p;
-    p.run_out = run_out;
-    const CoveragePlan plan = planCoverage(lField(), p);
-    SCOPED_TRACE("run_out " + std::to_string(run_out));
-    std::printf(
-        "L field, run-out %.2f m: %zu swaths in %d parts, path %.0f m, turns %.0f m, joins %.0f m (%d across "
-        "the inner field)\n",
-        run_out, plan.swaths.size(), plan.parts, plan.path_length, plan.turn_length, plan.join_length,
-        plan.joins_across);
-    expectRouteInside(lField(), plan);
-    EXPECT_EQ(plan.straight_joins, 0);
-    EXPECT_GT(plan.parts, 1);
-    EXPECT_GT(plan.join_length, 0.0);
-    EXPECT_LE(plan.join_length, plan.turn_length);
-    // Across the inner field only onto the loops round the pond and the pole (one per pass and void at most).
-    EXPECT_LE(plan.joins_across, 2 * 2);
-    EXPECT_LE(plan.peak_curvature, 1.0 / p.min_turn_radius + 1e-9);
-    EXPECT_LE(plan.peak_curvature_rate, p.max_curvature_rate + 1e-9);
-    EXPECT_LE(peakPointCurvature(plan.route.points), 1.02 / p.min_turn_radius);
-  }
-  // The check names what it finds: a route through the pond, and one off the field.
-  CoveragePath through;
-  through.points = {{10.0, 30.0}, {45.0, 30.0}};
-  through.tool_down = {false};
-  EXPECT_EQ(checkRoute(lField(), through).rfind("the route enters void 0 after (10, 30)", 0), 0u)
-      << checkRoute(lField(), through);
-  through.points = {{10.0, 30.0}, {-5.0, 30.0}};
-  EXPECT_EQ(checkRoute(lField(), through).rfind("the route leaves the field boundary after (10, 30)", 0), 0u)
-      << checkRoute(lField(), through);
 }
 
 // A void reaching across the inner field splits it in two: both sides swept, joined through the headland.
@@ -243,23 +166,6 @@ TEST(CoveragePlanner, ASplittingVoidIsCoveredOnBothSides) {
   EXPECT_GE(fig.covered_inner_share, 0.99);
   EXPECT_EQ(plan.straight_joins, 0);
   EXPECT_LE(peakPointCurvature(plan.route.points), 1.02 / p.min_turn_radius);
-  expectRouteInside(f, plan);
-  // The headland joins both sides: no tool-up stretch (joins, turns) crosses either side's swaths, whose strips
-  // fill the inner field (2 m in from the boundary, 2 m off the void); the run-out is 0, so the tool is down on every
-  // swath from its start.
-  EXPECT_EQ(plan.joins_across, 0);
-  EXPECT_GT(plan.join_length, 0.0);
-  namespace geo = sowing_robot::core::geo;
-  using Box = bg::model::box<geo::Point>;
-  const Box sides[2] = {Box(geo::Point(2.01, 2.01), geo::Point(25.99, 37.99)),
-                        Box(geo::Point(34.01, 2.01), geo::Point(57.99, 37.99))};
-  for (std::size_t i = 0; i < plan.route.tool_down.size(); ++i) {
-    if (plan.route.tool_down[i]) continue;
-    const auto seg = lineOf({plan.route.points[i], plan.route.points[i + 1]});
-    for (const Box& side : sides)
-      EXPECT_FALSE(bg::intersects(seg, side))
-          << "tool-up segment " << i << " from (" << plan.route.points[i].transpose() << ") crosses the swaths";
-  }
 }
 
 TEST(CoveragePlanner, AutoHeadingFollowsTheLongEdges) {

@@ -33,7 +33,6 @@ struct CoverageFigures {
   int swaths = 0;
   double path_length = 0.0;  ///< [m]
   double turn_length = 0.0;  ///< tool up [m]
-  double join_length = 0.0;  ///< of it the joins between parts and onto the headland loops [m]
 };
 
 /// The figures of `plan` over `field` (the field it was planned on).

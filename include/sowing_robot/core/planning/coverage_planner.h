@@ -99,15 +99,6 @@ struct CoveragePlan {
   double peak_curvature_rate = 0.0;  ///< largest |dkappa/ds| planned on the turns [1/m^2]
   /// Joins for which no turn-straight-turn was found, driven as a straight line instead (0 expected).
   int straight_joins = 0;
-  /// The tool-up joins between parts, onto the first headland loop and between the loops [m] (part of turn_length).
-  double join_length = 0.0;
-  /// Joins that cross the inner field because no way through the headland band joins their ends (ends on rings of
-  /// the headland that do not meet, as round a void apart from the boundary).
-  int joins_across = 0;
-  /// Joins for which no way inside the field was found, driven as the direct join (0 expected; route_error says where).
-  int joins_outside = 0;
-  /// checkRoute(field, route): "" when no part of the route leaves the boundary or enters a void.
-  std::string route_error;
   /// Every swath's tool rows, in route order, then the headland rows: the plan's rows (FieldPlan, SeedDrill).
   std::vector<RowSegment> rows() const;
   /// How many of rows() are the swaths' (the headland rows follow them).
@@ -128,11 +119,6 @@ std::vector<RowSegment> headlandSideRows(const Eigen::Vector2d& p, const Eigen::
 /// "" when the boundary can be planned on, else one line: a ring with too few points or non-finite ones, a
 /// self-intersecting boundary or void (Boost.Geometry's reason), a void (polygon or circle) outside the field.
 std::string checkBoundary(const FieldBoundary& field);
-
-/// "" when the route lies within the field's outer boundary and meets none of its voids (polygons and circles as
-/// planned, 36-gons), else one line naming the first segment at fault ("the route leaves the field boundary after
-/// (x, y)", "the route enters void i after (x, y)"). Boost.Geometry's within and intersects.
-std::string checkRoute(const FieldBoundary& field, const CoveragePath& route);
 
 /// The plan over `field`. Throws std::invalid_argument with one line (checkBoundary, params.validate(), or a
 /// field narrower than one swath plus its headlands).
