@@ -29,9 +29,8 @@ const ParamTable<SeedingParams>& seedingTable() {
       number("detour_margin", &P::detour_margin, 4.0, Limits::nonNegative(), "m",
              "seeds within radius + influence_distance + this of an obstacle are detour seeds, reported apart "
              "(the reference rejoins the row about 3 m after leaving the influence zone at 1 m/s)"),
-      number("engage_distance", &P::engage_distance, 0.02, Limits::positive(), "m",
-             "the tool is lowered once the tool point is this close to a row (the tolerance: a seed there is on the "
-             "line; at 1 cm, about the tracking's own p95, the drill waited 1-2 m into a row for the error to dip)"),
+      number("engage_distance", &P::engage_distance, 0.01, Limits::positive(), "m",
+             "the tool is lowered once the tool point is this close to a row"),
       number("depth_min", &P::depth_min, 0.03, Limits::positive(), "m",
              "shallowest depth of the agronomic band (maize, sunflower: 3-5 cm; seeds above it are counted)"),
       number("depth_max", &P::depth_max, 0.05, Limits::positive(), "m",

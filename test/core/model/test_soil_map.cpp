@@ -166,7 +166,7 @@ TEST(SoilMap, OneWheelOnTheWetPatchTurnsTheRobot) {
 }
 
 TEST(ToolEngagement, LowersOnTheRowRaisesBeyondItsEnds) {
-  SeedingParams sp;  // engage_distance 0.02
+  SeedingParams sp;  // engage_distance 0.01
   ToolEngagement tool(sp, {{{0.0, 3.0}, {100.0, 3.0}}});
   EXPECT_FALSE(tool.update({-1.0, 3.0}));   // before the row
   EXPECT_FALSE(tool.update({5.0, 3.5}));    // beside it, too far to lower
