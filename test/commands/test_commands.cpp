@@ -61,7 +61,8 @@ const std::vector<std::string> kScripts{"run",
                                         "dev/path_evidence",
                                         "dev/seed_evidence",
                                         "dev/seed_evidence_table",
-                                        "dev/recording_sizes"};
+                                        "dev/recording_sizes",
+                                        "dev/fleet_figures"};
 
 struct Outcome {
   int status = -1;

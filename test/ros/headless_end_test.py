@@ -92,11 +92,9 @@ class HeadlessEnd(unittest.TestCase):
             self.assertIn(w, last)
 
     def test_no_traction_exits_5(self):
-        # no_traction.test's field: the verdict at t = 26.2 s, the run ends 3 s later, before its duration. (With the
-        # drill, and so its draft, engaging within 1 cm of the row the verdict came at 19.6 s; within 2 cm,
-        # kanayama+atsmc creeps 0.13 m further into the patch before the verdict.)
+        # no_traction.test's field: the verdict at t = 19.6 s, the run ends 3 s later, before its duration.
         self.check_end_code(11678, "no_traction_overlay.yaml", 40.0, 5,
-                            ["run_monitor: the run ended on no traction: no traction at (", "ended at t = 29."])
+                            ["run_monitor: the run ended on no traction: no traction at (", "ended at t = 22."])
 
     def test_stopped_short_exits_6(self):
         # stop_hold.test's field: a 20 m row whose end lies inside an obstacle. The code comes from the plan's status
