@@ -7,8 +7,9 @@
 //                       LINE_STRIP per ring, in the order they are driven
 //   coverage/swaths     (visualization_msgs/MarkerArray) one LINE_LIST (ns "swaths"): a pair of points per swath, its
 //                       centre line from where it is entered to where it is left, in route order
-//   coverage/route      (nav_msgs/Path) the route driven: the tool-up approach from the start pose (coverageFrom), then
-//                       the swaths, turns and headland loops; each pose heads along the segment it starts
+//   coverage/route      (nav_msgs/Path) the route driven from its start (ros/coverage_route.h: the route's own start,
+//                       or a fleet robot's share after its start pose): the swaths, turns and headland loops; each
+//                       pose heads along the segment it starts
 // geometry_msgs/PolygonStamped holds one ring (a field with voids has several), hence the markers for display. The
 // messages are built by the functions below, so a test needs no master to check them.
 #pragma once

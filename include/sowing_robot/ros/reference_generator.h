@@ -11,9 +11,12 @@
 //               With field/follower path: core::FieldPathReference, the field's rows and turns as a path
 //               through the follower of type path (core/planning/field_path_follower.h), with its reports.
 //   type coverage: the field of a field file (field_file, docs/field_file.md) planned by the coverage planner
-//               (coverage/..., core/planning/coverage_planner.h) and its route followed from run/start by the
-//               path follower (coverageReference, core/planning/coverage_follower.h); the plan on coverage/...
-//               (ros/coverage_topics.h), its swaths' tool rows on `plan` for the seed drill.
+//               (coverage/..., core/planning/coverage_planner.h) and its route (ros/coverage_route.h: from the
+//               route's own start, where plant_sim places the robot; with fleet/robots, this robot's share after
+//               its planned wait, core/planning/fleet_share.h) followed by the path follower
+//               (coverageFollowerParams, core/planning/coverage_follower.h); the plan on coverage/...
+//               (ros/coverage_topics.h); on `plan` for the seed drill the swaths' and headland rows (a fleet
+//               robot: its own swaths' rows).
 //   type path:  core::PathReference (a given path, rounded and timed: core/planning/path_plan.h), from
 //               path/points or nav_msgs/Path on `path`; ros/path_follower.h says what it reports.
 // Speed governor (speed_governor/..., core/planning/speed_governor.h; off by default): the source's time runs
